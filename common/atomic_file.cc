@@ -1,0 +1,86 @@
+#include "common/atomic_file.h"
+
+#include <fstream>
+#include <opencv2/imgcodecs.hpp>
+#include <unistd.h>
+
+#include "common/errors.h"
+
+namespace docunfold {
+
+AtomicOutput::AtomicOutput(const fs::path& target) : target_(target) {
+  EnsureDirectory(target.has_parent_path() ? target.parent_path()
+                                           : fs::path("."));
+  temp_ = target;
+  temp_.replace_filename("." + target.stem().string() + ".tmp." +
+                         std::to_string(::getpid()) +
+                         target.extension().string());
+}
+
+AtomicOutput::~AtomicOutput() {
+  if (!committed_) {
+    std::error_code ec;
+    fs::remove(temp_, ec);
+  }
+}
+
+void AtomicOutput::Commit() {
+  std::error_code ec;
+  if (!fs::exists(temp_, ec))
+    throw OutputError(target_.string() + ": nothing was written");
+  fs::rename(temp_, target_, ec);
+  if (ec)
+    throw OutputError(target_.string() + ": cannot rename temporary file: " +
+                      ec.message());
+  committed_ = true;
+}
+
+void EnsureDirectory(const fs::path& dir) {
+  std::error_code ec;
+  if (dir.empty()) return;
+  fs::create_directories(dir, ec);
+  if (ec || !fs::is_directory(dir))
+    throw OutputError(dir.string() + ": cannot create directory" +
+                      (ec ? ": " + ec.message() : std::string()));
+}
+
+void WriteTextAtomic(const fs::path& path, const std::string& text) {
+  AtomicOutput out(path);
+  {
+    std::ofstream f(out.temp_path(), std::ios::binary);
+    f << text;
+    f.close();
+    if (!f) throw OutputError(path.string() + ": write failed");
+  }
+  out.Commit();
+}
+
+void WriteImageAtomic(const fs::path& path, const cv::Mat& image,
+                      const std::vector<int>& params) {
+  if (image.empty()) throw OutputError(path.string() + ": empty image");
+  AtomicOutput out(path);
+  bool ok = false;
+  try {
+    ok = cv::imwrite(out.temp_path().string(), image, params);
+  } catch (const cv::Exception& e) {
+    throw OutputError(path.string() + ": " + e.what());
+  }
+  if (!ok) throw OutputError(path.string() + ": cannot encode or write image");
+  out.Commit();
+}
+
+cv::Mat ReadImage(const fs::path& path, int flags) {
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec))
+    throw InputError(path.string() + ": no such file");
+  cv::Mat image;
+  try {
+    image = cv::imread(path.string(), flags);
+  } catch (const cv::Exception&) {
+  }
+  if (image.empty())
+    throw InputError(path.string() + ": not a readable image");
+  return image;
+}
+
+}  // namespace docunfold

@@ -1,0 +1,48 @@
+// Atomic output: everything is written to a temporary file beside the target
+// and renamed into place only when complete, so a failed or interrupted stage
+// never leaves a truncated file behind.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+namespace docunfold {
+
+namespace fs = std::filesystem;
+
+// A temporary path beside `target` that keeps its extension (so encoders that
+// choose a format by extension still work). Commit() renames it onto the
+// target; the destructor removes it if Commit() was never reached.
+class AtomicOutput {
+ public:
+  explicit AtomicOutput(const fs::path& target);
+  ~AtomicOutput();
+  AtomicOutput(const AtomicOutput&) = delete;
+  AtomicOutput& operator=(const AtomicOutput&) = delete;
+
+  const fs::path& temp_path() const { return temp_; }
+  const fs::path& target() const { return target_; }
+  // Renames the temporary file onto the target; throws OutputError.
+  void Commit();
+
+ private:
+  fs::path target_;
+  fs::path temp_;
+  bool committed_ = false;
+};
+
+// Creates `dir` and its parents; throws OutputError when that fails.
+void EnsureDirectory(const fs::path& dir);
+
+void WriteTextAtomic(const fs::path& path, const std::string& text);
+// Writes an 8- or 16-bit image with cv::imwrite; format from the extension.
+void WriteImageAtomic(const fs::path& path, const cv::Mat& image,
+                      const std::vector<int>& params = {});
+
+// Reads an image or throws InputError naming the file.
+cv::Mat ReadImage(const fs::path& path, int flags = 1 /*cv::IMREAD_COLOR*/);
+
+}  // namespace docunfold

@@ -1,0 +1,60 @@
+// The pinhole camera (OpenCV axes: x right, y down, z forward; pixel centres
+// at integer coordinates) and the cameras.json files that hold sets of them.
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "common/json_io.h"
+
+namespace docunfold {
+
+struct PinholeCamera {
+  std::string image;  // file name of the photo (relative to images/)
+  int width = 0;      // image size in pixels
+  int height = 0;
+  Eigen::Matrix3d K = Eigen::Matrix3d::Identity();  // intrinsics
+  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();  // cam_from_world rotation
+  Eigen::Vector3d t = Eigen::Vector3d::Zero();      // cam_from_world translation
+
+  Eigen::Vector3d CamFromWorld(const Eigen::Vector3d& x_world) const {
+    return R * x_world + t;
+  }
+  // Camera centre in world coordinates.
+  Eigen::Vector3d Center() const { return -R.transpose() * t; }
+  // Pixel of a point given in camera coordinates (z must be > 0).
+  Eigen::Vector2d ProjectCam(const Eigen::Vector3d& x_cam) const {
+    Eigen::Vector3d p = K * x_cam;
+    return p.head<2>() / p.z();
+  }
+  Eigen::Vector2d Project(const Eigen::Vector3d& x_world) const {
+    return ProjectCam(CamFromWorld(x_world));
+  }
+  // Unit viewing direction of a pixel, in world coordinates.
+  Eigen::Vector3d RayDirection(const Eigen::Vector2d& pixel) const {
+    Eigen::Vector3d d = K.inverse() * Eigen::Vector3d(pixel.x(), pixel.y(), 1);
+    return (R.transpose() * d).normalized();
+  }
+};
+
+// A cameras.json file: either ground truth ("docunfold.gt-cameras") or the
+// output of sfm ("docunfold.cameras", which also names the reference view).
+struct CameraSet {
+  std::string reference;  // image name of the reference view ("" if none)
+  std::vector<PinholeCamera> views;
+
+  const PinholeCamera* Find(const std::string& image) const;
+};
+
+// Reads either format; validates shapes and finiteness (throws InputError).
+CameraSet ReadCameras(const fs::path& path);
+
+// JSON for one camera: {"image","width","height","K","R","t"}.
+Json CameraToJson(const PinholeCamera& camera);
+
+}  // namespace docunfold

@@ -1,0 +1,48 @@
+// Command-line plumbing shared by every stage: parsing with CLI11 into an
+// options struct, exception-to-exit-code mapping, and rate-limited logging.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <functional>
+#include <string>
+
+#include "common/errors.h"
+
+namespace docunfold {
+
+// Version string of the whole project (from CMake).
+const char* ProgramVersion();
+
+// Name used as the prefix of every log line ("sfm: ...").
+void SetProgramName(const std::string& name);
+const std::string& ProgramName();
+
+// Runs `body` and maps what it throws to an exit code, printing exactly one
+// line "<program>: error: <message>" to stderr. CLI11 parse errors become
+// exit 2 (or 0 for --help / --version).
+int RunStage(const std::string& program, CLI::App& app, int argc, char** argv,
+             const std::function<void()>& body);
+
+// One plain line on stderr: "<program>: <message>".
+void Log(const std::string& message);
+
+// Progress of a long loop, logged at most about once a second, plus the last
+// step when `Done` is called.
+class Progress {
+ public:
+  Progress(std::string what, long total);
+  void Update(long done);
+  void Done();
+
+ private:
+  std::string what_;
+  long total_;
+  std::chrono::steady_clock::time_point start_;
+  std::chrono::steady_clock::time_point last_;
+};
+
+// Seconds since `start` as a double; for summaries and log.json.
+double SecondsSince(std::chrono::steady_clock::time_point start);
+
+}  // namespace docunfold

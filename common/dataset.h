@@ -1,0 +1,29 @@
+// A data set on disk: images/ with the photos and, optionally,
+// ground_truth/ (DESIGN.md §3).
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace docunfold {
+
+namespace fs = std::filesystem;
+
+struct DataSet {
+  fs::path root;
+  std::vector<fs::path> images;  // sorted by file name
+  bool has_ground_truth = false;
+
+  fs::path ground_truth(const std::string& file) const {
+    return root / "ground_truth" / file;
+  }
+};
+
+// True for the photo extensions we accept (jpg, jpeg, png, tif, tiff; any case).
+bool IsImageFile(const fs::path& path);
+
+// Lists a data set; throws InputError when the folder or images/ is missing.
+DataSet OpenDataSet(const fs::path& root);
+
+}  // namespace docunfold

@@ -1,0 +1,373 @@
+#include "common/ply.h"
+
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+#include "common/atomic_file.h"
+#include "common/errors.h"
+
+namespace docunfold {
+namespace {
+
+const char* ScalarName(PlyScalar t) {
+  switch (t) {
+    case PlyScalar::kFloat32: return "float";
+    case PlyScalar::kFloat64: return "double";
+    case PlyScalar::kInt32: return "int";
+    case PlyScalar::kUint32: return "uint";
+    case PlyScalar::kUint8: return "uchar";
+  }
+  return "float";
+}
+
+bool ParseScalar(const std::string& s, PlyScalar* t, int* size) {
+  struct Entry { const char* a; const char* b; PlyScalar t; int size; };
+  static const Entry kTable[] = {
+      {"float", "float32", PlyScalar::kFloat32, 4},
+      {"double", "float64", PlyScalar::kFloat64, 8},
+      {"int", "int32", PlyScalar::kInt32, 4},
+      {"uint", "uint32", PlyScalar::kUint32, 4},
+      {"uchar", "uint8", PlyScalar::kUint8, 1}};
+  for (const Entry& e : kTable)
+    if (s == e.a || s == e.b) { *t = e.t; *size = e.size; return true; }
+  // Types we read but never write.
+  if (s == "char" || s == "int8") { *t = PlyScalar::kInt32; *size = -1; return true; }
+  if (s == "short" || s == "int16") { *t = PlyScalar::kInt32; *size = -2; return true; }
+  if (s == "ushort" || s == "uint16") { *t = PlyScalar::kUint32; *size = -2; return true; }
+  return false;
+}
+
+// A scalar type as it appears in a file being read: byte size and signedness.
+struct FileType {
+  PlyScalar t = PlyScalar::kFloat32;
+  int bytes = 4;
+  bool is_signed_small = false;  // char/short
+};
+
+FileType ToFileType(const std::string& name, bool* ok) {
+  FileType ft;
+  int size = 0;
+  *ok = ParseScalar(name, &ft.t, &size);
+  if (size < 0) {
+    ft.bytes = -size;
+    ft.is_signed_small = (name == "char" || name == "int8" || name == "short" ||
+                          name == "int16");
+  } else {
+    ft.bytes = size;
+  }
+  return ft;
+}
+
+template <typename T>
+T SwapIfNeeded(T v, bool swap) {
+  if (!swap) return v;
+  unsigned char b[sizeof(T)];
+  std::memcpy(b, &v, sizeof(T));
+  for (size_t i = 0; i < sizeof(T) / 2; ++i) std::swap(b[i], b[sizeof(T) - 1 - i]);
+  std::memcpy(&v, b, sizeof(T));
+  return v;
+}
+
+double DecodeBinary(const unsigned char* p, const FileType& ft, bool swap) {
+  switch (ft.bytes) {
+    case 1:
+      return ft.is_signed_small ? double(*reinterpret_cast<const int8_t*>(p))
+                                : double(*p);
+    case 2: {
+      uint16_t u;
+      std::memcpy(&u, p, 2);
+      u = SwapIfNeeded(u, swap);
+      return ft.is_signed_small ? double(int16_t(u)) : double(u);
+    }
+    case 4: {
+      uint32_t u;
+      std::memcpy(&u, p, 4);
+      u = SwapIfNeeded(u, swap);
+      if (ft.t == PlyScalar::kFloat32) { float f; std::memcpy(&f, &u, 4); return f; }
+      if (ft.t == PlyScalar::kInt32) return double(int32_t(u));
+      return double(u);
+    }
+    default: {
+      uint64_t u;
+      std::memcpy(&u, p, 8);
+      u = SwapIfNeeded(u, swap);
+      double d;
+      std::memcpy(&d, &u, 8);
+      return d;
+    }
+  }
+}
+
+void EncodeBinary(std::string* out, double v, PlyScalar t) {
+  auto put = [out](const void* p, size_t n) {
+    out->append(static_cast<const char*>(p), n);
+  };
+  switch (t) {
+    case PlyScalar::kFloat32: { float f = float(v); put(&f, 4); break; }
+    case PlyScalar::kFloat64: put(&v, 8); break;
+    case PlyScalar::kInt32: { int32_t i = int32_t(std::lround(v)); put(&i, 4); break; }
+    case PlyScalar::kUint32: { uint32_t i = uint32_t(std::llround(v)); put(&i, 4); break; }
+    case PlyScalar::kUint8: { uint8_t i = uint8_t(std::lround(v)); put(&i, 1); break; }
+  }
+}
+
+bool HostIsLittleEndian() {
+  uint16_t x = 1;
+  unsigned char c;
+  std::memcpy(&c, &x, 1);
+  return c == 1;
+}
+
+}  // namespace
+
+const PlyProperty* PlyData::FindProperty(const std::string& name) const {
+  for (const PlyProperty& p : properties)
+    if (p.name == name) return &p;
+  return nullptr;
+}
+
+void PlyData::SetProperty(const std::string& name, std::vector<double> values,
+                          PlyScalar type) {
+  for (PlyProperty& p : properties)
+    if (p.name == name) { p.values = std::move(values); p.type = type; return; }
+  properties.push_back({name, type, std::move(values)});
+}
+
+std::optional<std::string> PlyData::CommentValue(const std::string& key) const {
+  for (const std::string& c : comments) {
+    if (c.compare(0, key.size(), key) == 0 &&
+        (c.size() == key.size() || c[key.size()] == ' '))
+      return c.size() > key.size() ? c.substr(key.size() + 1) : std::string();
+  }
+  return std::nullopt;
+}
+
+std::optional<std::array<int, 2>> PlyData::GridSize() const {
+  auto v = CommentValue("grid");
+  if (!v) return std::nullopt;
+  std::istringstream s(*v);
+  int nx = 0, ny = 0;
+  if (!(s >> nx >> ny) || nx < 2 || ny < 2 ||
+      size_t(nx) * size_t(ny) != vertices.size())
+    return std::nullopt;
+  return std::array<int, 2>{nx, ny};
+}
+
+void PlyData::SetGridSize(int nx, int ny) {
+  for (auto it = comments.begin(); it != comments.end();)
+    it = (it->rfind("grid ", 0) == 0) ? comments.erase(it) : it + 1;
+  comments.push_back("grid " + std::to_string(nx) + " " + std::to_string(ny));
+}
+
+void WritePly(const fs::path& path, const PlyData& ply, PlyEncoding encoding) {
+  const size_t n = ply.vertices.size();
+  if (!ply.colors.empty() && ply.colors.size() != n)
+    throw std::invalid_argument("WritePly: colors size differs from vertices");
+  for (const PlyProperty& p : ply.properties)
+    if (p.values.size() != n)
+      throw std::invalid_argument("WritePly: property " + p.name +
+                                  " size differs from vertices");
+  for (const auto& f : ply.faces)
+    for (int i : f)
+      if (i < 0 || size_t(i) >= n)
+        throw std::invalid_argument("WritePly: face index out of range");
+
+  const bool binary = encoding == PlyEncoding::kBinary;
+  std::string out;
+  out += "ply\nformat ";
+  out += binary ? (HostIsLittleEndian() ? "binary_little_endian" : "binary_big_endian")
+                : "ascii";
+  out += " 1.0\n";
+  for (const std::string& c : ply.comments) out += "comment " + c + "\n";
+  out += "element vertex " + std::to_string(n) + "\n";
+  out += "property float x\nproperty float y\nproperty float z\n";
+  if (!ply.colors.empty())
+    out += "property uchar red\nproperty uchar green\nproperty uchar blue\n";
+  for (const PlyProperty& p : ply.properties)
+    out += std::string("property ") + ScalarName(p.type) + " " + p.name + "\n";
+  if (!ply.faces.empty()) {
+    out += "element face " + std::to_string(ply.faces.size()) + "\n";
+    out += "property list uchar int vertex_indices\n";
+  }
+  out += "end_header\n";
+
+  std::ostringstream text;
+  text.precision(9);
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Vector3d& v = ply.vertices[i];
+    if (binary) {
+      for (int k = 0; k < 3; ++k) EncodeBinary(&out, v[k], PlyScalar::kFloat32);
+      if (!ply.colors.empty())
+        for (int k = 0; k < 3; ++k) out.push_back(char(ply.colors[i][k]));
+      for (const PlyProperty& p : ply.properties)
+        EncodeBinary(&out, p.values[i], p.type);
+    } else {
+      text << float(v[0]) << ' ' << float(v[1]) << ' ' << float(v[2]);
+      if (!ply.colors.empty())
+        for (int k = 0; k < 3; ++k) text << ' ' << int(ply.colors[i][k]);
+      for (const PlyProperty& p : ply.properties) {
+        if (p.type == PlyScalar::kFloat32) text << ' ' << float(p.values[i]);
+        else if (p.type == PlyScalar::kFloat64) text << ' ' << p.values[i];
+        else text << ' ' << std::llround(p.values[i]);
+      }
+      text << '\n';
+    }
+  }
+  for (const auto& f : ply.faces) {
+    if (binary) {
+      out.push_back(char(uint8_t(f.size())));
+      for (int idx : f) EncodeBinary(&out, idx, PlyScalar::kInt32);
+    } else {
+      text << f.size();
+      for (int idx : f) text << ' ' << idx;
+      text << '\n';
+    }
+  }
+  if (!binary) out += text.str();
+  WriteTextAtomic(path, out);
+}
+
+PlyData ReadPly(const fs::path& path) {
+  std::ifstream f(path, std::ios::binary);
+  if (!f) throw InputError(path.string() + ": cannot open file");
+  auto fail = [&](const std::string& what) -> void {
+    throw InputError(path.string() + ": " + what);
+  };
+  std::string line;
+  if (!std::getline(f, line) || line.rfind("ply", 0) != 0)
+    fail(line.empty() && f.eof() ? "empty file" : "not a PLY file");
+
+  struct Prop { std::string name; FileType type; bool is_list = false; FileType count_type; };
+  struct Element { std::string name; size_t count = 0; std::vector<Prop> props; };
+  std::vector<Element> elements;
+  std::string format;
+  PlyData ply;
+  while (true) {
+    if (!std::getline(f, line)) fail("header ends before end_header");
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    std::istringstream s(line);
+    std::string word;
+    s >> word;
+    if (word == "end_header") break;
+    if (word == "format") {
+      s >> format;
+    } else if (word == "comment" || word == "obj_info") {
+      ply.comments.push_back(line.size() > word.size() + 1 ? line.substr(word.size() + 1) : "");
+    } else if (word == "element") {
+      Element e;
+      long long count = -1;
+      s >> e.name >> count;
+      if (count < 0) fail("bad element line: " + line);
+      e.count = size_t(count);
+      elements.push_back(e);
+    } else if (word == "property") {
+      if (elements.empty()) fail("property before any element");
+      Prop p;
+      std::string type;
+      s >> type;
+      bool ok = true;
+      if (type == "list") {
+        std::string count_type, item_type;
+        s >> count_type >> item_type >> p.name;
+        bool ok2 = true;
+        p.is_list = true;
+        p.count_type = ToFileType(count_type, &ok);
+        p.type = ToFileType(item_type, &ok2);
+        ok = ok && ok2;
+      } else {
+        s >> p.name;
+        p.type = ToFileType(type, &ok);
+      }
+      if (!ok) fail("unsupported property type in: " + line);
+      elements.back().props.push_back(p);
+    } else if (!word.empty()) {
+      fail("unexpected header line: " + line);
+    }
+  }
+  const bool ascii = format == "ascii";
+  const bool swap = (format == "binary_little_endian") != HostIsLittleEndian();
+  if (!ascii && format != "binary_little_endian" && format != "binary_big_endian")
+    fail("unknown format '" + format + "'");
+
+  // Reads one scalar of the given type from the body.
+  auto read_value = [&](const FileType& ft) -> double {
+    if (ascii) {
+      // strtod, unlike operator>>, accepts "nan" and "inf", which are then
+      // reported as non-finite coordinates rather than as garbage.
+      std::string token;
+      if (!(f >> token)) fail("truncated data");
+      char* end = nullptr;
+      double v = std::strtod(token.c_str(), &end);
+      if (end == token.c_str() || *end != '\0')
+        fail("malformed number '" + token + "'");
+      return v;
+    }
+    unsigned char buf[8];
+    if (!f.read(reinterpret_cast<char*>(buf), ft.bytes)) fail("truncated data");
+    return DecodeBinary(buf, ft, swap);
+  };
+
+  for (const Element& e : elements) {
+    if (e.name == "vertex") {
+      int ix = -1, iy = -1, iz = -1, ir = -1, ig = -1, ib = -1;
+      for (size_t k = 0; k < e.props.size(); ++k) {
+        const std::string& nm = e.props[k].name;
+        if (nm == "x") ix = int(k); else if (nm == "y") iy = int(k);
+        else if (nm == "z") iz = int(k); else if (nm == "red") ir = int(k);
+        else if (nm == "green") ig = int(k); else if (nm == "blue") ib = int(k);
+        else if (!e.props[k].is_list)
+          ply.properties.push_back({nm, e.props[k].type.t, {}});
+      }
+      if (ix < 0 || iy < 0 || iz < 0) fail("vertex element lacks x, y or z");
+      const bool has_color = ir >= 0 && ig >= 0 && ib >= 0;
+      ply.vertices.resize(e.count);
+      if (has_color) ply.colors.resize(e.count);
+      for (PlyProperty& p : ply.properties) p.values.resize(e.count);
+      std::vector<double> row(e.props.size());
+      for (size_t i = 0; i < e.count; ++i) {
+        size_t extra = 0;
+        for (size_t k = 0; k < e.props.size(); ++k) {
+          if (e.props[k].is_list) {
+            int m = int(read_value(e.props[k].count_type));
+            for (int j = 0; j < m; ++j) read_value(e.props[k].type);
+            continue;
+          }
+          row[k] = read_value(e.props[k].type);
+          if (int(k) != ix && int(k) != iy && int(k) != iz && int(k) != ir &&
+              int(k) != ig && int(k) != ib)
+            ply.properties[extra++].values[i] = row[k];
+        }
+        ply.vertices[i] = {row[ix], row[iy], row[iz]};
+        if (!ply.vertices[i].allFinite())
+          fail("vertex " + std::to_string(i) + " has a non-finite coordinate");
+        if (has_color)
+          ply.colors[i] = {uint8_t(row[ir]), uint8_t(row[ig]), uint8_t(row[ib])};
+      }
+    } else {
+      const bool is_face = e.name == "face";
+      for (size_t i = 0; i < e.count; ++i) {
+        for (const Prop& p : e.props) {
+          if (!p.is_list) { read_value(p.type); continue; }
+          double m = read_value(p.count_type);
+          if (m < 0 || m > 1e6) fail("bad list length in element " + e.name);
+          std::vector<int> idx(static_cast<size_t>(m));
+          for (int& v : idx) v = int(read_value(p.type));
+          if (is_face && (p.name == "vertex_indices" || p.name == "vertex_index")) {
+            for (int v : idx)
+              if (v < 0 || size_t(v) >= ply.vertices.size())
+                fail("face " + std::to_string(i) + " indexes a missing vertex " +
+                     std::to_string(v));
+            ply.faces.push_back(std::move(idx));
+          }
+        }
+      }
+    }
+  }
+  return ply;
+}
+
+}  // namespace docunfold

@@ -1,0 +1,48 @@
+// A small triangle rasterizer with a depth buffer. It returns, for every
+// pixel centre, the nearest triangle and perspective-correct barycentric
+// coordinates, from which any per-vertex attribute can be interpolated
+// (texture coordinates for synth and render, face ids for markers, ...).
+#pragma once
+
+#include <array>
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include "common/camera.h"
+
+namespace docunfold {
+
+struct RasterResult {
+  cv::Mat1f depth;  // camera depth of the nearest surface; +inf where empty
+  cv::Mat1i face;   // index of the nearest triangle; -1 where empty
+  cv::Mat2f bary;   // perspective-correct (b1, b2) of that triangle; b0 = 1-b1-b2
+};
+
+using Triangle = std::array<int, 3>;
+
+// Rasterizes triangles whose vertices are given in screen space as (pixel x,
+// pixel y, camera depth z). Pixel centres are at integer coordinates.
+// Triangles with a vertex at depth <= `near_depth` are skipped.
+RasterResult Rasterize(const std::vector<Eigen::Vector3d>& screen_vertices,
+                       const std::vector<Triangle>& triangles, int width,
+                       int height, double near_depth = 1e-6);
+
+// Projects world-space vertices through `camera` and rasterizes them at
+// the camera's image size scaled by `scale` (e.g. 2 for supersampling).
+RasterResult RasterizeMesh(const PinholeCamera& camera,
+                           const std::vector<Eigen::Vector3d>& vertices,
+                           const std::vector<Triangle>& triangles,
+                           double scale = 1.0);
+
+// Interpolates per-vertex attributes (one row per vertex, one column per
+// channel) over the raster; returns CV_32FC(channels), NaN where empty.
+cv::Mat InterpolateAttributes(const RasterResult& raster,
+                              const std::vector<Triangle>& triangles,
+                              const Eigen::MatrixXf& attributes);
+
+// Splits polygons (quads from PLY files) into triangles by fanning.
+std::vector<Triangle> Triangulate(const std::vector<std::vector<int>>& faces);
+
+}  // namespace docunfold

@@ -1,0 +1,44 @@
+// Helpers shared by tests: a private temporary directory per test, running
+// the stage binaries, and locating samples.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace docunfold::testing {
+
+namespace fs = std::filesystem;
+
+// A fresh directory for the current test, removed at destruction unless
+// DOCUNFOLD_KEEP_TEST_DIRS is set in the environment.
+class TempDir {
+ public:
+  TempDir();
+  ~TempDir();
+  const fs::path& path() const { return path_; }
+  fs::path operator/(const std::string& name) const { return path_ / name; }
+
+ private:
+  fs::path path_;
+};
+
+struct CommandResult {
+  int exit_code = -1;
+  std::string output;  // stdout and stderr together
+};
+
+// Runs a shell command line (arguments already quoted) and captures output.
+CommandResult RunCommand(const std::string& command_line);
+
+// Path of a built stage binary, e.g. StageBinary("sfm").
+fs::path StageBinary(const std::string& name);
+fs::path SourceDir();
+// samples/<name>; also where synth-made fixtures live.
+fs::path SampleDir(const std::string& name);
+// ../shared/realistic relative to the source tree, or "" when absent.
+fs::path RealisticDir();
+
+std::string Quote(const std::string& s);
+
+}  // namespace docunfold::testing
