@@ -34,6 +34,11 @@ IMAGES := $(sort $(wildcard $(DATA_DIR)/images/*))
 REF ?=
 SFM_FLAGS ?=
 
+# TIMER=<file>: run each stage under scripts/stage-timer, appending its wall
+# time and peak memory to <file> (used by the benchmark).
+TIMER ?=
+timed = $(if $(TIMER),$(ROOT)/scripts/stage-timer $(TIMER) $(1))
+
 # ---- helpers ------------------------------------------------------------------
 streq = $(and $(findstring x$(1),x$(2)),$(findstring x$(2),x$(1)))
 
@@ -45,7 +50,7 @@ $(WORK)/.flags/$(1): FORCE
 endef
 $(eval $(call flags_rule,sfm,$(SFM_FLAGS) $(if $(REF),--ref $(REF))))
 
-.PHONY: all sfm help clean deps build test check-data FORCE
+.PHONY: all sfm help clean deps build test bench check-data FORCE
 FORCE:
 
 # ---- build ----------------------------------------------------------------------
@@ -67,6 +72,12 @@ $(BIN)/%: $(BUILD)/CMakeCache.txt FORCE | deps
 test: build
 	cd $(BUILD) && ctest --output-on-failure -j$(JOBS)
 
+# Runs the pipeline on every sample (or BENCH_SETS="set01 set02") from scratch
+# and writes per-stage wall time and peak memory to bench/results.{md,json}.
+BENCH_SETS ?=
+bench: build
+	$(ROOT)/scripts/bench.sh $(BENCH_SETS)
+
 # ---- pipeline ---------------------------------------------------------------------
 all: sfm
 	@echo "docunfold: $(NAME) done; results in $(WORK)"
@@ -77,7 +88,7 @@ check-data:
 SFM_OUT := $(addprefix $(WORK)/10_sfm/,cameras.json points.ply reference.png)
 sfm: check-data $(SFM_OUT)
 $(SFM_OUT) &: $(BIN)/sfm $(WORK)/.flags/sfm $(IMAGES) | check-data
-	$(BIN)/sfm --data $(DATA_DIR) --out $(WORK)/10_sfm $(if $(REF),--ref $(REF)) $(SFM_FLAGS)
+	$(call timed,sfm) $(BIN)/sfm --data $(DATA_DIR) --out $(WORK)/10_sfm $(if $(REF),--ref $(REF)) $(SFM_FLAGS)
 
 # ---- housekeeping -------------------------------------------------------------------
 clean:
@@ -92,6 +103,7 @@ help:
 	@echo "  test           build, then run all tests (ctest)"
 	@echo "  build          configure and build build/bin/*"
 	@echo "  deps           install missing Debian packages (root) or print the apt-get line"
+	@echo "  bench          time every stage on every sample -> bench/results.md"
 	@echo "  clean          remove work/<name>/"
 	@echo
 	@echo "Variables:"
@@ -100,5 +112,7 @@ help:
 	@echo "  REF=img.jpg    reference view for sfm (default: chosen automatically)"
 	@echo "  SFM_FLAGS=...  extra flags for build/bin/sfm (see build/bin/sfm --help)"
 	@echo "  JOBS=2         parallel build jobs"
+	@echo "  TIMER=file     append per-stage time and peak memory to file (JSON lines)"
+	@echo "  BENCH_SETS=... samples for bench (default: all)"
 	@echo
 	@echo "Changing REF or a *_FLAGS variable reruns that stage and everything after it."
