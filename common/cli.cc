@@ -1,6 +1,9 @@
 #include "common/cli.h"
 
+#include <cstdlib>
 #include <iostream>
+
+#include <unistd.h>
 
 #include <opencv2/core.hpp>
 
@@ -18,6 +21,12 @@ const char* ProgramVersion() { return DOCUNFOLD_VERSION; }
 
 void SetProgramName(const std::string& name) { MutableProgramName() = name; }
 const std::string& ProgramName() { return MutableProgramName(); }
+
+void LimitOpenMpThreads(char** argv) {
+  if (std::getenv("OMP_THREAD_LIMIT") != nullptr) return;
+  ::setenv("OMP_THREAD_LIMIT", "1", 1);
+  ::execv("/proc/self/exe", argv);  // returns only on failure: run as we are
+}
 
 void Log(const std::string& message) {
   std::cerr << ProgramName() << ": " << message << std::endl;

@@ -24,6 +24,13 @@ const std::string& ProgramName();
 int RunStage(const std::string& program, CLI::App& app, int argc, char** argv,
              const std::function<void()>& body);
 
+// For programs that use Tesseract: its OpenMP parallelism (up to 10 threads
+// per region) spins on few shared cores and makes OCR several times slower.
+// libgomp reads OMP_THREAD_LIMIT only when it is loaded, so when the variable
+// is unset this sets it to 1 and re-executes the program once (call first
+// thing in main; returns normally when nothing needs doing or exec fails).
+void LimitOpenMpThreads(char** argv);
+
 // One plain line on stderr: "<program>: <message>".
 void Log(const std::string& message);
 

@@ -1,5 +1,6 @@
 #include "common/gltf.h"
 
+#include <algorithm>
 #include <cstring>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
@@ -48,7 +49,8 @@ int AddAccessor(tinygltf::Model* model, int view, int component, int type,
 }  // namespace
 
 void WriteGlb(const std::filesystem::path& path,
-              const std::vector<GltfMesh>& meshes) {
+              const std::vector<GltfMesh>& meshes,
+              const std::vector<GltfPoints>& clouds) {
   tinygltf::Model model;
   model.asset.version = "2.0";
   model.asset.generator = "docunfold";
@@ -124,6 +126,49 @@ void WriteGlb(const std::filesystem::path& path,
     model.meshes.push_back(mesh);
     tinygltf::Node node;
     node.name = m.name;
+    node.mesh = int(model.meshes.size() - 1);
+    model.nodes.push_back(node);
+    scene.nodes.push_back(int(model.nodes.size() - 1));
+  }
+  for (const GltfPoints& c : clouds) {
+    if (c.positions.empty()) continue;
+    std::vector<float> pos;
+    std::vector<double> lo(3, 1e300), hi(3, -1e300);
+    for (const Eigen::Vector3d& p : c.positions) {
+      const double q[3] = {p.x(), -p.y(), -p.z()};
+      for (int k = 0; k < 3; ++k) {
+        pos.push_back(float(q[k]));
+        lo[k] = std::min(lo[k], double(float(q[k])));
+        hi[k] = std::max(hi[k], double(float(q[k])));
+      }
+    }
+    tinygltf::Primitive prim;
+    prim.mode = TINYGLTF_MODE_POINTS;
+    prim.attributes["POSITION"] = AddAccessor(
+        &model, AddView(&model, pos.data(), pos.size() * 4, TINYGLTF_TARGET_ARRAY_BUFFER),
+        TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, c.positions.size(), lo, hi);
+    if (!c.colors.empty()) {
+      if (c.colors.size() != c.positions.size())
+        throw std::invalid_argument("WriteGlb: point colours size mismatch");
+      std::vector<float> col;
+      for (const Eigen::Vector3f& v : c.colors)
+        for (int k = 0; k < 3; ++k) col.push_back(std::clamp(v[k], 0.0f, 1.0f));
+      prim.attributes["COLOR_0"] = AddAccessor(
+          &model, AddView(&model, col.data(), col.size() * 4, TINYGLTF_TARGET_ARRAY_BUFFER),
+          TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, c.colors.size());
+    }
+    tinygltf::Material material;
+    material.name = c.name;
+    material.pbrMetallicRoughness.metallicFactor = 0.0;
+    material.pbrMetallicRoughness.roughnessFactor = 1.0;
+    model.materials.push_back(material);
+    prim.material = int(model.materials.size() - 1);
+    tinygltf::Mesh mesh;
+    mesh.name = c.name;
+    mesh.primitives.push_back(prim);
+    model.meshes.push_back(mesh);
+    tinygltf::Node node;
+    node.name = c.name;
     node.mesh = int(model.meshes.size() - 1);
     model.nodes.push_back(node);
     scene.nodes.push_back(int(model.nodes.size() - 1));

@@ -21,10 +21,18 @@ struct GltfMesh {
   cv::Mat texture;  // 8-bit BGR image, embedded as PNG; may be empty
 };
 
-// Writes one .glb with all meshes as nodes of one scene (atomic; throws
-// OutputError). Positions are turned from OpenCV axes (y down, z forward)
-// into glTF's (y up, z backward) by flipping y and z.
+// A coloured point cloud (drawn as glTF POINTS).
+struct GltfPoints {
+  std::string name = "points";
+  std::vector<Eigen::Vector3d> positions;  // OpenCV axes; converted on export
+  std::vector<Eigen::Vector3f> colors;     // linear RGB in [0, 1]; may be empty
+};
+
+// Writes one .glb with all meshes and point clouds as nodes of one scene
+// (atomic; throws OutputError). Positions are turned from OpenCV axes (y
+// down, z forward) into glTF's (y up, z backward) by flipping y and z.
 void WriteGlb(const std::filesystem::path& path,
-              const std::vector<GltfMesh>& meshes);
+              const std::vector<GltfMesh>& meshes,
+              const std::vector<GltfPoints>& points = {});
 
 }  // namespace docunfold

@@ -76,8 +76,9 @@ cv::Mat InterpolateAttributes(const RasterResult& raster,
                               const std::vector<Triangle>& triangles,
                               const Eigen::MatrixXf& attributes) {
   const int channels = int(attributes.cols());
-  cv::Mat out(raster.face.size(), CV_32FC(channels),
-              cv::Scalar::all(std::numeric_limits<float>::quiet_NaN()));
+  cv::Mat out(raster.face.size(), CV_32FC(channels));
+  // Scalars hold at most four channels: fill through a one-channel view.
+  out.reshape(1).setTo(std::numeric_limits<float>::quiet_NaN());
   for (int y = 0; y < out.rows; ++y) {
     const int* face_row = raster.face.ptr<int>(y);
     const cv::Vec2f* bary_row = raster.bary.ptr<cv::Vec2f>(y);

@@ -1,0 +1,83 @@
+#include "common/page_files.h"
+
+#include "common/json_io.h"
+
+namespace docunfold {
+namespace {
+
+Eigen::Vector2d Point(const JsonReader& r, const std::string& pointer) {
+  const Json& p = r.At(pointer);
+  if (!p.is_array() || p.size() != 2 || !p[0].is_number() || !p[1].is_number())
+    r.Fail(pointer, "expected [x, y]");
+  const Eigen::Vector2d v(p[0].get<double>(), p[1].get<double>());
+  if (!v.allFinite()) r.Fail(pointer, "not finite");
+  return v;
+}
+
+std::vector<Eigen::Vector2d> Polyline(const JsonReader& r, const std::string& pointer,
+                                      size_t min_points) {
+  const Json& points = r.At(pointer);
+  if (!points.is_array() || points.size() < min_points)
+    r.Fail(pointer, "expected at least " + std::to_string(min_points) + " points");
+  std::vector<Eigen::Vector2d> out;
+  for (size_t k = 0; k < points.size(); ++k)
+    out.push_back(Point(r, pointer + "/" + std::to_string(k)));
+  return out;
+}
+
+}  // namespace
+
+int Boundary::RealSides() const {
+  int n = 0;
+  for (const BoundarySide& s : sides) n += s.real;
+  return n;
+}
+
+Boundary ReadBoundary(const fs::path& file) {
+  const Json doc = ReadJsonFile(file);
+  CheckFormat(doc, file, "docunfold.boundary", 1);
+  JsonReader r(doc, file);
+  Boundary b;
+  b.file = file;
+  b.width = r.Integer("/width");
+  b.height = r.Integer("/height");
+  if (b.width <= 0 || b.height <= 0) r.Fail("/width", "image size must be positive");
+  b.contour = Polyline(r, "/contour", 3);
+  const Json& corners = r.At("/corners");
+  if (!corners.is_array() || corners.size() != 4) r.Fail("/corners", "expected 4 points");
+  for (int i = 0; i < 4; ++i) b.corners[i] = Point(r, "/corners/" + std::to_string(i));
+  for (int i = 0; i < 4; ++i) {
+    const std::string p = std::string("/sides/") + kSideNames[i];
+    const Json& real = r.At(p + "/real");
+    if (!real.is_boolean()) r.Fail(p + "/real", "expected true or false");
+    b.sides[i].real = real.get<bool>();
+    b.sides[i].points = Polyline(r, p + "/points", 2);
+  }
+  return b;
+}
+
+FeatureFile ReadFeatures(const fs::path& file) {
+  const Json doc = ReadJsonFile(file);
+  CheckFormat(doc, file, "docunfold.features", 1);
+  JsonReader r(doc, file);
+  FeatureFile f;
+  f.file = file;
+  if (doc.contains("producer") && doc["producer"].is_object())
+    f.producer = doc["producer"].value("stage", doc["producer"].value("program", ""));
+  if (r.Has("/width")) f.width = r.Integer("/width");
+  if (r.Has("/height")) f.height = r.Integer("/height");
+  const Json& segments = r.At("/segments");
+  if (!segments.is_array()) r.Fail("/segments", "expected an array");
+  for (size_t i = 0; i < segments.size(); ++i) {
+    const std::string p = "/segments/" + std::to_string(i);
+    FeatureSegment s;
+    s.kind = r.String(p + "/kind");
+    if (s.kind != "text" && s.kind != "edge")
+      r.Fail(p + "/kind", "expected \"text\" or \"edge\", found \"" + s.kind + "\"");
+    s.points = Polyline(r, p + "/points", 2);
+    f.segments.push_back(std::move(s));
+  }
+  return f;
+}
+
+}  // namespace docunfold
