@@ -1,0 +1,71 @@
+// baseline: the reference methods of the benchmark, each a rectified image
+// to evaluate beside docunfold's.
+//  - homography: the reference view warped by the four detected page corners
+//    onto a rectangle of the page's aspect (what a phone scanner app does);
+//  - oracle: the page textured from the reference photo through the TRUE
+//    surface and TRUE camera (the ceiling for any single-view texturing).
+#pragma once
+
+#include <array>
+#include <filesystem>
+#include <optional>
+#include <string>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include "common/camera.h"
+#include "common/ply.h"
+
+namespace docunfold::baseline {
+
+namespace fs = std::filesystem;
+
+// Page corners in an image: top-left, top-right, bottom-right, bottom-left.
+using Corners = std::array<Eigen::Vector2d, 4>;
+
+// Width / height of the planar rectangle whose image is `corners` under a
+// camera with intrinsics K (Zhang & He, "Whiteboard scanning and image
+// enhancement", 2007). Falls back to the ratio of mean opposite side lengths
+// when the quadrilateral is nearly a parallelogram (no perspective to use).
+double AspectFromCorners(const Corners& corners, const Eigen::Matrix3d& K);
+
+// Warps `image` so that `corners` land on the corners of an output image of
+// `size` (page edges on the outer pixel borders). Bicubic; when the output
+// is smaller than the page in the image, it is rendered larger and area-
+// averaged down so that text does not alias.
+cv::Mat WarpByCorners(const cv::Mat& image, const Corners& corners, cv::Size size);
+
+// Textures the flat page (size of flat.png) from `photo` through the true
+// surface: `mesh` has per-vertex s, t (column/row fractions of flat.png) and
+// vertices in the world frame of `camera`. Bicubic, area-averaged when the
+// photo is minified. Throws InputError when the mesh lacks s, t.
+cv::Mat TextureFromTruth(const cv::Mat& photo, const PinholeCamera& camera,
+                         const PlyData& mesh, cv::Size size);
+
+enum class Method { kHomography, kOracle };
+
+struct BaselineOptions {
+  Method method = Method::kHomography;
+  // Output width in pixels, the height following from the page's aspect.
+  // 0 = the size of ground_truth/flat.png when the data set has one, else
+  // (homography only) the mean length of the page's top and bottom sides in
+  // the reference view.
+  int width = 0;
+};
+
+struct BaselineInputs {
+  fs::path data;  // data set (images/, ground_truth/)
+  fs::path work;  // work directory (10_sfm/, 20_boundary/)
+};
+
+struct BaselineResult {
+  cv::Mat image;
+  std::string summary;  // one line: what was done, the size and aspect
+};
+
+// Reads what the method needs (throws InputError naming a missing or bad
+// file) and makes the image.
+BaselineResult Run(const BaselineInputs& inputs, const BaselineOptions& options);
+
+}  // namespace docunfold::baseline

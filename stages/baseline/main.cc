@@ -1,0 +1,42 @@
+// baseline: reference methods of the benchmark (homography, oracle).
+#include "common/atomic_file.h"
+#include "common/cli.h"
+#include "stages/baseline/baseline.h"
+
+using namespace docunfold;
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "Reference methods for the benchmark. homography: "
+      "<work>/10_sfm/reference.png warped by the four page corners of "
+      "<work>/20_boundary/boundary.json onto a rectangle of the page's aspect "
+      "(ground_truth/page.json, else estimated from the corners and K). "
+      "oracle: the photo images/<reference> textured through the TRUE surface "
+      "and camera (ground_truth/mesh.ply, cameras.json) at the size of "
+      "flat.png: the ceiling for any method that textures from one view."};
+  baseline::BaselineInputs in;
+  baseline::BaselineOptions options;
+  std::string method;
+  fs::path out;
+  app.add_option("--method", method, "homography or oracle")
+      ->required()
+      ->check(CLI::IsMember({"homography", "oracle"}));
+  app.add_option("--data", in.data, "data set folder")->required();
+  app.add_option("--work", in.work, "work directory with 10_sfm/ (and 20_boundary/)")
+      ->required();
+  app.add_option("--out", out, "image to write (.png)")->required();
+  app.add_option("--width", options.width,
+                 "output width in pixels, height from the page aspect (default 0: "
+                 "the size of flat.png, else the page's width in the reference view)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+
+  return RunStage("baseline", app, argc, argv, [&] {
+    options.method = method == "oracle" ? baseline::Method::kOracle
+                                        : baseline::Method::kHomography;
+    const baseline::BaselineResult r = baseline::Run(in, options);
+    EnsureDirectory(out.parent_path().empty() ? fs::path(".") : out.parent_path());
+    WriteImageAtomic(out, r.image);
+    Log(r.summary + " -> " + out.string());
+  });
+}

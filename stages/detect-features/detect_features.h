@@ -1,0 +1,84 @@
+// detect-features: short, locally reliable, straight segments in the
+// reference image (paper §"Feature line extraction", feature segment
+// detection), restricted to the document region:
+//   - text segments: pieces of text baselines. Characters (connected
+//     components of a Sauvola-binarised image) are chained with their
+//     neighbours of similar size along the text direction; each chain's
+//     baseline (the lower envelope of its characters, descenders removed,
+//     "lower" read from the text itself) is cut where it bends (a crease) and
+//     fitted piecewise by straight lines. The paper chains character centres;
+//     a baseline is the same straight line on the page, only sharper.
+//   - edge segments: table rules and other thin printed lines. LSD finds the
+//     two edges of a dark line; paired, they give its centre line. Single
+//     step edges (shading at folds, colour fields, the page outline itself)
+//     are left out unless asked for: shading edges are not straight on the
+//     page, and precision comes first (paper, Remarks).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "common/json_io.h"
+
+namespace docunfold::features {
+
+struct FeaturesOptions {
+  // Margin (pixels) kept from the outline of the document region, so that
+  // the page edge and the shadow at it never become features; 0 = automatic
+  // (0.6 % of the image diagonal, at least 4 px).
+  double margin_px = 0;
+  // Sauvola binarisation: window (pixels; 0 = automatic, 1.5 % of the image
+  // diagonal) and k.
+  int sauvola_window = 0;
+  double sauvola_k = 0.2;
+  // Text: a chain's baseline is cut where it leaves a straight line by more
+  // than this many pixels, or this fraction of the text height if larger.
+  double straightness_px = 1.2;
+  double straightness_rel = 0.12;
+  // Text: neighbours are chained across gaps up to this many text heights.
+  double max_gap = 1.0;
+  // Shortest segment kept, in text heights (text) or pixels (both).
+  double min_text_length = 5.0;
+  double min_length_px = 20.0;
+  // Edge: keep single step edges too (not only the centre lines of thin dark
+  // lines).
+  bool step_edges = false;
+  // Log each step and its time.
+  bool verbose = false;
+
+  Json ToJson() const;
+};
+
+struct Segment {
+  std::string kind;                  // "text" or "edge"
+  std::vector<cv::Point2d> points;   // a straight polyline, >= 2 points
+  int characters = 0;                // text: characters chained
+};
+
+struct FeaturesResult {
+  std::vector<Segment> segments;
+  double text_height = 0;       // median character height (pixels), 0 if no text
+  double text_direction = 0;    // degrees, of the text lines in the image
+  bool text_upside_down = false;  // baselines on the image-up side of the text
+  int votes_upright = 0, votes_upside_down = 0;  // evidence for either
+  int text_segments = 0;
+  int edge_segments = 0;
+};
+
+// `image` 8-bit BGR; `mask` 8-bit, same size, 255 = document. Throws
+// InputError when the mask is empty or of another size.
+FeaturesResult DetectFeatures(const cv::Mat& image, const cv::Mat& mask,
+                              const FeaturesOptions& options);
+
+// features.json (format docunfold.features, version 1).
+Json FeaturesToJson(const FeaturesResult& result, const std::string& image_name,
+                    int width, int height, const FeaturesOptions& options);
+
+// Segments drawn over the image (text red, edges cyan, outside the region
+// darkened); at most `max_size` pixels long.
+cv::Mat DrawFeaturesOverlay(const cv::Mat& image, const cv::Mat& mask,
+                            const FeaturesResult& result, int max_size = 2000);
+
+}  // namespace docunfold::features

@@ -1,0 +1,61 @@
+// Pieces of detect-features shared by its text and edge detectors (internal
+// to the stage; tests may call them).
+#pragma once
+
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "stages/detect-features/detect_features.h"
+
+namespace docunfold::features::detail {
+
+// Dark marks (255) by Sauvola's threshold T = m (1 + k (s / 128 - 1)) over a
+// window x window neighbourhood (mean m, standard deviation s).
+cv::Mat1b SauvolaInk(const cv::Mat1b& grey, int window, double k);
+
+// Connected components of the ink (8-connected).
+struct InkComponents {
+  cv::Mat1i labels;  // 0 = background
+  cv::Mat1i stats;   // cv::connectedComponentsWithStats layout
+  int count = 0;     // including the background label 0
+};
+InkComponents FindComponents(const cv::Mat1b& ink);
+
+struct TextResult {
+  std::vector<Segment> segments;
+  double height = 0;          // median character height across the lines (px)
+  double direction_deg = 0;   // text line direction in the image
+  bool upside_down = false;  // baselines on the image-up side of the letters
+  // How far (pixels, summed) the outlines on the -n side and on the +n side
+  // stray from straight: the baseline side strays less.
+  int votes_upright = 0, votes_upside_down = 0;
+  // Small marks: periods on the baseline, dots beyond the other side.
+  int dots_upright = 0, dots_upside_down = 0;
+  bool orientation_known = false;  // if not, no text segments are made
+  std::vector<char> is_character;  // per component label: chained as text
+};
+TextResult DetectTextSegments(const InkComponents& ink, const FeaturesOptions& options);
+
+// Centre lines of thin dark lines (and, if asked, single step edges) found by
+// LSD in `grey`, inside `region`, that are not character strokes.
+std::vector<Segment> DetectEdgeSegments(const cv::Mat1b& grey, const cv::Mat1b& ink,
+                                        const InkComponents& components,
+                                        const TextResult& text, const cv::Mat1b& region,
+                                        const FeaturesOptions& options);
+
+// Least-squares line through points: unit direction, a point on it, and the
+// RMS of the perpendicular residuals.
+struct LineFit {
+  cv::Point2d direction;
+  cv::Point2d point;
+  double rms = 0;
+};
+LineFit FitLine(const std::vector<cv::Point2d>& points);
+
+// Douglas-Peucker split of an ordered point sequence: index ranges
+// [first, last] of pieces that each stay within `tolerance` of their chord.
+std::vector<std::pair<int, int>> SplitWhereBent(const std::vector<cv::Point2d>& points,
+                                                double tolerance);
+
+}  // namespace docunfold::features::detail

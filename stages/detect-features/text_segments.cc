@@ -1,0 +1,474 @@
+// Text segments: characters chained along the text direction, their baseline
+// cut where it bends and fitted by straight pieces.
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <numeric>
+
+#include <opencv2/imgproc.hpp>
+
+#include "stages/detect-features/feature_parts.h"
+
+namespace docunfold::features::detail {
+namespace {
+
+double Median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  const size_t m = v.size() / 2;
+  std::nth_element(v.begin(), v.begin() + long(m), v.end());
+  return v[m];
+}
+
+// A character candidate: a connected component with its pixels and, once
+// the text direction d and its normal n are known, its extent along both.
+struct Mark {
+  int label = 0;
+  cv::Rect box;
+  cv::Point2d centre;
+  std::vector<cv::Point> pixels;
+  double a0 = 0, a1 = 0;  // along d
+  double c0 = 0, c1 = 0;  // along n
+  double height() const { return c1 - c0 + 1; }
+  double along_mid() const { return 0.5 * (a0 + a1); }
+  double across_mid() const { return 0.5 * (c0 + c1); }
+};
+
+// Direction (radians in [0, pi)) of the text lines: the angle at which the
+// marks' centres, projected across it, pile up most sharply (projection
+// profiles, as in classical skew detection), summed over a 3x3 grid of tiles
+// so that lines converging under perspective still count. (Nearest-neighbour
+// directions fail when letters merge into words: the next line is then
+// nearer than the next word.)
+double TextDirection(const std::vector<Mark>& marks, double char_size) {
+  std::vector<cv::Point2d> points;
+  for (const Mark& m : marks)
+    if (std::sqrt(double(m.box.area())) <= 3.0 * char_size) points.push_back(m.centre);
+  if (points.size() < 3) return 0;
+  double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
+  for (const auto& p : points) {
+    x0 = std::min(x0, p.x); y0 = std::min(y0, p.y);
+    x1 = std::max(x1, p.x); y1 = std::max(y1, p.y);
+  }
+  constexpr int kTiles = 3;
+  std::vector<std::vector<cv::Point2d>> tiles(kTiles * kTiles);
+  for (const auto& p : points) {
+    const int tx = std::min(kTiles - 1, int((p.x - x0) / std::max(1e-9, x1 - x0) * kTiles));
+    const int ty = std::min(kTiles - 1, int((p.y - y0) / std::max(1e-9, y1 - y0) * kTiles));
+    tiles[size_t(ty * kTiles + tx)].push_back(p);
+  }
+  const double bin = std::max(1.0, 0.3 * char_size);
+  auto score = [&](double theta) {
+    const double nx = -std::sin(theta), ny = std::cos(theta);
+    double total = 0;
+    std::map<long, int> hist;
+    for (const auto& tile : tiles) {
+      if (tile.size() < 10) continue;
+      hist.clear();
+      for (const auto& p : tile) ++hist[long(std::floor((p.x * nx + p.y * ny) / bin))];
+      double sq = 0;
+      for (const auto& [k, c] : hist) sq += double(c) * c;
+      total += sq / double(tile.size());
+    }
+    return total;
+  };
+  double best = 0, best_score = -1;
+  for (int deg = 0; deg < 180; ++deg) {
+    const double sc = score(deg * CV_PI / 180);
+    if (sc > best_score) { best_score = sc; best = deg * CV_PI / 180; }
+  }
+  const double coarse = best;
+  for (int k = -10; k <= 10; ++k) {
+    const double theta = coarse + k * 0.1 * CV_PI / 180;
+    const double sc = score(theta);
+    if (sc > best_score) { best_score = sc; best = theta; }
+  }
+  best = std::fmod(best + CV_PI, CV_PI);
+  // Monospaced text (receipts) also piles up sharply across its columns.
+  // When the best direction roughly across the first scores nearly as well,
+  // take the one along which neighbours are nearer: letters in a line are
+  // closer than lines (proportional text piles up far less in columns, so
+  // merged words, whose neighbours across lines are nearer, never get here).
+  double across = 0, across_score = -1;
+  for (int deg = 65; deg <= 115; ++deg) {
+    const double theta = best + deg * CV_PI / 180;
+    const double sc = score(theta);
+    if (sc > across_score) { across_score = sc; across = theta; }
+  }
+  if (across_score < 0.6 * best_score) return best;
+  auto median_spacing = [&](double theta) {
+    const cv::Point2d dir(std::cos(theta), std::sin(theta));
+    std::vector<double> nearest;
+    for (size_t i = 0; i < points.size(); ++i) {
+      double d = 1e300;
+      for (size_t j = 0; j < points.size(); ++j) {
+        if (i == j) continue;
+        const cv::Point2d v = points[j] - points[i];
+        const double along = std::abs(v.dot(dir)), off = std::abs(v.x * dir.y - v.y * dir.x);
+        if (off < 0.3 * along && along < d) d = along;
+      }
+      if (d < 1e299) nearest.push_back(d);
+    }
+    return nearest.empty() ? 1e300 : Median(nearest);
+  };
+  if (median_spacing(across) < median_spacing(best)) best = std::fmod(across + CV_PI, CV_PI);
+  return best;
+}
+
+}  // namespace
+
+LineFit FitLine(const std::vector<cv::Point2d>& points) {
+  LineFit fit;
+  if (points.empty()) return fit;
+  cv::Point2d mean(0, 0);
+  for (const auto& p : points) mean += p;
+  mean *= 1.0 / double(points.size());
+  double sxx = 0, sxy = 0, syy = 0;
+  for (const auto& p : points) {
+    const cv::Point2d d = p - mean;
+    sxx += d.x * d.x; sxy += d.x * d.y; syy += d.y * d.y;
+  }
+  const double angle = 0.5 * std::atan2(2 * sxy, sxx - syy);
+  fit.direction = {std::cos(angle), std::sin(angle)};
+  fit.point = mean;
+  double r2 = 0;
+  for (const auto& p : points) {
+    const cv::Point2d d = p - mean;
+    const double r = d.x * -fit.direction.y + d.y * fit.direction.x;
+    r2 += r * r;
+  }
+  fit.rms = std::sqrt(r2 / double(points.size()));
+  return fit;
+}
+
+std::vector<std::pair<int, int>> SplitWhereBent(const std::vector<cv::Point2d>& points,
+                                                double tolerance) {
+  std::vector<std::pair<int, int>> out;
+  if (points.size() < 2) {
+    if (!points.empty()) out.emplace_back(0, 0);
+    return out;
+  }
+  std::vector<std::pair<int, int>> stack = {{0, int(points.size()) - 1}};
+  while (!stack.empty()) {
+    auto [a, b] = stack.back();
+    stack.pop_back();
+    const cv::Point2d chord = points[b] - points[a];
+    const double len = cv::norm(chord);
+    int worst = -1;
+    double worst_d = tolerance;
+    for (int k = a + 1; k < b; ++k) {
+      const cv::Point2d v = points[k] - points[a];
+      const double d = len > 1e-9 ? std::abs(chord.x * v.y - chord.y * v.x) / len : cv::norm(v);
+      if (d > worst_d) { worst_d = d; worst = k; }
+    }
+    if (worst < 0) {
+      out.emplace_back(a, b);
+    } else {
+      stack.emplace_back(worst, b);
+      stack.emplace_back(a, worst);
+    }
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+TextResult DetectTextSegments(const InkComponents& ink, const FeaturesOptions& options) {
+  TextResult result;
+  result.is_character.assign(size_t(ink.count), 0);
+  const double diag = std::hypot(ink.labels.cols, ink.labels.rows);
+  // 1. Marks of character size (merged letters of a word included).
+  std::vector<int> mark_of(size_t(ink.count), -1);
+  std::vector<Mark> marks;
+  for (int l = 1; l < ink.count; ++l) {
+    const int w = ink.stats(l, cv::CC_STAT_WIDTH), h = ink.stats(l, cv::CC_STAT_HEIGHT);
+    const int area = ink.stats(l, cv::CC_STAT_AREA);
+    if (area < 5 || std::max(w, h) < 3) continue;
+    if (std::min(w, h) > 0.03 * diag || std::max(w, h) > 0.08 * diag) continue;
+    if (area < 0.08 * w * h) continue;  // thin diagonal strokes, frames
+    Mark m;
+    m.label = l;
+    m.box = cv::Rect(ink.stats(l, cv::CC_STAT_LEFT), ink.stats(l, cv::CC_STAT_TOP), w, h);
+    mark_of[size_t(l)] = int(marks.size());
+    marks.push_back(std::move(m));
+  }
+  if (marks.size() < 3) return result;
+  for (int y = 0; y < ink.labels.rows; ++y) {
+    const int* row = ink.labels.ptr<int>(y);
+    for (int x = 0; x < ink.labels.cols; ++x)
+      if (row[x] > 0 && mark_of[size_t(row[x])] >= 0)
+        marks[size_t(mark_of[size_t(row[x])])].pixels.emplace_back(x, y);
+  }
+  std::vector<double> sizes;
+  for (Mark& m : marks) {
+    cv::Point2d c(0, 0);
+    for (const cv::Point& p : m.pixels) c += cv::Point2d(p);
+    m.centre = c * (1.0 / double(m.pixels.size()));
+    sizes.push_back(std::sqrt(double(m.box.area())));
+  }
+
+  // 2. Text direction d and its normal n (n points down the image for
+  //    left-to-right lines).
+  const double theta = TextDirection(marks, Median(sizes));
+  const cv::Point2d d(std::cos(theta), std::sin(theta)), n(-std::sin(theta), std::cos(theta));
+  result.direction_deg = theta * 180.0 / CV_PI;
+  for (Mark& m : marks) {
+    m.a0 = m.c0 = 1e300;
+    m.a1 = m.c1 = -1e300;
+    for (const cv::Point& p : m.pixels) {
+      const double a = p.x * d.x + p.y * d.y, c = p.x * n.x + p.y * n.y;
+      m.a0 = std::min(m.a0, a); m.a1 = std::max(m.a1, a);
+      m.c0 = std::min(m.c0, c); m.c1 = std::max(m.c1, c);
+    }
+  }
+  std::vector<double> heights;
+  for (const Mark& m : marks) heights.push_back(m.height());
+  const double h_med = Median(heights);
+  // Dots, commas and noise are too small to chain; large marks are not text.
+  std::vector<int> usable;
+  for (size_t i = 0; i < marks.size(); ++i)
+    if (marks[i].height() >= 0.4 * h_med && marks[i].height() <= 2.5 * h_med)
+      usable.push_back(int(i));
+
+  // 3. Chain neighbours: the nearest mark ahead along d of similar height
+  //    whose across-extent overlaps, if each is the other's choice.
+  const double cell = 4.0 * h_med;
+  double ax0 = 1e300, cy0 = 1e300;
+  for (int i : usable) { ax0 = std::min(ax0, marks[i].a0); cy0 = std::min(cy0, marks[i].c0); }
+  std::map<std::pair<int, int>, std::vector<int>> grid;
+  for (int i : usable) {
+    const Mark& m = marks[i];
+    for (int gy = int((m.c0 - cy0) / cell); gy <= int((m.c1 - cy0) / cell); ++gy)
+      for (int gx = int((m.a0 - ax0) / cell); gx <= int((m.a1 - ax0) / cell); ++gx)
+        grid[{gx, gy}].push_back(i);
+  }
+  std::vector<int> next(marks.size(), -1), prev(marks.size(), -1);
+  std::vector<double> next_gap(marks.size(), 1e300), prev_gap(marks.size(), 1e300);
+  for (int i : usable) {
+    const Mark& m = marks[i];
+    const double reach = options.max_gap * 5.0 * m.height();
+    for (int gy = int((m.c0 - cy0) / cell); gy <= int((m.c1 - cy0) / cell); ++gy)
+      for (int gx = int((m.a1 - ax0) / cell); gx <= int((m.a1 + reach - ax0) / cell); ++gx) {
+        auto it = grid.find({gx, gy});
+        if (it == grid.end()) continue;
+        for (int j : it->second) {
+          if (j == i) continue;
+          const Mark& o = marks[j];
+          const double hmin = std::min(m.height(), o.height());
+          const double hmax = std::max(m.height(), o.height());
+          if (hmax > 2.0 * hmin) continue;
+          const double gap = o.a0 - m.a1;
+          if (gap < -0.3 * hmin || gap > options.max_gap * hmax) continue;
+          if (o.along_mid() <= m.along_mid()) continue;
+          const double overlap = std::min(m.c1, o.c1) - std::max(m.c0, o.c0) + 1;
+          if (overlap < 0.5 * hmin) continue;
+          if (gap < next_gap[i]) { next_gap[i] = gap; next[i] = j; }
+          if (gap < prev_gap[j]) { prev_gap[j] = gap; prev[j] = i; }
+        }
+      }
+  }
+  std::vector<std::vector<int>> chains;
+  for (int i : usable) {
+    const bool head = prev[i] < 0 || next[prev[i]] != i;
+    if (!head) continue;
+    std::vector<int> chain = {i};
+    for (int k = i; next[k] >= 0 && prev[next[k]] == k; k = next[k]) chain.push_back(next[k]);
+    if (chain.size() >= 2) chains.push_back(std::move(chain));
+  }
+
+  // 4. Line height (x-height band) from each chain's medians of tops and
+  //    bottoms, after removing its tilt.
+  std::vector<double> line_heights;
+  for (const auto& chain : chains) {
+    if (chain.size() < 3) continue;
+    std::vector<cv::Point2d> mids;
+    for (int k : chain) mids.emplace_back(marks[k].along_mid(), marks[k].across_mid());
+    const LineFit fit = FitLine(mids);
+    const double slope = fit.direction.y / (std::abs(fit.direction.x) > 1e-9 ? fit.direction.x : 1e-9);
+    std::vector<double> tops, bottoms;
+    for (int k : chain) {
+      const double trend = fit.point.y + slope * (marks[k].along_mid() - fit.point.x);
+      tops.push_back(marks[k].c0 - trend);
+      bottoms.push_back(marks[k].c1 - trend);
+    }
+    line_heights.push_back(Median(bottoms) - Median(tops) + 1);
+  }
+  result.height = line_heights.empty() ? h_med : Median(line_heights);
+  const double x_height = result.height;
+  const double bin = std::max(1.5, 0.4 * x_height);
+
+  // The outline of a chain on one side: in narrow bins along the line, the
+  // ink's extreme towards sign * n (sign +1: the +n side).
+  struct Sample { double a, c; int mark; };
+  auto outline = [&](const std::vector<int>& chain, double sign) {
+    std::vector<Sample> samples;
+    for (int k : chain) {
+      const Mark& m = marks[k];
+      const int bins = int((m.a1 - m.a0) / bin) + 1;
+      std::vector<double> best(size_t(bins), -1e300), best_a(size_t(bins), 0),
+          least(size_t(bins), 1e300);
+      for (const cv::Point& p : m.pixels) {
+        const double a = p.x * d.x + p.y * d.y, c = sign * (p.x * n.x + p.y * n.y);
+        const int b = std::min(bins - 1, int((a - m.a0) / bin));
+        if (c > best[size_t(b)]) { best[size_t(b)] = c; best_a[size_t(b)] = a; }
+        least[size_t(b)] = std::min(least[size_t(b)], c);
+      }
+      // Only bins the ink crosses nearly from one side of the x-height band
+      // to the other (stems, bowls): at the flanks of round letters the
+      // extreme is somewhere in the middle of the band. The ink's edge lies
+      // half a pixel beyond the last ink pixel's centre.
+      for (int b = 0; b < bins; ++b)
+        if (best[size_t(b)] > -1e299 && best[size_t(b)] - least[size_t(b)] >= 0.6 * x_height)
+          samples.push_back({best_a[size_t(b)], best[size_t(b)] + 0.5, k});
+    }
+    std::sort(samples.begin(), samples.end(), [](const Sample& p, const Sample& q) { return p.a < q.a; });
+    return samples;
+  };
+  // Which samples of an outline lie on its line: within a band of the
+  // median of their neighbours (three text heights either way), the chain's
+  // overall tilt removed. Descenders, or ascenders, stick out.
+  // Each sample's offset from the median of its neighbours (three text
+  // heights either way), the chain's overall tilt removed.
+  auto offsets = [&](const std::vector<Sample>& samples) {
+    std::vector<double> out(samples.size(), 0.0);
+    if (samples.size() < 3) return out;
+    std::vector<cv::Point2d> raw;
+    for (const Sample& s : samples) raw.emplace_back(s.a, s.c);
+    const LineFit tilt = FitLine(raw);
+    const double slope = tilt.direction.y / (std::abs(tilt.direction.x) > 1e-9 ? tilt.direction.x : 1e-9);
+    std::vector<double> e(samples.size());
+    for (size_t k = 0; k < samples.size(); ++k)
+      e[k] = samples[k].c - (tilt.point.y + slope * (samples[k].a - tilt.point.x));
+    for (size_t k = 0, lo = 0, hi = 0; k < samples.size(); ++k) {
+      while (samples[lo].a < samples[k].a - 3 * x_height) ++lo;
+      while (hi < samples.size() && samples[hi].a <= samples[k].a + 3 * x_height) ++hi;
+      out[k] = e[k] - Median(std::vector<double>(e.begin() + long(lo), e.begin() + long(hi)));
+    }
+    return out;
+  };
+
+  // 5. Which side is the baseline. Two kinds of evidence:
+  //    - Almost every letter sits on the baseline, while on the other side
+  //      the x-height and the ascenders, capitals and digits alternate: the
+  //      side whose outline strays less from its local median is the
+  //      baseline (counted over narrow bins, so letters merged into words at
+  //      low resolution do not matter).
+  //    - Small marks: periods and commas sit inside the band on the
+  //      baseline, i- and j-dots float outside it on the other side.
+  //    Where neither is clear (a receipt of capitals and digits without
+  //    periods) or they disagree, no text segments are made: a mean line
+  //    taken for a baseline would be off by a whole x-height.
+  double stray_plus = 0, stray_minus = 0;
+  for (const auto& chain : chains) {
+    if (chain.size() < 3) continue;
+    for (double side : {1.0, -1.0})
+      for (double o : offsets(outline(chain, side)))
+        (side > 0 ? stray_plus : stray_minus) += std::min(std::abs(o), 0.6 * x_height);
+  }
+  std::vector<Mark> small;
+  for (int l = 1; l < ink.count; ++l) {
+    const int w = ink.stats(l, cv::CC_STAT_WIDTH), h = ink.stats(l, cv::CC_STAT_HEIGHT);
+    if (ink.stats(l, cv::CC_STAT_AREA) < 2 || std::max(w, h) > 0.45 * x_height) continue;
+    Mark m;
+    const double left = ink.stats(l, cv::CC_STAT_LEFT) - 0.5, top = ink.stats(l, cv::CC_STAT_TOP) - 0.5;
+    m.a0 = m.c0 = 1e300;
+    m.a1 = m.c1 = -1e300;
+    for (const cv::Point2d corner : {cv::Point2d(left, top), cv::Point2d(left + w, top),
+                                     cv::Point2d(left, top + h), cv::Point2d(left + w, top + h)}) {
+      const double a = corner.dot(d), c = corner.dot(n);
+      m.a0 = std::min(m.a0, a); m.a1 = std::max(m.a1, a);
+      m.c0 = std::min(m.c0, c); m.c1 = std::max(m.c1, c);
+    }
+    small.push_back(m);
+  }
+  std::map<std::pair<int, int>, std::vector<const Mark*>> small_grid;
+  for (const Mark& m : small)
+    small_grid[{int(std::floor(m.along_mid() / cell)), int(std::floor(m.across_mid() / cell))}]
+        .push_back(&m);
+  int dots_plus = 0, dots_minus = 0;  // evidence that the baseline is on +n / -n
+  for (const auto& chain : chains) {
+    if (chain.size() < 3) continue;
+    std::vector<cv::Point2d> mids;
+    for (int k : chain) mids.emplace_back(marks[k].along_mid(), marks[k].across_mid());
+    const LineFit fit = FitLine(mids);
+    const double slope = fit.direction.y / (std::abs(fit.direction.x) > 1e-9 ? fit.direction.x : 1e-9);
+    auto trend = [&](double a) { return fit.point.y + slope * (a - fit.point.x); };
+    std::vector<double> tops, bottoms;
+    for (int k : chain) {
+      tops.push_back(marks[k].c0 - trend(marks[k].along_mid()));
+      bottoms.push_back(marks[k].c1 - trend(marks[k].along_mid()));
+    }
+    const double t = Median(tops), b = Median(bottoms), x = b - t;
+    if (x < 2) continue;
+    const double a_first = marks[chain.front()].a0, a_last = marks[chain.back()].a1;
+    const double mid = trend(0.5 * (a_first + a_last));
+    for (int gx = int(std::floor(a_first / cell)); gx <= int(std::floor(a_last / cell)); ++gx)
+      for (int gy = int(std::floor((mid + t - x) / cell)); gy <= int(std::floor((mid + b + x) / cell)); ++gy) {
+        auto it = small_grid.find({gx, gy});
+        if (it == small_grid.end()) continue;
+        for (const Mark* m : it->second) {
+          if (m->along_mid() < a_first || m->along_mid() > a_last) continue;
+          const double base = trend(m->along_mid());
+          const double c0 = m->c0 - base, c1 = m->c1 - base, c = 0.5 * (c0 + c1);
+          if (c < t - 0.9 * x || c > b + 0.9 * x) continue;
+          if (c1 < t + 0.1 * x) ++dots_plus;        // a dot above the band (-n side)
+          else if (c0 > b - 0.1 * x) ++dots_minus;  // a dot beyond the +n side
+          else if (c1 >= b - 0.25 * x && c0 > t + 0.4 * x) ++dots_plus;   // a period on +n
+          else if (c0 <= t + 0.25 * x && c1 < b - 0.4 * x) ++dots_minus;  // a period on -n
+        }
+      }
+  }
+  result.votes_upright = int(std::lround(stray_minus));
+  result.votes_upside_down = int(std::lround(stray_plus));
+  result.dots_upright = dots_plus;
+  result.dots_upside_down = dots_minus;
+  // -1: baseline on -n, +1: on +n, 0: unclear.
+  const int by_stray = stray_minus > 1.15 * stray_plus ? 1 : stray_plus > 1.15 * stray_minus ? -1 : 0;
+  const int dots = dots_plus + dots_minus;
+  const int by_dots = dots >= 5 && dots_plus >= 0.75 * dots ? 1
+                      : dots >= 5 && dots_minus >= 0.75 * dots ? -1 : 0;
+  const int side = by_stray != 0 && by_dots != 0 && by_stray != by_dots ? 0
+                   : by_stray != 0 ? by_stray : by_dots;
+  const double sign = side < 0 ? -1.0 : 1.0;
+  result.orientation_known = side != 0;
+  // Upside down: the baselines lie on the image-up side of their letters.
+  result.upside_down = side != 0 && sign * n.y < 0;
+
+  // 6. Baselines: the outline on the baseline side, descenders and raised
+  //    parts dropped, cut where it bends, fitted piece by piece.
+  const double tolerance = std::max(options.straightness_px, options.straightness_rel * x_height);
+  const double min_length = std::max(options.min_length_px, options.min_text_length * x_height);
+  for (const auto& chain : chains) {
+    for (int k : chain) result.is_character[size_t(marks[k].label)] = 1;
+    if (!result.orientation_known) continue;
+    const std::vector<Sample> samples = outline(chain, sign);
+    if (samples.size() < 5) continue;
+    const std::vector<double> off = offsets(samples);
+    const double band = 0.2 * x_height + 0.5;
+    std::vector<char> keep(samples.size());
+    for (size_t k = 0; k < samples.size(); ++k) keep[k] = std::abs(off[k]) <= band;
+    std::vector<cv::Point2d> kept;
+    std::vector<int> kept_mark;
+    for (size_t k = 0; k < samples.size(); ++k) {
+      if (!keep[k]) continue;
+      const double c = sign * samples[k].c;  // back to image pixels
+      kept.emplace_back(samples[k].a * d.x + c * n.x, samples[k].a * d.y + c * n.y);
+      kept_mark.push_back(samples[k].mark);
+    }
+    for (auto [first, last] : SplitWhereBent(kept, tolerance)) {
+      std::vector<cv::Point2d> piece(kept.begin() + first, kept.begin() + last + 1);
+      int characters = 0;
+      for (int k = first; k <= last; ++k) characters += k == first || kept_mark[size_t(k)] != kept_mark[size_t(k - 1)];
+      if (piece.size() < 5 || characters < 3) continue;
+      const LineFit fit = FitLine(piece);
+      if (fit.rms > 0.5 * tolerance) continue;
+      auto project = [&](const cv::Point2d& p) {
+        return fit.point + fit.direction * (p - fit.point).dot(fit.direction);
+      };
+      const cv::Point2d p0 = project(piece.front()), p1 = project(piece.back());
+      if (cv::norm(p1 - p0) < min_length) continue;
+      result.segments.push_back({"text", {p0, p1}, characters});
+    }
+  }
+  return result;
+}
+
+}  // namespace docunfold::features::detail

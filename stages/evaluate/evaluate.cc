@@ -1,0 +1,314 @@
+#include "stages/evaluate/evaluate.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+#include <opencv2/imgproc.hpp>
+
+#include "common/atomic_file.h"
+#include "common/camera.h"
+#include "common/cli.h"
+#include "common/errors.h"
+#include "common/ply.h"
+#include "common/raster.h"
+#include "stages/evaluate/geometry_metrics.h"
+#include "stages/evaluate/image_metrics.h"
+#include "stages/evaluate/ocr.h"
+#include "stages/evaluate/text_metrics.h"
+
+namespace docunfold::evaluate {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+std::string ReadTextFile(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path.string() + ": cannot open file");
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  return buffer.str();
+}
+
+// FNV-1a over the file's bytes and the OCR settings: a stable cache key
+// (std::hash is not stable across builds).
+std::string CacheKey(const fs::path& file, const std::string& settings) {
+  std::string bytes = ReadTextFile(file) + '\0' + settings;
+  uint64_t h = 1469598103934665603ull;
+  for (unsigned char c : bytes) {
+    h ^= c;
+    h *= 1099511628211ull;
+  }
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
+  return hex;
+}
+
+Json Number(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
+
+Json SizeJson(cv::Size s) { return Json::array({s.width, s.height}); }
+
+Json Skipped(const std::string& why) { return Json{{"skipped", why}}; }
+
+// OCR of the ground truth, from the cache when it holds this file's text.
+std::string GroundTruthText(Ocr& ocr, const fs::path& flat, const fs::path& work,
+                            bool use_cache, bool* from_cache) {
+  *from_cache = false;
+  if (!use_cache || work.empty()) return ocr.RecognizeFile(flat);
+  const fs::path cache =
+      work / "70_eval" / "ocr-cache" / (CacheKey(flat, ocr.Description()) + ".txt");
+  std::error_code ec;
+  if (fs::is_regular_file(cache, ec)) {
+    *from_cache = true;
+    return ReadTextFile(cache);
+  }
+  std::string text = ocr.RecognizeFile(flat);
+  try {
+    EnsureDirectory(cache.parent_path());
+    WriteTextAtomic(cache, text);
+  } catch (const OutputError& e) {
+    Log(std::string("cannot cache OCR text (") + e.what() + "); continuing");
+  }
+  return text;
+}
+
+Json ScoresJson(const TextScores& s) {
+  return Json{{"ed", s.ed},
+              {"reference_chars", s.reference_chars},
+              {"result_chars", s.result_chars},
+              {"cer", Number(s.cer)},
+              {"word_ed", s.word_ed},
+              {"reference_words", s.reference_words},
+              {"wer", Number(s.wer)}};
+}
+
+Json EvaluateOcr(const EvaluateInputs& in, const EvaluateOptions& options,
+                 const cv::Mat& result_image, cv::Size truth_size, Metrics* m) {
+  Ocr ocr(options.ocr_language);
+  bool cached = false;
+  const fs::path flat = in.data / "ground_truth" / "flat.png";
+  const std::string reference =
+      GroundTruthText(ocr, flat, in.work, options.ocr_cache, &cached);
+  const bool resize = options.ocr_at_truth_size && result_image.size() != truth_size;
+  std::string result;
+  if (resize) {
+    cv::Mat resized;
+    const bool enlarge = truth_size.area() > result_image.size().area();
+    cv::resize(result_image, resized, truth_size, 0, 0,
+               enlarge ? cv::INTER_CUBIC : cv::INTER_AREA);
+    result = ocr.RecognizeImage(resized);
+  } else {
+    result = ocr.RecognizeFile(in.result);
+  }
+  const TextScores s = CompareTexts(reference, result);
+  m->ed = double(s.ed);
+  m->cer = s.cer;
+  m->wer = s.wer;
+  Json out = ScoresJson(s);
+  out["engine"] = ocr.Description();
+  out["reference"] = "OCR of ground_truth/flat.png";
+  out["reference_from_cache"] = cached;
+  out["result_text"] = result;  // what OCR read, to see why a CER is what it is
+  out["result_ocr_size"] = SizeJson(resize ? truth_size : result_image.size());
+  const fs::path text_file = in.data / "ground_truth" / "text.txt";
+  std::error_code ec;
+  if (fs::is_regular_file(text_file, ec)) {
+    // text.txt has one line per text line and no paragraph gaps; OCR output
+    // has both, so whitespace is normalised before this comparison.
+    auto collapse = [](const std::string& t) {
+      return CodePointsToUtf8(CollapseWhitespace(Utf8ToCodePoints(t)));
+    };
+    const std::string truth = collapse(ReadTextFile(text_file));
+    const TextScores t = CompareTexts(truth, collapse(result));
+    const TextScores f = CompareTexts(truth, collapse(reference));
+    m->cer_text = t.cer;
+    m->wer_text = t.wer;
+    Json tj = ScoresJson(t);
+    tj["reference"] = "ground_truth/text.txt, whitespace collapsed";
+    tj["flat_cer"] = Number(f.cer);  // what OCR achieves on the flat scan
+    tj["flat_wer"] = Number(f.wer);
+    out["text_txt"] = tj;
+  } else {
+    out["text_txt"] = nullptr;
+  }
+  return out;
+}
+
+double PageDiagonal(const fs::path& page_json) {
+  const Json page = ReadJsonFile(page_json);
+  CheckFormat(page, page_json, "docunfold.gt-page", 1);
+  JsonReader r(page, page_json);
+  const double w = r.Number("/width_m"), h = r.Number("/height_m");
+  if (!(w > 0) || !(h > 0)) r.Fail("/width_m", "page size must be positive");
+  return std::hypot(w, h);
+}
+
+Json EvaluateGeometry(const EvaluateInputs& in, const EvaluateOptions& options,
+                      Metrics* m) {
+  const fs::path gt = in.data / "ground_truth";
+  std::error_code ec;
+  fs::path mesh_dir = options.mesh_dir;
+  if (mesh_dir.empty()) {
+    if (in.work.empty()) return Skipped("no work directory given");
+    for (const char* stage : {"50_optimize", "40_init"}) {
+      if (fs::is_regular_file(in.work / stage / "mesh3d.ply", ec)) {
+        mesh_dir = in.work / stage;
+        break;
+      }
+    }
+    if (mesh_dir.empty()) return Skipped("no mesh3d.ply in 50_optimize/ or 40_init/");
+  } else if (!fs::is_regular_file(mesh_dir / "mesh3d.ply", ec)) {
+    throw InputError((mesh_dir / "mesh3d.ply").string() + ": no such file (--mesh-dir)");
+  }
+  for (const char* f : {"mesh.ply", "cameras.json", "page.json"})
+    if (!fs::is_regular_file(gt / f, ec))
+      return Skipped(std::string("data set has no ground_truth/") + f);
+  const fs::path sfm_cameras = in.work / "10_sfm" / "cameras.json";
+  if (in.work.empty() || !fs::is_regular_file(sfm_cameras, ec))
+    return Skipped("no 10_sfm/cameras.json to align the meshes through");
+
+  const PlyData mesh3d = ReadPly(mesh_dir / "mesh3d.ply");
+  const PlyData truth = ReadPly(gt / "mesh.ply");
+  const double diagonal = PageDiagonal(gt / "page.json");
+  std::string why;
+  const auto alignment =
+      AlignCameras(ReadCameras(sfm_cameras), ReadCameras(gt / "cameras.json"), &why);
+  Json out{{"mesh_dir", mesh_dir.string()}, {"page_diagonal_m", diagonal}};
+  if (!alignment) {
+    out["surface_distance"] = Skipped(why);
+  } else {
+    const SurfaceDistance surface(truth.vertices, Triangulate(truth.faces));
+    const DistanceStats d =
+        MeshToSurface(mesh3d.vertices, alignment->truth_from_sfm, surface);
+    m->surface_mean_pct = 100 * d.mean / diagonal;
+    m->surface_max_pct = 100 * d.max / diagonal;
+    out["alignment"] = {
+        {"method", "similarity (Eigen::umeyama) of the camera centres of "
+                   "10_sfm/cameras.json onto ground_truth/cameras.json"},
+        {"cameras", alignment->cameras},
+        {"scale", alignment->truth_from_sfm.scale},
+        {"residual_pct", 100 * alignment->rms_residual / diagonal}};
+    out["surface_distance"] = {{"mean_pct", Number(m->surface_mean_pct)},
+                               {"max_pct", Number(m->surface_max_pct)},
+                               {"vertices", d.samples}};
+  }
+  if (fs::is_regular_file(mesh_dir / "mesh2d.ply", ec)) {
+    const PlyData mesh2d = ReadPly(mesh_dir / "mesh2d.ply");
+    const IsometryStats iso = IsometryError(
+        mesh3d, mesh2d, (mesh_dir / "mesh3d.ply").string() + " and mesh2d.ply");
+    m->isometry_mean = iso.mean;
+    m->isometry_max = iso.max;
+    out["isometry"] = {{"mean", iso.mean}, {"max", iso.max}, {"edges", iso.edges},
+                       {"definition", "|edge length in M - in M'| / length in M'"}};
+  } else {
+    out["isometry"] = Skipped("no mesh2d.ply beside mesh3d.ply");
+  }
+  return out;
+}
+
+}  // namespace
+
+bool HasGroundTruth(const fs::path& data) {
+  std::error_code ec;
+  return fs::is_regular_file(data / "ground_truth" / "flat.png", ec);
+}
+
+EvaluateResult Run(const EvaluateInputs& in, const EvaluateOptions& options) {
+  const auto start = Clock::now();
+  const fs::path flat_path = in.data / "ground_truth" / "flat.png";
+  const cv::Mat flat = ReadImage(flat_path);
+  const cv::Mat result = ReadImage(in.result);
+  EvaluateResult out;
+  Metrics& m = out.metrics;
+  Json seconds = Json::object();
+
+  auto t = Clock::now();
+  const EvaluationPair pair = PrepareEvaluationPair(flat, result);
+  const MsSsimResult ms = MsSsim(pair.ground_truth, pair.result);
+  m.ms_ssim = ms.value;
+  seconds["ms_ssim"] = SecondsSince(t);
+  Json ms_json{{"eval_size", SizeJson(pair.ground_truth.size())},
+               {"scales", ms.scales},
+               {"weights", kMsSsimWeights},
+               {"definition",
+                "DocUNet: MATLAB rgb2gray; ground truth resized (INTER_AREA) to "
+                "598400 pixels keeping aspect, result to the same size; SSIM "
+                "11x11 Gaussian sigma 1.5, replicated borders; 5 scales by "
+                "pyrDown (reflect); weighted sum, finest scale first, weights "
+                "divided by their sum 1.0001 so that identical images give 1"}};
+
+  Json flow_json;
+  if (options.flow) {
+    t = Clock::now();
+    const FlowResult flow = DenseFlowMetrics(pair.ground_truth, pair.result);
+    m.ld = flow.ld;
+    m.li_d = flow.li_d;
+    seconds["flow"] = SecondsSince(t);
+    flow_json = {{"method", "DeepFlow (OpenCV contrib optflow), a stand-in for "
+                            "the SIFT flow of the literature"},
+                 {"size", SizeJson(flow.size)},
+                 {"units", "pixels at the flow size (half the MS-SSIM size)"},
+                 {"ld", flow.ld},
+                 {"li_d", flow.li_d}};
+  } else {
+    flow_json = Skipped("--no-flow");
+  }
+
+  Json ocr_json;
+  if (options.ocr) {
+    t = Clock::now();
+    ocr_json = EvaluateOcr(in, options, result, flat.size(), &m);
+    seconds["ocr"] = SecondsSince(t);
+  } else {
+    ocr_json = Skipped("--no-ocr");
+  }
+
+  Json geometry_json;
+  if (options.geometry) {
+    t = Clock::now();
+    geometry_json = EvaluateGeometry(in, options, &m);
+    seconds["geometry"] = SecondsSince(t);
+  } else {
+    geometry_json = Skipped("--no-geometry");
+  }
+  seconds["total"] = SecondsSince(start);
+
+  Json opts{{"method", options.method},
+            {"ocr", options.ocr},
+            {"flow", options.flow},
+            {"geometry", options.geometry},
+            {"mesh_dir", options.mesh_dir.string()},
+            {"ocr_cache", options.ocr_cache},
+            {"ocr_language", options.ocr_language},
+            {"ocr_at_truth_size", options.ocr_at_truth_size}};
+  Json doc = MakeHeader("docunfold.metrics", 1, "evaluate", opts);
+  doc["method"] = options.method;
+  doc["data_set"] = fs::absolute(in.data).lexically_normal().string();
+  doc["result"] = in.result.string();
+  doc["ground_truth"] = flat_path.string();
+  doc["result_size"] = SizeJson(result.size());
+  doc["ground_truth_size"] = SizeJson(flat.size());
+  doc["metrics"] = {{"ms_ssim", Number(m.ms_ssim)},
+                    {"ld", Number(m.ld)},
+                    {"li_d", Number(m.li_d)},
+                    {"cer", Number(m.cer)},
+                    {"ed", std::isfinite(m.ed) ? Json(int64_t(m.ed)) : Json(nullptr)},
+                    {"wer", Number(m.wer)},
+                    {"cer_text", Number(m.cer_text)},
+                    {"wer_text", Number(m.wer_text)},
+                    {"surface_mean_pct", Number(m.surface_mean_pct)},
+                    {"surface_max_pct", Number(m.surface_max_pct)},
+                    {"isometry_mean", Number(m.isometry_mean)},
+                    {"isometry_max", Number(m.isometry_max)}};
+  doc["ms_ssim"] = ms_json;
+  doc["flow"] = flow_json;
+  doc["ocr"] = ocr_json;
+  doc["geometry"] = geometry_json;
+  doc["seconds"] = seconds;
+  out.document = std::move(doc);
+  return out;
+}
+
+}  // namespace docunfold::evaluate

@@ -1,0 +1,123 @@
+// optimize: the joint isometric optimisation of M and M' with feature lines.
+#include <cstdio>
+
+#include "common/cli.h"
+#include "stages/optimize/optimize.h"
+#include "stages/optimize/optimize_io.h"
+
+int main(int argc, char** argv) {
+  using namespace docunfold;
+  optimize::OptimizeOptions o;
+  optimize::InputPaths paths;
+  fs::path out;
+  std::string solver = "gn", linear = "auto";
+  bool no_features = false, no_projection = false, no_scene = false;
+  CLI::App app{
+      "optimize: jointly optimises the 3D page M and its flat twin M' under the isometry "
+      "constraint, fitted to the SfM points, with text lines, table rules and the real page "
+      "sides straightened in M' (Luo & Bo). Writes <out>/mesh3d.ply, mesh2d.ply, lines.json, "
+      "log.json, scene.glb and round0/ ... roundK/."};
+  app.add_option("--sfm", paths.sfm, "10_sfm/ (cameras.json, points.ply, reference.png)")
+      ->required();
+  app.add_option("--boundary", paths.boundary, "20_boundary/ or its boundary.json")->required();
+  app.add_option("--features", paths.features, "feature segments (docunfold.features)")
+      ->required();
+  app.add_option("--init", paths.init, "40_init/ (mesh3d.ply, mesh2d.ply)")->required();
+  app.add_option("--out", out, "output folder, e.g. 50_optimize")->required();
+  app.add_option("--rounds", o.rounds, "rounds of optimisation (subdivisions between them)")
+      ->capture_default_str();
+  app.add_option("--lambda-iso", o.weights.iso, "λ1, isometry")->capture_default_str();
+  app.add_option("--lambda-dist", o.weights.dist, "λ2, distance to the points")
+      ->capture_default_str();
+  app.add_option("--lambda-fair3d", o.weights.fair3d, "λ3, fairness of M")->capture_default_str();
+  app.add_option("--lambda-fair2d", o.weights.fair2d, "λ4, fairness of M'")
+      ->capture_default_str();
+  app.add_option("--lambda-line", o.weights.line, "λ5, straightness of feature lines in M'")
+      ->capture_default_str();
+  app.add_option("--lambda-ray", o.weights.ray, "λ6, feature points on their viewing rays")
+      ->capture_default_str();
+  app.add_option("--feature-growth", o.feature_weight_growth,
+                 "λ5 and λ6 are multiplied by this after each subdivision")
+      ->capture_default_str();
+  app.add_option("--tolerance", o.relative_tolerance, "inner loop stops when |ΔF/F| < this")
+      ->capture_default_str();
+  app.add_option("--max-iterations", o.max_outer_iterations, "outer iterations per round at most")
+      ->capture_default_str();
+  app.add_option("--outlier-distance", o.outlier_distance,
+                 "points farther from M than this fraction of the model size are ignored")
+      ->capture_default_str();
+  app.add_option("--solver", solver, "gn (Gauss-Newton/LM, sparse Cholesky) or lbfgs")
+      ->capture_default_str();
+  app.add_option("--linear-solver", linear,
+                 "Gauss-Newton's normal equations: auto (Cholesky on small grids, conjugate "
+                 "gradients on large), direct or cg")
+      ->capture_default_str();
+  app.add_flag("--no-features", no_features, "no feature lines at all (ablation)");
+  app.add_flag("--boundary-only", o.boundary_only, "only the real page sides as lines (ablation)");
+  app.add_flag("--no-projection", no_projection, "without feature line projection (ablation)");
+  app.add_option("--marker-step", o.marker_step_px, "sample spacing along segments, pixels")
+      ->capture_default_str();
+  app.add_option("--merge-gap", o.grouping.gap,
+                 "segments merge when their closest ends are this close along the line "
+                 "(fraction of the M' diagonal)")
+      ->capture_default_str();
+  app.add_option("--merge-offset", o.grouping.offset,
+                 "... and this close across it (fraction of the M' diagonal)")
+      ->capture_default_str();
+  app.add_option("--straightness", o.grouping.straightness,
+                 "largest h/w of a merged line's oriented box")
+      ->capture_default_str();
+  app.add_option("--axis-tolerance", o.grouping.axis_tolerance_deg,
+                 "lines kept within this many degrees of horizontal or vertical")
+      ->capture_default_str();
+  app.add_option("--threads", o.threads, "threads")->capture_default_str();
+  app.add_flag("--no-scene", no_scene, "do not write scene.glb");
+  return RunStage("optimize", app, argc, argv, [&] {
+    if (solver == "gn") {
+      o.method = isometry::Method::kGaussNewton;
+    } else if (solver == "lbfgs") {
+      o.method = isometry::Method::kLbfgs;
+    } else {
+      throw UsageError("--solver must be gn or lbfgs, not '" + solver + "'");
+    }
+    if (linear == "auto") {
+      o.linear_solver = isometry::LinearSolver::kAuto;
+    } else if (linear == "direct") {
+      o.linear_solver = isometry::LinearSolver::kDirect;
+    } else if (linear == "cg") {
+      o.linear_solver = isometry::LinearSolver::kConjugateGradient;
+    } else {
+      throw UsageError("--linear-solver must be auto, direct or cg, not '" + linear + "'");
+    }
+    o.features = !no_features;
+    o.project = !no_projection;
+    const Json options_json = {{"rounds", o.rounds},
+                               {"solver", solver},
+                               {"linear_solver", linear},
+                               {"lambda", {o.weights.iso, o.weights.dist, o.weights.fair3d,
+                                           o.weights.fair2d, o.weights.line, o.weights.ray}},
+                               {"feature_growth", o.feature_weight_growth},
+                               {"tolerance", o.relative_tolerance},
+                               {"max_iterations", o.max_outer_iterations},
+                               {"outlier_distance", o.outlier_distance},
+                               {"features", o.features},
+                               {"boundary_only", o.boundary_only},
+                               {"projection", o.project},
+                               {"marker_step", o.marker_step_px},
+                               {"merge_gap", o.grouping.gap},
+                               {"merge_offset", o.grouping.offset},
+                               {"straightness", o.grouping.straightness},
+                               {"axis_tolerance", o.grouping.axis_tolerance_deg}};
+    const optimize::OptimizeInputs in = optimize::ReadInputs(paths);
+    const optimize::OptimizeResult r = optimize::Run(in, o);
+    optimize::OutputOptions output;
+    output.scene = !no_scene;
+    optimize::WriteOutputs(out, paths, in, r, options_json, output);
+    char buf[200];
+    std::snprintf(buf, sizeof buf,
+                  "wrote %s: %dx%d grid after %zu rounds, %zu lines, %.1f s", out.c_str(),
+                  r.meshes.grid.nx, r.meshes.grid.ny, r.rounds.size(),
+                  r.rounds.back().lines.size(), r.seconds);
+    Log(buf);
+  });
+}

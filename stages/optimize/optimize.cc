@@ -1,0 +1,141 @@
+#include "stages/optimize/optimize.h"
+
+#include <chrono>
+#include <cstdio>
+
+#include "common/cli.h"
+#include "common/errors.h"
+#include "common/isometry/subdivision.h"
+
+namespace docunfold::optimize {
+namespace {
+
+std::vector<Segment> MakeSegments(const OptimizeInputs& in, const OptimizeOptions& o,
+                                  int* boundary_lines) {
+  std::vector<Segment> segments;
+  *boundary_lines = 0;
+  if (!o.features) return segments;
+  for (int i = 0; i < 4; ++i) {
+    if (!in.boundary.sides[i].real) continue;
+    segments.push_back({"boundary", i, SamplePolyline(in.boundary.sides[i].points, o.marker_step_px)});
+    ++*boundary_lines;
+  }
+  if (o.boundary_only) return segments;
+  for (const FeatureSegment& f : in.features.segments)
+    segments.push_back({f.kind, -1, SamplePolyline(f.points, o.marker_step_px)});
+  return segments;
+}
+
+}  // namespace
+
+OptimizeResult Run(const OptimizeInputs& in, const OptimizeOptions& o) {
+  const auto start = std::chrono::steady_clock::now();
+  if (o.rounds < 1) throw UsageError("--rounds must be at least 1");
+  OptimizeResult result;
+  result.segments = int(in.features.segments.size());
+  std::vector<Segment> segments = MakeSegments(in, o, &result.boundary_lines);
+
+  // Segments whose samples mostly miss the page (another detector's file
+  // with lines on the table, say) are reported and dropped.
+  if (!segments.empty()) {
+    const MarkerSet first = CastMarkers(in.init, in.reference, segments, o.cast);
+    std::vector<Segment> kept;
+    for (size_t s = 0; s < segments.size(); ++s) {
+      const bool on_page =
+          first.markers_of_segment[s] >= 0.5 * double(segments[s].pixels.size());
+      if (on_page || segments[s].kind == "boundary") {
+        kept.push_back(segments[s]);
+      } else {
+        ++result.segments_off_page;
+      }
+    }
+    segments.swap(kept);
+    if (result.segments_off_page > 0)
+      Log("warning: " + std::to_string(result.segments_off_page) + " of " +
+          std::to_string(result.segments) +
+          " feature segments fall outside the page and are dropped (" +
+          in.features.file.string() + ")");
+  }
+
+  MeshPair meshes = in.init;
+  isometry::Weights weights = o.weights;
+  if (segments.empty()) weights.line = weights.ray = 0;
+  for (int r = 0; r < o.rounds; ++r) {
+    if (r > 0) {
+      meshes = isometry::SubdivideCatmullClark(meshes);
+      weights.line *= o.feature_weight_growth;
+      weights.ray *= o.feature_weight_growth;
+    }
+    RoundResult round;
+    round.round = r;
+    round.weights = weights;
+    round.start_seconds = SecondsSince(start);
+
+    isometry::Problem problem;
+    problem.meshes = meshes;
+    problem.points = in.points;
+    isometry::SolveOptions so;
+    so.weights = weights;
+    so.outlier_distance = o.outlier_distance;
+    so.relative_tolerance = o.relative_tolerance;
+    so.max_outer_iterations = o.max_outer_iterations;
+    so.method = o.method;
+    so.linear_solver = o.linear_solver;
+    so.project_markers = o.project;
+    so.num_threads = o.threads;
+
+    // Every outer iteration: the samples' rays meet the current M, their
+    // points in M' are grouped into lines, and only markers on a line stay.
+    MarkerSet current;
+    Grouping grouping;
+    std::vector<int> kept;  // solver marker -> index in `current`
+    if (!segments.empty()) {
+      so.on_outer_iteration = [&](const isometry::OuterIterationContext& c) {
+        current = CastMarkers(*c.meshes, in.reference, segments, o.cast);
+        grouping = GroupSegments(*c.meshes, current, segments, o.grouping);
+        *c.lines = AssignLines(*c.meshes, grouping, &current);
+        c.markers->clear();
+        kept.clear();
+        for (size_t i = 0; i < current.markers.size(); ++i)
+          if (current.markers[i].line >= 0) {
+            c.markers->push_back(current.markers[i]);
+            kept.push_back(int(i));
+          }
+      };
+    }
+    isometry::Result solved = isometry::Solve(problem, so);
+    meshes = solved.meshes;
+    round.meshes = meshes;
+    round.report = solved.report;
+    for (size_t l = 0; l < solved.lines.size() && l < grouping.line_kind.size(); ++l) {
+      LineRecord rec;
+      rec.kind = grouping.line_kind[l];
+      rec.side = grouping.line_side[l];
+      rec.segments = grouping.line_segments[l];
+      rec.line = solved.lines[l];
+      round.lines.push_back(rec);
+    }
+    for (size_t k = 0; k < solved.markers.size() && k < kept.size(); ++k) {
+      const int line = solved.markers[k].line;
+      if (line < 0 || line >= int(round.lines.size())) continue;
+      round.lines[line].pixels.push_back(current.pixel[kept[k]]);
+      round.lines[line].flat.push_back(PointOnMesh2d(meshes, solved.markers[k].where));
+    }
+    result.inliers = solved.point_inlier;
+    const auto& last = solved.report.iterations.back();
+    char buf[256];
+    std::snprintf(buf, sizeof buf,
+                  "round %d: %dx%d grid, %zu iterations (%s), F %.4g, %d lines, %d markers, "
+                  "%d/%d points inside, %.1f s",
+                  r, meshes.grid.nx, meshes.grid.ny, solved.report.iterations.size(),
+                  solved.report.stop_reason.c_str(), last.F, last.lines, last.markers,
+                  last.inliers, last.inliers + last.outliers, solved.report.seconds);
+    Log(buf);
+    result.rounds.push_back(std::move(round));
+  }
+  result.meshes = meshes;
+  result.seconds = SecondsSince(start);
+  return result;
+}
+
+}  // namespace docunfold::optimize

@@ -1,0 +1,77 @@
+// optimize: the joint isometric optimisation of M and M' with feature lines
+// (paper §3-4, DESIGN §6): rounds of the inner loop of isometry::Solve,
+// separated by Catmull-Clark subdivision, with markers recast, feature lines
+// regrouped and markers projected onto their lines every outer iteration.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "common/camera.h"
+#include "common/grid_mesh.h"
+#include "common/isometry/isometry.h"
+#include "common/page_files.h"
+#include "stages/optimize/feature_lines.h"
+
+namespace docunfold::optimize {
+
+struct OptimizeOptions {
+  int rounds = 4;  // rounds of optimisation; rounds - 1 subdivisions between them
+  isometry::Weights weights;          // λ1..λ6 of the first round (paper values)
+  double feature_weight_growth = 4;   // λ5 and λ6 are multiplied by this per subdivision
+  double relative_tolerance = 0.01;   // inner loop stops when |ΔF/F| < this (ε)
+  int max_outer_iterations = 100;     // ... or after this many outer iterations (Q)
+  double outlier_distance = 0.06;     // φ, fraction of the model size
+  isometry::Method method = isometry::Method::kGaussNewton;
+  isometry::LinearSolver linear_solver = isometry::LinearSolver::kAuto;
+  bool features = true;        // false: no feature lines at all (--no-features)
+  bool boundary_only = false;  // only the real boundary sides (--boundary-only)
+  bool project = true;         // feature line projection (paper §"Feature line projection")
+  double marker_step_px = 4;   // sample spacing along segments, reference pixels
+  CastOptions cast;
+  GroupingOptions grouping;
+  int threads = 2;
+};
+
+struct OptimizeInputs {
+  MeshPair init;                         // 40_init/
+  PinholeCamera reference;               // reference camera (world = its frame)
+  std::vector<Eigen::Vector3d> points;   // SfM points
+  Boundary boundary;
+  FeatureFile features;
+};
+
+// A feature line at the end of a round, for lines.json.
+struct LineRecord {
+  std::string kind;  // text, edge, boundary
+  int side = -1;     // boundary side (0 top, 1 right, 2 bottom, 3 left)
+  int segments = 0;
+  isometry::FeatureLine line;             // n·p' = offset in M'
+  std::vector<Eigen::Vector2d> pixels;    // its markers in the reference image
+  std::vector<Eigen::Vector2d> flat;      // and in M'
+};
+
+struct RoundResult {
+  int round = 0;
+  MeshPair meshes;
+  isometry::Weights weights;
+  isometry::SolveReport report;
+  std::vector<LineRecord> lines;
+  double start_seconds = 0;  // since optimize started
+};
+
+struct OptimizeResult {
+  MeshPair meshes;                 // final M and M'
+  std::vector<RoundResult> rounds;
+  std::vector<bool> inliers;       // per SfM point, after the last round
+  int segments = 0;                // feature segments given (text + edge)
+  int segments_off_page = 0;       // of those, dropped: their samples miss M
+  int boundary_lines = 0;          // real boundary sides used
+  double seconds = 0;
+};
+
+// Throws InputError when the inputs do not fit together (features for
+// another image size, say) and std::runtime_error when the solver fails.
+OptimizeResult Run(const OptimizeInputs& inputs, const OptimizeOptions& options);
+
+}  // namespace docunfold::optimize

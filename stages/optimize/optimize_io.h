@@ -1,0 +1,40 @@
+// Files of the optimize stage: reading 10_sfm/, 20_boundary/, 30_features/
+// and 40_init/, and writing 50_optimize/ (final and per-round meshes,
+// lines.json, log.json, scene.glb).
+#pragma once
+
+#include <filesystem>
+
+#include <opencv2/core.hpp>
+
+#include "common/json_io.h"
+#include "stages/optimize/optimize.h"
+
+namespace docunfold::optimize {
+
+namespace fs = std::filesystem;
+
+struct InputPaths {
+  fs::path sfm;       // 10_sfm/
+  fs::path boundary;  // 20_boundary/ or its boundary.json
+  fs::path features;  // features.json
+  fs::path init;      // 40_init/
+};
+
+// Reads and checks every input (throws InputError naming file and problem).
+OptimizeInputs ReadInputs(const InputPaths& paths);
+
+struct OutputOptions {
+  bool scene = true;       // write scene.glb
+  int texture_width = 2048;  // scene.glb's texture, pixels at most
+};
+
+// Writes everything into `out` (each file atomically).
+void WriteOutputs(const fs::path& out, const InputPaths& paths, const OptimizeInputs& in,
+                  const OptimizeResult& result, const Json& options_json,
+                  const OutputOptions& output_options);
+
+Json LinesJson(const std::vector<LineRecord>& lines, const Json& options_json);
+Json LogJson(const OptimizeResult& result, const Json& options_json);
+
+}  // namespace docunfold::optimize

@@ -1,0 +1,96 @@
+// render: texture-maps M' with the reference image through M and writes the
+// cropped, rectified page. See render.h and the README section "render".
+#include <chrono>
+
+#include "common/cli.h"
+#include "stages/render/render.h"
+
+int main(int argc, char** argv) {
+  using namespace docunfold;
+  LimitOpenMpThreads(argv);
+  render::RenderOptions o;
+  std::string sfm, boundary, meshes, out;
+  CLI::App app{
+      "render: the flat, cropped page from the meshes M (mesh3d.ply) and M' "
+      "(mesh2d.ply) and the reference image"};
+  app.add_option("--sfm", sfm,
+                 "sfm output folder (cameras.json, reference.png)")
+      ->required();
+  app.add_option("--boundary", boundary,
+                 "segment-boundary output folder (boundary.json)")
+      ->required();
+  app.add_option(
+         "--meshes", meshes,
+         "folder with mesh3d.ply and mesh2d.ply (50_optimize or 40_init)")
+      ->required();
+  app.add_option(
+         "--out", out,
+         "output folder: rectified.png, rectified_grid.png, render.json")
+      ->required();
+  auto* width = app.add_option("--width", o.width,
+                               "output width in pixels (default: keep the "
+                               "reference image's pixel density on the page)");
+  auto* height =
+      app.add_option("--height", o.height, "output height in pixels");
+  auto* dpi = app.add_option("--dpi", o.dpi,
+                             "dots per inch; needs --page-width-mm or "
+                             "--page-height-mm");
+  auto* scale = app.add_option("--scale", o.scale,
+                               "multiple of the reference image's pixel "
+                               "density on the page");
+  width->excludes(height, dpi, scale);
+  height->excludes(dpi, scale);
+  dpi->excludes(scale);
+  auto* pw = app.add_option(
+      "--page-width-mm", o.page_width_mm,
+      "physical width of the crop (the page's width when its left and "
+      "right sides are real), for --dpi");
+  auto* ph = app.add_option("--page-height-mm", o.page_height_mm,
+                            "physical height of the crop, for --dpi");
+  pw->excludes(ph);
+  app.add_option("--max-pixels", o.max_pixels, "cap on width*height")
+      ->capture_default_str();
+  app.add_option("--fill", o.fill,
+                 "colour where the crop shows no visible page: paper (median "
+                 "page colour), white or #RRGGBB")
+      ->capture_default_str();
+  bool no_antialias = false, no_deskew = false, no_orient = false;
+  app.add_flag("--no-orient", no_orient,
+               "keep the page as M' has it, even if its text reads sideways or "
+               "upside down (by default Tesseract decides which way up)");
+  app.add_flag("--no-antialias", no_antialias,
+               "plain bicubic even when minifying");
+  app.add_flag("--no-deskew", no_deskew,
+               "do not turn M' to make the boundary lines axis aligned");
+  app.add_option("--max-deskew-deg", o.max_deskew_deg, "largest tilt corrected")
+      ->capture_default_str();
+  app.add_option("--side-snap", o.side_snap,
+                 "boundary samples up to this far outside M (fraction of the "
+                 "image diagonal) "
+                 "are mapped onto the plane of the nearest face")
+      ->capture_default_str();
+  app.add_flag(
+      "--sample-hidden", o.sample_hidden,
+      "sample the reference image also where it does not see the page");
+  return RunStage("render", app, argc, argv, [&] {
+    const auto start = std::chrono::steady_clock::now();
+    o.antialias = !no_antialias;
+    o.deskew = !no_deskew;
+    o.orient = !no_orient;
+    const render::RenderInputs in =
+        render::ReadRenderInputs(sfm, boundary, meshes);
+    const double read_s = SecondsSince(start);
+    render::RenderResult result = render::Run(o, in);
+    result.report["timing_s"]["read"] = read_s;
+    const auto write_start = std::chrono::steady_clock::now();
+    render::WriteRenderOutputs(out, result);
+    Log("wrote " + out + "/rectified.png " +
+        std::to_string(result.rectified.cols) + "x" +
+        std::to_string(result.rectified.rows) + " (crop " + result.crop_rule +
+        ", size " + result.size_rule + ", rotation " +
+        std::to_string(result.rotation_deg) + " deg) in " +
+        std::to_string(SecondsSince(start)) + " s (read " +
+        std::to_string(read_s) + " s, write " +
+        std::to_string(SecondsSince(write_start)) + " s)");
+  });
+}

@@ -1,0 +1,144 @@
+// render: the flat page out of the pipeline (DESIGN §5, paper §"Image
+// generation of rectified document"). M' is texture-mapped with the
+// reference image through M: every output pixel is a point of M' (triangle
+// and barycentrics), the same point of M is projected by the reference
+// camera and the reference image is sampled there (bicubic, filtered over
+// the pixel's footprint when minifying). The output is cropped to the
+// rectangle bounded by the lines fitted to the real boundary sides in M'.
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <filesystem>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "common/camera.h"
+#include "common/grid_mesh.h"
+#include "common/json_io.h"
+#include "common/page_files.h"
+
+namespace docunfold::render {
+
+namespace fs = std::filesystem;
+
+// How the output size is chosen. At most one of width, height, dpi and
+// scale may be set (main enforces it; Run throws UsageError otherwise).
+struct RenderOptions {
+  // Output width or height in pixels (0 = not set); the other side follows
+  // the crop's aspect ratio, pixels are square.
+  int width = 0;
+  int height = 0;
+  // Dots per inch on the physical page. Photos carry no absolute scale, so
+  // dpi needs the physical size of the crop: page_width_mm (the crop's width,
+  // i.e. the page's width whenever its left and right sides are real) or
+  // page_height_mm. 0 = not set.
+  double dpi = 0;
+  double page_width_mm = 0;
+  double page_height_mm = 0;
+  // Multiplier of the reference image's pixel density on the page (the
+  // default size: the median over visible faces of sqrt(area in the
+  // reference image / area in M') pixels per unit of M'). 0 = not set (1).
+  double scale = 0;
+  // Upper bound on width*height (25 MP: an A4 page at ~500 dpi; render needs
+  // about 40 bytes per output pixel). The default size is scaled down to fit
+  // (and logged); an explicitly requested size above it is a usage error.
+  double max_pixels = 25e6;
+  // Fill for crop pixels that show no page: outside M', or points of the page
+  // the reference view does not see (hidden by the page itself, seen from
+  // behind or outside the image). "paper" = the per-channel median colour of
+  // the rendered page, "white", or "#RRGGBB".
+  std::string fill = "paper";
+  // Pre-filter when minifying (image pyramid + anisotropic taps). Off only to
+  // measure what it buys.
+  bool antialias = true;
+  // Turn M' by the small angle that makes the fitted boundary lines axis
+  // aligned (at most max_deskew_deg; larger tilts are left alone and logged).
+  bool deskew = true;
+  double max_deskew_deg = 20;
+  // Sample the reference image even where the page is hidden from the
+  // reference view by the page itself or seen from behind (by default such
+  // pixels get the fill colour). Points outside the image are always filled.
+  bool sample_hidden = false;
+  // Boundary sides mapped onto M: a sample whose viewing ray misses M is
+  // taken on the plane of the nearest face of M within this distance (the
+  // mesh border may run a little inside the segmented outline: init-mesh
+  // keeps a margin); farther samples are dropped. Fraction of the reference
+  // image's diagonal (0.006: 12 px at 1600x1200, 30 px at 4000x3000).
+  double side_snap = 0.006;
+  // Grid overlay colour (BGR) and minimum spacing of drawn grid lines in
+  // output pixels (denser grids are drawn every k-th line).
+  // Turn the result by quarter turns so that its text reads upright
+  // (Tesseract reads it each way; see orientation.h). The boundary cannot
+  // tell a page's top from its sides, so without this the page may come out
+  // on its side or upside down.
+  bool orient = true;
+  cv::Scalar grid_color = cv::Scalar(40, 40, 230);
+  double grid_min_spacing_px = 12;
+};
+
+struct RenderInputs {
+  PinholeCamera camera;  // reference camera (world frame = its frame)
+  cv::Mat reference;     // reference.png, 8-bit BGR
+  Boundary boundary;
+  MeshPair meshes;
+  // Where each input came from, for error messages and the report.
+  fs::path cameras_file, reference_file, meshes_dir;
+};
+
+// Per boundary side: what its mapping onto M' gave.
+struct SideFit {
+  bool real = false;
+  bool used = false;  // real, and enough of it maps onto M
+  int samples = 0;    // pixels sampled along the side
+  int mapped = 0;     // of those, mapped onto M and kept as inliers
+  Eigen::Vector2d point = Eigen::Vector2d::Zero();       // on the line (M')
+  Eigen::Vector2d direction = Eigen::Vector2d::UnitX();  // unit
+  double rms = 0;    // residual of the fit, M' units
+  std::string note;  // why a real side was not used
+};
+
+struct RenderResult {
+  cv::Mat rectified;       // 8-bit BGR
+  cv::Mat rectified_grid;  // the same with the edges of M' drawn
+  cv::Mat1b page_mask;     // 255 where `rectified` shows the page (not fill)
+  // Crop rectangle in M' units (after the deskew rotation) and the scale.
+  double crop_x0 = 0, crop_y0 = 0, crop_x1 = 0, crop_y1 = 0;
+  double pixels_per_unit = 0;
+  double reference_pixels_per_unit = 0;  // the reference image's density
+  double rotation_deg = 0;               // deskew applied to M'
+  std::string crop_rule;  // "boundary-lines", "real-sides-and-visible-mesh",
+                          // "visible-mesh"
+  std::string
+      size_rule;  // "reference-density", "width", "height", "dpi", "scale"
+  bool capped = false;  // the default size was reduced to max_pixels
+  std::array<SideFit, 4> sides;
+  cv::Vec3b fill;
+  double page_fraction = 0;      // output pixels showing the page
+  double hidden_fraction = 0;    // output pixels on M' but not seen
+  double minified_fraction = 0;  // output pixels that needed pre-filtering
+  int grid_line_step = 1;
+  // Clockwise quarter turns applied to the images after rendering (the crop
+  // and pixels_per_unit above refer to the unturned image).
+  int quarter_turns = 0;
+  std::vector<std::pair<std::string, double>> timings;  // seconds per step
+  Json report;  // render.json (docunfold.render)
+};
+
+// Reads and validates everything render needs; InputError naming the file
+// and the problem otherwise.
+RenderInputs ReadRenderInputs(const fs::path& sfm_dir,
+                              const fs::path& boundary_dir,
+                              const fs::path& meshes_dir);
+
+// Renders the rectified page. Throws InputError for inconsistent inputs
+// (image sizes, mesh behind the camera or out of view) and UsageError for
+// contradictory size options.
+RenderResult Run(const RenderOptions& options, const RenderInputs& inputs);
+
+// Writes rectified.png, rectified_grid.png and render.json into `out_dir`:
+// all three or none (OutputError).
+void WriteRenderOutputs(const fs::path& out_dir, const RenderResult& result);
+
+}  // namespace docunfold::render

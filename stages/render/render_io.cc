@@ -1,0 +1,82 @@
+// Reading render's inputs and writing its outputs (all or nothing).
+#include <memory>
+#include <opencv2/imgcodecs.hpp>
+
+#include "common/atomic_file.h"
+#include "common/errors.h"
+#include "stages/render/render.h"
+
+namespace docunfold::render {
+
+RenderInputs ReadRenderInputs(const fs::path& sfm_dir,
+                              const fs::path& boundary_dir,
+                              const fs::path& meshes_dir) {
+  RenderInputs in;
+  in.cameras_file = sfm_dir / "cameras.json";
+  in.reference_file = sfm_dir / "reference.png";
+  in.meshes_dir = meshes_dir;
+  const CameraSet cameras = ReadCameras(in.cameras_file);
+  if (cameras.reference.empty())
+    throw InputError(in.cameras_file.string() +
+                     ":/reference: missing; render needs sfm's cameras.json, "
+                     "which names the "
+                     "reference view");
+  in.camera = *cameras.Find(cameras.reference);
+  in.reference = ReadImage(in.reference_file, cv::IMREAD_COLOR);
+  in.boundary = ReadBoundary(boundary_dir / "boundary.json");
+  std::error_code ec;
+  if (!fs::is_directory(meshes_dir, ec))
+    throw InputError(meshes_dir.string() +
+                     ": no such directory (expected mesh3d.ply, mesh2d.ply)");
+  in.meshes = ReadMeshPair(meshes_dir);
+  return in;
+}
+
+void WriteRenderOutputs(const fs::path& out_dir, const RenderResult& result) {
+  if (result.rectified.empty() || result.rectified_grid.empty())
+    throw OutputError(out_dir.string() + ": nothing to write");
+  EnsureDirectory(out_dir);
+  // A target that exists as something other than a file (a directory in the
+  // way) would fail its rename after the others were renamed: refuse first.
+  for (const char* name :
+       {"rectified.png", "rectified_grid.png", "render.json"}) {
+    std::error_code ec;
+    const fs::path target = out_dir / name;
+    if (fs::exists(fs::symlink_status(target, ec)) &&
+        !fs::is_regular_file(target, ec))
+      throw OutputError(target.string() + ": exists and is not a regular file");
+  }
+  // Everything goes to temporary files first; only when all three are
+  // complete are they renamed into place.
+  AtomicOutput rectified(out_dir / "rectified.png");
+  AtomicOutput grid(out_dir / "rectified_grid.png");
+  AtomicOutput report(out_dir / "render.json");
+  // Light PNG compression: the files are large and written on every run.
+  const std::vector<int> png = {cv::IMWRITE_PNG_COMPRESSION, 3};
+  auto write_image = [&](const AtomicOutput& out, const cv::Mat& image) {
+    bool ok = false;
+    try {
+      ok = cv::imwrite(out.temp_path().string(), image, png);
+    } catch (const cv::Exception& e) {
+      throw OutputError(out.target().string() + ": " + e.what());
+    }
+    if (!ok) throw OutputError(out.target().string() + ": cannot write image");
+  };
+  write_image(rectified, result.rectified);
+  write_image(grid, result.rectified_grid);
+  {
+    // WriteJsonAtomic would commit on its own; write the text by hand.
+    FILE* f = std::fopen(report.temp_path().c_str(), "wb");
+    if (!f)
+      throw OutputError(report.target().string() + ": cannot open for writing");
+    const std::string text = result.report.dump(1) + "\n";
+    const bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();
+    if (std::fclose(f) != 0 || !ok)
+      throw OutputError(report.target().string() + ": write failed");
+  }
+  rectified.Commit();
+  grid.Commit();
+  report.Commit();
+}
+
+}  // namespace docunfold::render

@@ -1,0 +1,419 @@
+#include "stages/report/report.h"
+
+#include <algorithm>
+#include <chrono>
+#include <ctime>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "common/camera.h"
+#include "common/cli.h"
+#include "common/dataset.h"
+#include "common/errors.h"
+#include "common/grid_mesh.h"
+#include "common/json_io.h"
+#include "common/ply.h"
+#include "stages/report/html.h"
+#include "stages/report/mesh_views.h"
+
+namespace docunfold::report {
+namespace {
+
+std::string Fmt(double v, const char* format = "%.3f") {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, format, v);
+  return buf;
+}
+
+std::string ReadText(const fs::path& p) {
+  std::ifstream f(p);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+// A JSON file if it exists and parses; null otherwise (the report shows what
+// there is and never fails on one stage's output).
+Json TryJson(const fs::path& p) {
+  std::error_code ec;
+  if (!fs::is_regular_file(p, ec)) return nullptr;
+  try {
+    return ReadJsonFile(p);
+  } catch (const std::exception& e) {
+    Log("warning: " + std::string(e.what()));
+    return nullptr;
+  }
+}
+
+cv::Mat TryImage(const fs::path& p) {
+  std::error_code ec;
+  if (!fs::is_regular_file(p, ec)) return {};
+  return cv::imread(p.string(), cv::IMREAD_COLOR);
+}
+
+std::string Missing(const std::string& what) {
+  return "<p class=\"missing\">" + Escape(what) + "</p>";
+}
+
+class Page {
+ public:
+  void Section(const std::string& id, const std::string& title) {
+    body_ += "<section id=\"" + id + "\"><h2>" + Escape(title) + "</h2>\n";
+    toc_ += "<a href=\"#" + id + "\">" + Escape(title) + "</a> ";
+  }
+  void End() { body_ += "</section>\n"; }
+  void Add(const std::string& html) { body_ += html; }
+  std::string Html(const std::string& title, const std::string& summary) const {
+    return "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
+           "<title>" + Escape(title) + "</title><style>"
+           "body{font-family:sans-serif;margin:1.5em auto;max-width:1200px;color:#222}"
+           "h1{margin-bottom:0.2em}h2{border-bottom:1px solid #ccc;padding-bottom:0.2em;"
+           "margin-top:1.6em}nav a{margin-right:1em}figure{display:inline-block;margin:0.4em;"
+           "vertical-align:top}figcaption{font-size:0.85em;color:#555;max-width:600px}"
+           "table{border-collapse:collapse;margin:0.5em 0}td,th{border:1px solid #ccc;"
+           "padding:3px 8px;text-align:right}th{background:#f0f0f0}td.l,th.l{text-align:left}"
+           ".ref{outline:4px solid #d62728}.missing{color:#a00;font-style:italic}"
+           "code{background:#f4f4f4;padding:1px 3px}img{max-width:100%;height:auto}"
+           "</style></head><body>\n<h1>" + Escape(title) + "</h1><p>" + summary +
+           "</p><nav>" + toc_ + "</nav>\n" + body_ + "</body></html>\n";
+  }
+
+ private:
+  std::string body_, toc_;
+};
+
+std::string Figure(const std::string& img, const std::string& caption) {
+  return "<figure>" + img + "<figcaption>" + caption + "</figcaption></figure>";
+}
+
+// The newest entry per stage of <work>/timings.jsonl (pipeline.mk appends
+// one line per stage run).
+std::map<std::string, Json> StageTimings(const fs::path& work) {
+  std::map<std::string, Json> out;
+  std::ifstream f(work / "timings.jsonl");
+  std::string line;
+  while (std::getline(f, line)) {
+    try {
+      Json j = Json::parse(line);
+      out[j.at("stage").get<std::string>()] = j;
+    } catch (const std::exception&) {
+    }
+  }
+  return out;
+}
+
+void PhotosSection(const ReportOptions& o, const DataSet& data, const Json& cameras, Page* page) {
+  page->Section("photos", "Photos and the reference view");
+  std::string reference = cameras.is_object() ? cameras.value("reference", "") : "";
+  std::string html;
+  for (const fs::path& p : data.images) {
+    cv::Mat image = cv::imread(p.string(), cv::IMREAD_COLOR);
+    if (image.empty()) continue;
+    const std::string name = p.filename().string();
+    const bool is_ref = name == reference;
+    std::string img = InlineImage(image, o.thumbnail_width, name);
+    if (is_ref) img.insert(4, " class=\"ref\"");
+    bool registered = false;
+    if (cameras.is_object())
+      for (const Json& v : cameras.at("views"))
+        registered = registered || v.value("image", "") == name;
+    html += Figure(img, Escape(name) + (is_ref ? " — <b>reference</b>" : "") +
+                            (cameras.is_object() && !registered ? " — not registered" : ""));
+  }
+  page->Add(html);
+  if (!cameras.is_object()) {
+    page->Add(Missing("sfm has not run yet (10_sfm/cameras.json is missing)."));
+  } else {
+    std::string why = "Chosen automatically by sfm: the registered view that sees the most of "
+                      "the page most frontally.";
+    const std::string flags = ReadText(o.work / ".flags/sfm");
+    if (flags.find("--ref") != std::string::npos)
+      why = "Chosen by the user (<code>REF=</code>).";
+    // sfm's scores of every view (cameras.json /reference_selection/views).
+    if (cameras.contains("reference_selection")) {
+      const Json& c = cameras["reference_selection"];
+      if (c.contains("views") && c["views"].is_array() && !c["views"].empty()) {
+        why += "<table><tr><th class=l>view</th>";
+        std::vector<std::string> keys;
+        for (const auto& [k, v] : c["views"][0].items())
+          if (k != "image" && v.is_number()) keys.push_back(k);
+        for (const auto& k : keys) why += "<th>" + Escape(k) + "</th>";
+        why += "</tr>";
+        for (const Json& cand : c["views"]) {
+          why += "<tr><td class=l>" + Escape(cand.value("image", "?")) + "</td>";
+          for (const auto& k : keys)
+            why += "<td>" + (cand.contains(k) && cand[k].is_number()
+                                 ? Fmt(cand[k].get<double>(), "%.3g")
+                                 : std::string("–")) + "</td>";
+          why += "</tr>";
+        }
+        why += "</table>";
+      }
+    }
+    page->Add("<p>" + std::to_string(cameras.at("views").size()) + " of " +
+              std::to_string(data.images.size()) + " views registered. " + why + "</p>");
+  }
+  page->End();
+}
+
+void BoundarySection(const ReportOptions& o, Page* page) {
+  page->Section("boundary", "Boundary and feature segments");
+  const Json boundary = TryJson(o.work / "20_boundary/boundary.json");
+  const cv::Mat overlay = TryImage(o.work / "20_boundary/overlay.png");
+  if (!overlay.empty()) {
+    std::string caption = "Document boundary (20_boundary/overlay.png).";
+    if (boundary.is_object() && boundary.contains("sides")) {
+      caption += " Sides:";
+      for (const char* s : {"top", "right", "bottom", "left"})
+        if (boundary["sides"].contains(s))
+          caption += std::string(" ") + s + " " +
+                     (boundary["sides"][s].value("real", false) ? "real" : "<b>cut off</b>");
+    }
+    page->Add(Figure(InlineImage(overlay, o.figure_width / 2 + 100, "boundary"), caption));
+  } else {
+    page->Add(Missing("segment-boundary has not run yet."));
+  }
+  const Json features = TryJson(o.work / "30_features/features.json");
+  const cv::Mat foverlay = TryImage(o.work / "30_features/overlay.png");
+  std::string caption;
+  if (features.is_object() && features.contains("segments")) {
+    int text = 0, edge = 0;
+    for (const Json& s : features["segments"])
+      (s.value("kind", "") == "text" ? text : edge)++;
+    caption = std::to_string(text) + " text and " + std::to_string(edge) +
+              " edge segments (30_features/features.json).";
+    if (features.contains("producer") && features["producer"].value("stage", "") != "detect-features")
+      caption += " From another detector.";
+  }
+  if (!foverlay.empty())
+    page->Add(Figure(InlineImage(foverlay, o.figure_width / 2 + 100, "features"), caption));
+  else if (!caption.empty())
+    page->Add("<p>" + caption + " (no overlay: the file came from another detector)</p>");
+  else
+    page->Add(Missing("detect-features has not run yet."));
+  page->End();
+}
+
+void MeshSection(const ReportOptions& o, const Json& cameras, Page* page, fs::path* mesh_dir) {
+  page->Section("meshes", "Point cloud and meshes");
+  *mesh_dir = fs::path();
+  for (const char* d : {"50_optimize", "40_init"})
+    if (fs::is_regular_file(o.work / d / "mesh3d.ply")) {
+      *mesh_dir = o.work / d;
+      break;
+    }
+  if (mesh_dir->empty() || !cameras.is_object()) {
+    page->Add(Missing("No meshes yet (init-mesh has not run)."));
+    page->End();
+    return;
+  }
+  try {
+    const MeshPair mesh = ReadMeshPair(*mesh_dir);
+    const CameraSet set = ReadCameras(o.work / "10_sfm/cameras.json");
+    const PinholeCamera* ref = set.Find(set.reference);
+    std::vector<Eigen::Vector3d> points;
+    std::error_code ec;
+    if (fs::is_regular_file(o.work / "10_sfm/points.ply", ec))
+      points = ReadPly(o.work / "10_sfm/points.ply").vertices;
+    const cv::Mat texture = TryImage(o.work / "10_sfm/reference.png");
+    std::string html;
+    for (auto [yaw, pitch] : {std::pair<double, double>{-35, -20}, {40, 25}}) {
+      MeshViewOptions v;
+      v.yaw_deg = yaw;
+      v.pitch_deg = pitch;
+      cv::Mat picture = RenderMeshView(mesh, *ref, texture, points, v);
+      html += Figure(InlineImage(picture, v.width, "M"),
+                     "M from " + Fmt(yaw, "%+.0f") + "°, " + Fmt(pitch, "%+.0f") +
+                         "° off the reference view, with the SfM points (red)");
+    }
+    page->Add(html);
+    page->Add("<p>M and M' from <code>" + Escape(mesh_dir->filename().string()) + "/</code>: " +
+              std::to_string(mesh.grid.nx) + " × " + std::to_string(mesh.grid.ny) +
+              " vertices; " + std::to_string(points.size()) +
+              " SfM points. Open <code>mesh3d.ply</code> in MeshLab to see M textured, or "
+              "<code>50_optimize/scene.glb</code> in any glTF viewer.</p>");
+  } catch (const std::exception& e) {
+    page->Add(Missing(std::string("Cannot draw the meshes: ") + e.what()));
+  }
+  page->End();
+}
+
+void ConvergenceSection(const ReportOptions& o, Page* page) {
+  page->Section("convergence", "Convergence of the optimisation");
+  const Json log = TryJson(o.work / "50_optimize/log.json");
+  if (!log.is_object() || !log.contains("rounds")) {
+    page->Add(Missing("optimize has not run yet (50_optimize/log.json is missing)."));
+    page->End();
+    return;
+  }
+  std::vector<PlotPoint> points;
+  PlotOptions plot;
+  plot.x_label = "time (s)";
+  plot.y_label = "F";
+  plot.log_y = true;
+  std::string table = "<table><tr><th class=l>round</th><th>grid</th><th>iterations</th>"
+                      "<th>final F</th><th>seconds</th><th class=l>stopped</th></tr>";
+  for (const Json& round : log["rounds"]) {
+    const int r = round.value("round", 0);
+    plot.series_names.push_back("round " + std::to_string(r));
+    double last_f = 0, last_t = 0;
+    for (const Json& it : round.value("iterations", Json::array())) {
+      last_f = it.value("F", 0.0);
+      last_t = it.value("seconds", 0.0);
+      points.push_back({last_t, last_f, r});
+    }
+    std::string grid = "–";
+    if (round.contains("grid") && round["grid"].size() == 2)
+      grid = std::to_string(round["grid"][0].get<int>()) + "×" +
+             std::to_string(round["grid"][1].get<int>());
+    table += "<tr><td class=l>" + std::to_string(r) + "</td><td>" + grid + "</td><td>" +
+             std::to_string(round.value("iterations", Json::array()).size()) + "</td><td>" +
+             Fmt(last_f, "%.3e") + "</td><td>" + Fmt(last_t, "%.2f") + "</td><td class=l>" +
+             Escape(round.value("stop_reason", "")) + "</td></tr>";
+  }
+  table += "</table>";
+  page->Add(SvgScatter(points, plot));
+  page->Add("<p>Each dot is one outer iteration (footpoints, outliers and feature lines "
+            "recomputed, then one solver step); colours are rounds, separated by "
+            "Catmull–Clark subdivision.</p>" + table);
+  page->End();
+}
+
+std::string MetricsRow(const Json& m) {
+  const Json& v = m.at("metrics");
+  auto cell = [&](const char* key, const char* format) {
+    return "<td>" + (v.contains(key) && v[key].is_number() ? Fmt(v[key].get<double>(), format)
+                                                           : std::string("–")) + "</td>";
+  };
+  return "<tr><td class=l>" + Escape(m.value("method", "?")) + "</td>" +
+         cell("ms_ssim", "%.4f") + cell("ld", "%.2f") + cell("li_d", "%.2f") +
+         cell("cer", "%.3f") + cell("wer", "%.3f") + cell("surface_mean_pct", "%.2f") +
+         cell("isometry_mean", "%.4f") + "</tr>";
+}
+
+void ResultSection(const ReportOptions& o, const DataSet& data, const fs::path& mesh_dir,
+                   Page* page) {
+  page->Section("result", "The rectified page");
+  const cv::Mat rectified = TryImage(o.work / "60_render/rectified.png");
+  const cv::Mat grid = TryImage(o.work / "60_render/rectified_grid.png");
+  if (rectified.empty()) {
+    page->Add(Missing("render has not run yet."));
+    page->End();
+    return;
+  }
+  std::string html = Figure(InlineImage(rectified, o.figure_width / 2, "rectified"),
+                            "60_render/rectified.png (" + std::to_string(rectified.cols) + " × " +
+                                std::to_string(rectified.rows) + ")");
+  if (!grid.empty())
+    html += Figure(InlineImage(grid, o.figure_width / 2, "rectified with M'"),
+                   "The same with the edges of M' (from " +
+                       Escape(mesh_dir.filename().string()) + ")");
+  const Json lines = TryJson(o.work / "50_optimize/lines.json");
+  std::string lines_note;
+  if (lines.is_object() && lines.contains("lines")) {
+    std::map<std::string, int> kinds;
+    for (const Json& l : lines["lines"]) kinds[l.value("kind", "?")]++;
+    lines_note = "Feature lines straightened in M':";
+    for (const auto& [k, n] : kinds) lines_note += " " + std::to_string(n) + " " + k;
+    lines_note += " (50_optimize/lines.json).";
+  }
+  const cv::Mat flat = TryImage(data.ground_truth("flat.png"));
+  if (!flat.empty())
+    html += Figure(InlineImage(flat, o.figure_width / 2, "ground truth"),
+                   "ground_truth/flat.png, the true flat page");
+  page->Add(html);
+  if (!lines_note.empty()) page->Add("<p>" + lines_note + "</p>");
+
+  // Metrics of every method evaluated in 70_eval/ (docunfold, homography, oracle, ...).
+  std::vector<Json> metrics;
+  std::error_code ec;
+  if (fs::is_directory(o.work / "70_eval", ec))
+    for (const auto& e : fs::recursive_directory_iterator(o.work / "70_eval", ec))
+      if (e.path().extension() == ".json") {
+        Json m = TryJson(e.path());
+        if (m.is_object() && m.value("format", "") == "docunfold.metrics") metrics.push_back(m);
+      }
+  std::sort(metrics.begin(), metrics.end(), [](const Json& a, const Json& b) {
+    return a.value("method", "") < b.value("method", "");
+  });
+  if (!metrics.empty()) {
+    std::string t = "<table><tr><th class=l>method</th><th>MS-SSIM</th><th>LD</th>"
+                    "<th>Li-D</th><th>CER</th><th>WER</th><th>surface %</th>"
+                    "<th>isometry</th></tr>";
+    for (const Json& m : metrics) t += MetricsRow(m);
+    page->Add(t + "</table><p>MS-SSIM as on the DocUNet benchmark; LD and Li-D from DeepFlow; "
+                  "CER and WER from Tesseract against the OCR of flat.png; surface: mean "
+                  "distance of M to the true surface in % of the page diagonal.</p>");
+  } else if (data.has_ground_truth) {
+    page->Add(Missing("evaluate has not run yet."));
+  } else {
+    page->Add("<p>This data set has no ground truth, so nothing is measured.</p>");
+  }
+  page->End();
+}
+
+void StagesSection(const ReportOptions& o, Page* page) {
+  page->Section("stages", "Stages: time, memory and flags");
+  const auto timings = StageTimings(o.work);
+  const std::vector<std::pair<std::string, std::string>> stages = {
+      {"sfm", "sfm"},           {"segment-boundary", "boundary"}, {"detect-features", "features"},
+      {"init-mesh", "init"},    {"optimize", "optimize"},         {"render", "render"},
+      {"evaluate", "evaluate"}};
+  std::string t = "<table><tr><th class=l>stage</th><th>wall time (s)</th><th>peak memory (MB)"
+                  "</th><th class=l>flags</th></tr>";
+  double total = 0;
+  for (const auto& [stage, flag_file] : stages) {
+    std::string flags = ReadText(o.work / ".flags" / flag_file);
+    while (!flags.empty() && std::isspace(static_cast<unsigned char>(flags.back()))) flags.pop_back();
+    auto it = timings.find(stage);
+    std::string secs = "–", mem = "–";
+    if (it != timings.end()) {
+      secs = Fmt(it->second.value("seconds", 0.0), "%.1f");
+      mem = Fmt(it->second.value("max_rss_mb", 0.0), "%.0f");
+      total += it->second.value("seconds", 0.0);
+    }
+    t += "<tr><td class=l>" + stage + "</td><td>" + secs + "</td><td>" + mem +
+         "</td><td class=l><code>" + Escape(flags.empty() ? "(defaults)" : flags) +
+         "</code></td></tr>";
+  }
+  t += "<tr><th class=l>total</th><th>" + Fmt(total, "%.1f") + "</th><th></th><th></th></tr>";
+  page->Add(t + "</table><p>Times are those of each stage's last run (work/&lt;name&gt;/"
+                "timings.jsonl). To rerun a stage with other flags: <code>make -f pipeline.mk "
+                "DATA=… OPTIMIZE_FLAGS=\"…\"</code>.</p>");
+  page->End();
+}
+
+}  // namespace
+
+ReportResult Run(const ReportOptions& o) {
+  const DataSet data = OpenDataSet(o.data);
+  std::error_code ec;
+  if (!fs::is_directory(o.work, ec))
+    throw InputError(o.work.string() + ": no such work directory (run the pipeline first)");
+  const Json cameras = TryJson(o.work / "10_sfm/cameras.json");
+  Page page;
+  PhotosSection(o, data, cameras, &page);
+  BoundarySection(o, &page);
+  fs::path mesh_dir;
+  MeshSection(o, cameras, &page, &mesh_dir);
+  ConvergenceSection(o, &page);
+  ResultSection(o, data, mesh_dir, &page);
+  StagesSection(o, &page);
+
+  const std::time_t now = std::time(nullptr);
+  char date[64];
+  std::strftime(date, sizeof date, "%Y-%m-%d %H:%M", std::localtime(&now));
+  const std::string name = fs::absolute(o.data).lexically_normal().filename().string();
+  ReportResult r;
+  r.html = page.Html("docunfold report: " + name,
+                     "Data set <code>" + Escape(fs::absolute(o.data).string()) + "</code>, " +
+                         std::to_string(data.images.size()) + " photos; made " + date +
+                         " by docunfold " + ProgramVersion() + ".");
+  return r;
+}
+
+}  // namespace docunfold::report

@@ -1,0 +1,83 @@
+// segment-boundary --image reference.png --out 20_boundary/
+// Writes mask.png, boundary.json and overlay.png (see segment_boundary.h).
+#include <chrono>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "common/atomic_file.h"
+#include "common/cli.h"
+#include "stages/segment-boundary/segment_boundary.h"
+
+using namespace docunfold;
+
+int main(int argc, char** argv) {
+  CLI::App app{"Finds the page in the reference image: its region (mask.png), outline, "
+               "corners and sides (boundary.json, real sides vs sides cut by the image "
+               "border) and an overlay.png to check them at a glance."};
+  fs::path image_path, out_dir;
+  boundary::BoundaryOptions opt;
+  app.add_option("--image", image_path, "reference image (e.g. 10_sfm/reference.png)")
+      ->required();
+  app.add_option("--out", out_dir, "output directory (e.g. 20_boundary)")->required();
+  app.add_option("--work-size", opt.work_size,
+                 "long side (px) of the downscaled image the page is found on")
+      ->capture_default_str()->check(CLI::Range(64, 8192));
+  app.add_option("--frame-fraction", opt.frame_fraction,
+                 "width of the image frame that teaches the background colour, as a "
+                 "fraction of the short side")
+      ->capture_default_str()->check(CLI::Range(0.005, 0.3));
+  app.add_option("--table-distance", opt.table_distance,
+                 "colour distance (std. deviations of the background) beyond which a "
+                 "pixel is not background")
+      ->capture_default_str()->check(CLI::Range(1.0, 100.0));
+  app.add_option("--min-area", opt.min_area_fraction,
+                 "smallest page area, as a fraction of the image")
+      ->capture_default_str()->check(CLI::Range(0.0, 1.0));
+  app.add_option("--border-tolerance", opt.border_tolerance_px,
+                 "outline within this many pixels of the image border is cut off")
+      ->capture_default_str()->check(CLI::Range(0.0, 50.0));
+  app.add_option("--max-cut-fraction", opt.max_cut_fraction,
+                 "a side with more of its length on the image border is not real")
+      ->capture_default_str()->check(CLI::Range(0.0, 1.0));
+  app.add_option("--contour-epsilon", opt.contour_epsilon_px,
+                 "Douglas-Peucker tolerance (px) of the stored outline and sides")
+      ->capture_default_str()->check(CLI::Range(0.0, 20.0));
+  app.add_option("--orientation", opt.orientation,
+                 "which side is the top: auto (text if it tells, else geometry), text, "
+                 "geometry")
+      ->capture_default_str()->check(CLI::IsMember({"auto", "text", "geometry"}));
+  app.add_flag("--verbose", opt.verbose, "log each step and its time");
+
+  return RunStage("segment-boundary", app, argc, argv, [&] {
+    const auto start = std::chrono::steady_clock::now();
+    const cv::Mat image = ReadImage(image_path, 1 /*cv::IMREAD_COLOR*/);
+    if (opt.verbose)
+      Log("read " + image_path.string() + " (" + std::to_string(image.cols) + "x" +
+          std::to_string(image.rows) + ") in " + std::to_string(SecondsSince(start)) + " s");
+    boundary::BoundaryResult result;
+    try {
+      result = boundary::SegmentBoundary(image, opt);
+    } catch (const InputError& e) {
+      throw InputError(image_path.string() + ": " + e.what());
+    }
+    if (opt.verbose)
+      Log("page found in " + std::to_string(SecondsSince(start)) + " s; orientation by " +
+          result.orientation.method);
+    EnsureDirectory(out_dir);
+    const Json doc = boundary::BoundaryToJson(result, image_path.filename().string(),
+                                              image.cols, image.rows, opt);
+    // Fast PNG compression: the mask compresses well anyway, the overlay is
+    // for a quick look.
+    const std::vector<int> png_fast = {cv::IMWRITE_PNG_COMPRESSION, 1};
+    WriteImageAtomic(out_dir / "mask.png", result.mask, png_fast);
+    WriteImageAtomic(out_dir / "overlay.png", boundary::DrawBoundaryOverlay(image, result),
+                     png_fast);
+    WriteJsonAtomic(out_dir / "boundary.json", doc);
+    int real = 0;
+    for (const auto& s : result.sides) real += s.real;
+    Log("page covers " + std::to_string(int(std::lround(result.area_fraction * 100))) +
+        "% of the image, " + std::to_string(real) + " of 4 sides real, top by " +
+        result.orientation.method + ", " + std::to_string(SecondsSince(start)).substr(0, 4) +
+        " s");
+  });
+}

@@ -1,0 +1,116 @@
+// segment-boundary: the document region in the reference image, its outline,
+// its four corners and its four sides (paper §"Reference image and document
+// boundary"). Sides that run along the image border, because the page is cut
+// off there, are marked not real: they must never be straightened.
+//
+// Orientation convention (also in schemas/docunfold.boundary.schema.json):
+// corners are TL, TR, BR, BL, in clockwise order as seen in the image. Which
+// corner is TL comes from the text when the page has enough of it (the side
+// the text lines' tops face is the top; `orientation.method` = "text"),
+// otherwise from geometry (the side whose outward normal points most towards
+// the image's top is the top; `orientation.method` = "geometry").
+#pragma once
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "common/json_io.h"
+
+namespace docunfold::boundary {
+
+struct BoundaryOptions {
+  // Long side, in pixels, of the downscaled image the region is found on
+  // before its outline is refined at full resolution.
+  int work_size = 640;
+  // Width of the image frame used to learn the table's colour, as a fraction
+  // of the image's short side.
+  double frame_fraction = 0.04;
+  // A pixel belongs to the table (or the table in shadow) while its
+  // Mahalanobis distance to the table's colour is below this (in standard
+  // deviations of the table's colour spread).
+  double table_distance = 5.0;
+  // The page must cover at least this fraction of the image.
+  double min_area_fraction = 0.01;
+  // Contour points closer than this to the image border (pixels) lie on the
+  // border: the page is cut off there.
+  double border_tolerance_px = 2.0;
+  // A side counts as real when at most this fraction of its length lies on
+  // the image border (a real corner may touch it).
+  double max_cut_fraction = 0.02;
+  // Douglas–Peucker tolerance of the stored contour and sides (pixels).
+  double contour_epsilon_px = 0.7;
+  // "auto": text when the page has enough text to tell, else geometry;
+  // "text" or "geometry" force one.
+  std::string orientation = "auto";
+  // Log each step and its time on stderr.
+  bool verbose = false;
+
+  Json ToJson() const;
+};
+
+// One side of the page: a polyline along the outline from one corner to the
+// next, and which parts of it are the true page edge.
+struct Side {
+  std::vector<cv::Point2d> points;
+  bool real = true;  // the whole side is page edge (not cut by the image)
+  // Pieces of `points` that are page edge; all of it when `real`.
+  std::vector<std::vector<cv::Point2d>> real_parts;
+  double cut_fraction = 0;  // fraction of its length on the image border
+};
+
+enum SideIndex { kTop = 0, kRight = 1, kBottom = 2, kLeft = 3 };
+constexpr const char* kSideNames[4] = {"top", "right", "bottom", "left"};
+constexpr const char* kCornerNames[4] = {"TL", "TR", "BR", "BL"};
+
+struct Orientation {
+  std::string method;        // "text" or "geometry"
+  double confidence = 0;     // text: fraction of votes for the chosen top
+  int votes = 0;             // text: characters that voted
+};
+
+struct BoundaryResult {
+  cv::Mat1b mask;                      // 255 = page, image size
+  std::vector<cv::Point2d> contour;    // closed, clockwise in the image
+  std::array<cv::Point2d, 4> corners;  // TL, TR, BR, BL
+  // False where the "corner" is where the outline meets the image border
+  // (the page's true corner is outside the image).
+  std::array<bool, 4> corner_in_image{{true, true, true, true}};
+  // top: TL->TR, right: TR->BR, bottom: BL->BR, left: TL->BL.
+  std::array<Side, 4> sides;
+  Orientation orientation;
+  double area_fraction = 0;  // page area / image area
+};
+
+// Finds the page. Throws InputError("no document found: ...") when there is
+// no page-like region (an empty table, a blank image).
+BoundaryResult SegmentBoundary(const cv::Mat& bgr_image,
+                               const BoundaryOptions& options);
+
+// boundary.json (format docunfold.boundary, version 1).
+Json BoundaryToJson(const BoundaryResult& result, const std::string& image_name,
+                    int width, int height, const BoundaryOptions& options);
+
+// The reference image with the outline, corners and side names drawn: real
+// sides in green, cut sides dashed in red; at most `max_size` pixels long.
+cv::Mat DrawBoundaryOverlay(const cv::Mat& bgr_image,
+                            const BoundaryResult& result, int max_size = 1600);
+
+// Internals exposed for tests.
+namespace detail {
+// Turning angle (radians, positive = convex for a clockwise outline) at each
+// point between the chords to the points `reach` steps before and after.
+std::vector<double> TurningAngles(const std::vector<cv::Point>& contour, int reach);
+// Indices (into the clockwise `contour`) of the four corners, in contour
+// order: the four sharpest convex turns of the outline (page corners turn by
+// 60-120 degrees, folds far less); the largest quadrilateral on the convex
+// hull when there are not four turns.
+std::array<int, 4> FindCornerIndices(const std::vector<cv::Point>& contour);
+// Rotates corner order so that the side whose outward normal points most
+// towards image-up is the top; corners must be clockwise.
+int GeometricTopSide(const std::array<cv::Point2d, 4>& corners);
+}  // namespace detail
+
+}  // namespace docunfold::boundary

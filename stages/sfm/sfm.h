@@ -1,0 +1,151 @@
+// sfm: cameras and a sparse point cloud from the photos of a data set, by
+// COLMAP's command-line tools (CPU SIFT, exhaustive matching, incremental
+// mapper), expressed in the frame of an automatically chosen reference view
+// (DESIGN §4-5).
+//
+// Writes into options.out_dir (all or nothing: everything is made in a
+// temporary directory beside it and renamed into place at the end):
+//   cameras.json   docunfold.cameras v1: reference image name; per registered
+//                  view image, width, height, K, R, t (x_cam = R x_world + t,
+//                  world = reference camera frame scaled so that the median
+//                  depth of the points the reference sees is 1)
+//   points.ply     binary PLY: x y z, red green blue, track_length,
+//                  reprojection_error (pixels)
+//   reference.png  the reference photo, undistorted when the camera model has
+//                  distortion; its K is the one in cameras.json
+//   colmap/        database.db, sparse/0/*.bin (COLMAP's binary model),
+//                  *.log (everything COLMAP printed)
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include "common/camera.h"
+#include "common/json_io.h"
+#include "stages/sfm/reference_view.h"
+
+namespace docunfold::sfm {
+
+namespace fs = std::filesystem;
+
+struct SfmOptions {
+  fs::path data_dir;        // data set folder (with images/)
+  fs::path out_dir;         // e.g. work/set01/10_sfm
+  std::string reference;    // image name forcing the reference view ("" = auto)
+
+  // Long side (pixels) of the copies SIFT runs on; keypoints are scaled back
+  // to full resolution by COLMAP. 1600 keeps the 1600x1200 sets at full
+  // resolution and brings 4000x3000 photos down to the same detail per page.
+  int max_image_size = 1600;
+  int max_num_features = 8192;  // per image
+  // COLMAP camera model shared by all views: SIMPLE_PINHOLE, PINHOLE,
+  // SIMPLE_RADIAL or RADIAL. The default SIMPLE_RADIAL with the tight
+  // reprojection filter below kept the shape best on our data (see sfm.cc).
+  std::string camera_model = "SIMPLE_RADIAL";
+  // Refine the distortion parameters in bundle adjustment (otherwise they
+  // stay 0 and a *_RADIAL model behaves as a pinhole one).
+  bool refine_distortion = true;
+  // Observations farther than this from their point's projection are
+  // dropped by the mapper, in pixels of the images SIFT ran on (scaled up to
+  // full resolution for COLMAP). COLMAP's default is 4.
+  double max_reprojection_error = 1.0;
+  // Triangulate points seen by only two views too (COLMAP ignores them by
+  // default, which suits large collections; with 3-6 photos they are a
+  // third of the data and pin the focal length down better: realistic r02
+  // 0.63 -> 0.25 %, r03 0.23 -> 0.12 % median point error).
+  bool two_view_tracks = true;
+  // When the first reconstruction is implausible (views left out, a focal
+  // length outside focal_range, too few points), retry with the other
+  // distortion setting and with COLMAP's default filter; keep the best.
+  bool retry = true;
+  // Plausible focal lengths as multiples of the image's long side (a 10x
+  // telephoto to a 120-degree wide angle).
+  double min_focal_factor = 0.3;
+  double max_focal_factor = 10.0;
+
+  int min_points = 100;     // fewer 3D points: bad input (exit 3)
+  int threads = -1;         // COLMAP threads; -1 = all cores
+  double timeout_seconds = 900;  // per COLMAP command
+  std::string colmap = "colmap";  // COLMAP executable (name in PATH or path)
+  bool verbose = false;     // echo COLMAP's output lines on stderr
+
+  ReferenceOptions reference_options;
+
+  // The options as recorded in cameras.json's producer.
+  Json ToJson() const;
+};
+
+// One run of COLMAP's mapper.
+struct MapperAttempt {
+  std::string description;      // e.g. "SIMPLE_RADIAL, distortion refined, filter 1 px"
+  bool produced_model = false;
+  int registered = 0;
+  int points = 0;
+  double mean_reprojection_error = 0;
+  double focal = 0;             // pixels
+  std::vector<double> params;   // COLMAP's camera parameters
+  bool plausible = false;
+  std::string problem;          // why not plausible
+  double seconds = 0;
+};
+
+struct SfmResult {
+  std::string reference;               // image name
+  std::string reference_choice;        // "auto" or "--ref"
+  CameraSet cameras;                   // every registered view, reference frame
+  // Distortion (OpenCV k1, k2, p1, p2 on normalized coordinates) of the
+  // photos; all zero for pinhole models. reference.png is undistorted.
+  std::array<double, 4> distortion{};
+  std::string camera_model;            // COLMAP model name
+  std::vector<double> colmap_params;   // COLMAP's camera parameters
+  std::vector<std::string> images;     // every image of the data set
+  std::vector<std::string> unregistered;
+  std::vector<Eigen::Vector3d> points; // reference frame
+  std::vector<std::array<uint8_t, 3>> colors;
+  std::vector<int> track_lengths;
+  std::vector<double> reprojection_errors;  // pixels, full resolution
+  double mean_reprojection_error = 0;
+  // Median depth (COLMAP's units) of the points the reference view sees:
+  // the frame was divided by it.
+  double scale_divisor = 1;
+  std::vector<ViewScore> view_scores;  // best first
+  int page_points = 0;                 // points the scores were computed on
+  std::vector<MapperAttempt> attempts;
+  double seconds_reading = 0, seconds_extracting = 0, seconds_matching = 0,
+         seconds_mapping = 0, seconds_total = 0;
+};
+
+// Runs the whole stage and writes the outputs. Throws InputError (bad data
+// set, image or --ref; too few views registered or points), OutputError
+// (cannot write), std::runtime_error (COLMAP missing or failing).
+SfmResult RunSfm(const SfmOptions& options);
+
+// --- building blocks (exposed for tests) ----------------------------------
+
+// Checks the data set: images/ exists, >= 2 photos, each decodes and all
+// have the same size (one shared camera). Returns the image names, sorted,
+// and, when `thumbnails` is given, each photo scaled to a long side of at
+// most 640 px. Throws InputError naming the folder or file.
+std::vector<std::string> CheckImages(const fs::path& data_dir, int* width,
+                                     int* height,
+                                     std::vector<cv::Mat>* thumbnails = nullptr);
+
+// The cameras and points of `model` in the frame of `reference`: rotation
+// and translation of the reference camera removed, scaled so that the median
+// depth of the points the reference sees is 1. K is COLMAP's pinhole part in
+// our pixel convention. Returns the divisor used.
+double ToReferenceFrame(const ColmapModel& model, const std::string& reference,
+                        CameraSet* cameras, std::vector<Eigen::Vector3d>* points);
+
+// The photo as the pinhole camera PinholeK() would have taken it (same size,
+// same K); a copy when the camera has no distortion.
+cv::Mat UndistortPhoto(const cv::Mat& photo, const ColmapCamera& camera);
+
+// The cameras.json document of a result.
+Json CamerasJson(const SfmResult& result, const SfmOptions& options);
+
+}  // namespace docunfold::sfm

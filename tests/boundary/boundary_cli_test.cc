@@ -1,0 +1,100 @@
+// The segment-boundary command line: outputs and their formats, --verbose,
+// and bad input (missing or unreadable image, an image without a document)
+// failing with exit 3, a message naming the file, and no output at all.
+#include <fstream>
+#include <random>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "tests/support/test_support.h"
+
+namespace docunfold::testing {
+namespace {
+
+std::string Binary() { return Quote(StageBinary("segment-boundary").string()); }
+
+// A page on a green table, written as PNG.
+fs::path WriteScene(const TempDir& dir, bool with_page) {
+  cv::Mat3b image(600, 800, cv::Vec3b(70, 110, 60));
+  std::mt19937 rng(3);
+  std::normal_distribution<float> noise(0, 3);
+  if (with_page) {
+    std::vector<cv::Point> page = {{250, 100}, {560, 130}, {540, 520}, {230, 500}};
+    cv::fillConvexPoly(image, page, cv::Scalar(235, 238, 240));
+    for (int y = 160; y < 470; y += 14)
+      cv::line(image, {280, y}, {500, y + 10}, cv::Scalar(40, 40, 40), 2);
+  }
+  image.forEach([&](cv::Vec3b& p, const int*) {
+    for (int c = 0; c < 3; ++c) p[c] = cv::saturate_cast<uchar>(p[c] + noise(rng));
+  });
+  const fs::path path = dir / (with_page ? "page.png" : "table.png");
+  cv::imwrite(path.string(), image);
+  return path;
+}
+
+bool Empty(const fs::path& dir) {
+  return !fs::exists(dir) || fs::directory_iterator(dir) == fs::directory_iterator();
+}
+
+TEST(SegmentBoundaryCli, WritesMaskBoundaryAndOverlay) {
+  TempDir dir;
+  const fs::path image = WriteScene(dir, true);
+  const CommandResult r = RunCommand(Binary() + " --image " + Quote(image.string()) +
+                                     " --out " + Quote((dir / "out").string()) + " --verbose");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("4 of 4 sides real"), std::string::npos) << r.output;
+  const cv::Mat mask = cv::imread((dir / "out" / "mask.png").string(), cv::IMREAD_UNCHANGED);
+  ASSERT_FALSE(mask.empty());
+  EXPECT_EQ(mask.type(), CV_8UC1);
+  EXPECT_EQ(mask.size(), cv::Size(800, 600));
+  EXPECT_FALSE(cv::imread((dir / "out" / "overlay.png").string()).empty());
+  const CommandResult valid = RunCommand(
+      Quote((SourceDir() / "scripts" / "validate-json").string()) + " " +
+      Quote((dir / "out" / "boundary.json").string()));
+  EXPECT_EQ(valid.exit_code, 0) << valid.output;
+}
+
+TEST(SegmentBoundaryCli, MissingImageIsBadInput) {
+  TempDir dir;
+  const CommandResult r = RunCommand(Binary() + " --image " + Quote((dir / "nope.png").string()) +
+                                     " --out " + Quote((dir / "out").string()));
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("nope.png"), std::string::npos) << r.output;
+  EXPECT_TRUE(Empty(dir / "out"));
+}
+
+TEST(SegmentBoundaryCli, UnreadableImageIsBadInput) {
+  TempDir dir;
+  std::ofstream(dir / "broken.png") << "this is not a PNG";
+  const CommandResult r = RunCommand(Binary() + " --image " + Quote((dir / "broken.png").string()) +
+                                     " --out " + Quote((dir / "out").string()));
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("broken.png"), std::string::npos) << r.output;
+  EXPECT_TRUE(Empty(dir / "out"));
+}
+
+TEST(SegmentBoundaryCli, EmptyTableIsBadInputWithoutOutputs) {
+  TempDir dir;
+  const fs::path image = WriteScene(dir, false);
+  const CommandResult r = RunCommand(Binary() + " --image " + Quote(image.string()) + " --out " +
+                                     Quote((dir / "out").string()));
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("table.png"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("no document found"), std::string::npos) << r.output;
+  EXPECT_TRUE(Empty(dir / "out"));
+}
+
+TEST(SegmentBoundaryCli, HelpAndBadFlags) {
+  EXPECT_EQ(RunCommand(Binary() + " --help").exit_code, 0);
+  TempDir dir;
+  const fs::path image = WriteScene(dir, true);
+  EXPECT_EQ(RunCommand(Binary() + " --image " + Quote(image.string()) + " --out " +
+                       Quote((dir / "out").string()) + " --orientation sideways")
+                .exit_code,
+            2);
+}
+
+}  // namespace
+}  // namespace docunfold::testing

@@ -1,0 +1,169 @@
+// segment-boundary on drawn scenes whose truth is known exactly: a page on a
+// plain and on a textured table, a page cut off by the image border, an empty
+// table; and the corner and orientation helpers.
+#include <random>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+#include "common/errors.h"
+#include "stages/segment-boundary/segment_boundary.h"
+
+namespace docunfold::boundary {
+namespace {
+
+struct Scene {
+  cv::Mat3b image;
+  cv::Mat1b mask;                     // true page region
+  std::vector<cv::Point2d> corners;   // true corners, clockwise
+};
+
+// A table (plain green with noise, or a blotchy texture) with a white page
+// (quadrilateral `corners`) carrying lines of dark "text" blocks.
+Scene DrawScene(const std::vector<cv::Point2d>& corners, bool textured, cv::Size size = {1200, 900}) {
+  Scene s;
+  std::mt19937 rng(7);
+  std::normal_distribution<float> noise(0, 3);
+  s.image = cv::Mat3b(size, cv::Vec3b(70, 110, 60));
+  if (textured) {
+    std::uniform_int_distribution<int> x(0, size.width), y(0, size.height), r(3, 12), c(-35, 35);
+    for (int i = 0; i < 6000; ++i) {
+      const int d = c(rng);
+      cv::circle(s.image, {x(rng), y(rng)}, r(rng),
+                 cv::Scalar(70 + d, 110 + d, 60 + d), cv::FILLED, cv::LINE_AA);
+    }
+  }
+  std::vector<cv::Point> poly;
+  for (const auto& p : corners) poly.emplace_back(int(std::lround(p.x)), int(std::lround(p.y)));
+  s.mask = cv::Mat1b::zeros(size);
+  cv::fillConvexPoly(s.mask, poly, 255);
+  s.image.setTo(cv::Scalar(235, 238, 240), s.mask);
+  // Text blocks along the page's top side direction.
+  const cv::Point2d u = (corners[1] - corners[0]) * (1.0 / cv::norm(corners[1] - corners[0]));
+  const cv::Point2d v = (corners[3] - corners[0]) * (1.0 / cv::norm(corners[3] - corners[0]));
+  const double w = cv::norm(corners[1] - corners[0]), h = cv::norm(corners[3] - corners[0]);
+  for (double t = 0.1 * h; t < 0.9 * h; t += 14)
+    for (double a = 0.1 * w; a < 0.85 * w; a += 9) {
+      const cv::Point2d p = corners[0] + u * a + v * t;
+      cv::line(s.image, p, p + v * 6.0, cv::Scalar(40, 40, 40), 2, cv::LINE_AA);
+    }
+  s.image.forEach([&](cv::Vec3b& px, const int*) {
+    for (int c = 0; c < 3; ++c) px[c] = cv::saturate_cast<uchar>(px[c] + noise(rng));
+  });
+  s.corners = corners;
+  return s;
+}
+
+double Iou(const cv::Mat1b& a, const cv::Mat1b& b) {
+  return double(cv::countNonZero(a & b)) / cv::countNonZero(a | b);
+}
+
+double NearestCorner(const BoundaryResult& r, const cv::Point2d& p) {
+  double best = 1e300;
+  for (const auto& c : r.corners) best = std::min(best, cv::norm(c - p));
+  return best;
+}
+
+double SignedArea(const std::array<cv::Point2d, 4>& c) {
+  double a = 0;
+  for (int i = 0; i < 4; ++i) a += c[i].x * c[(i + 1) % 4].y - c[(i + 1) % 4].x * c[i].y;
+  return 0.5 * a;
+}
+
+const std::vector<cv::Point2d> kTilted = {{380, 140}, {820, 210}, {760, 780}, {300, 700}};
+
+TEST(SegmentBoundary, FindsAPageOnAPlainTable) {
+  const Scene s = DrawScene(kTilted, false);
+  const BoundaryResult r = SegmentBoundary(s.image, {});
+  EXPECT_GE(Iou(r.mask, s.mask), 0.99);
+  for (const auto& c : s.corners) EXPECT_LE(NearestCorner(r, c), 3.0) << c;
+  for (const Side& side : r.sides) EXPECT_TRUE(side.real);
+  EXPECT_GT(SignedArea(r.corners), 0) << "corners must run clockwise in the image";
+  // Sides share the corners: top TL->TR, right TR->BR, bottom BL->BR, left TL->BL.
+  EXPECT_LE(cv::norm(r.sides[kTop].points.front() - r.corners[0]), 1e-9);
+  EXPECT_LE(cv::norm(r.sides[kTop].points.back() - r.corners[1]), 1e-9);
+  EXPECT_LE(cv::norm(r.sides[kRight].points.back() - r.corners[2]), 1e-9);
+  EXPECT_LE(cv::norm(r.sides[kBottom].points.front() - r.corners[3]), 1e-9);
+  EXPECT_LE(cv::norm(r.sides[kLeft].points.back() - r.corners[3]), 1e-9);
+}
+
+TEST(SegmentBoundary, FindsAPageOnATexturedTable) {
+  const Scene s = DrawScene(kTilted, true);
+  const BoundaryResult r = SegmentBoundary(s.image, {});
+  EXPECT_GE(Iou(r.mask, s.mask), 0.98);
+  for (const auto& c : s.corners) EXPECT_LE(NearestCorner(r, c), 4.0) << c;
+}
+
+TEST(SegmentBoundary, GeometricOrientationPutsTheUpwardSideOnTop) {
+  const Scene s = DrawScene(kTilted, false);
+  BoundaryOptions opt;
+  opt.orientation = "geometry";
+  const BoundaryResult r = SegmentBoundary(s.image, opt);
+  EXPECT_EQ(r.orientation.method, "geometry");
+  EXPECT_LE(cv::norm(r.corners[0] - kTilted[0]), 3.0);  // (380, 140) starts the top side
+}
+
+TEST(SegmentBoundary, CutOffPageHasItsCutSideNotReal) {
+  // The page runs off the bottom of the image.
+  const Scene s = DrawScene({{350, 300}, {850, 320}, {840, 1100}, {340, 1080}}, true);
+  BoundaryOptions opt;
+  opt.orientation = "geometry";
+  const BoundaryResult r = SegmentBoundary(s.image, opt);
+  EXPECT_GE(Iou(r.mask, s.mask), 0.98);
+  EXPECT_TRUE(r.sides[kTop].real);
+  EXPECT_TRUE(r.sides[kLeft].real);
+  EXPECT_TRUE(r.sides[kRight].real);
+  EXPECT_FALSE(r.sides[kBottom].real);
+  EXPECT_TRUE(r.corner_in_image[0] && r.corner_in_image[1]);
+  EXPECT_FALSE(r.corner_in_image[2] || r.corner_in_image[3]);
+  // The real parts of the sides may end at the image border but never run
+  // along it.
+  for (const Side& side : r.sides)
+    for (const auto& part : side.real_parts)
+      for (size_t k = 1; k < part.size(); ++k)
+        EXPECT_FALSE(part[k - 1].y >= s.image.rows - 3 && part[k].y >= s.image.rows - 3);
+}
+
+TEST(SegmentBoundary, EmptyTableIsNoDocument) {
+  Scene s = DrawScene(kTilted, true);
+  s.image = DrawScene({{-10, -10}, {-5, -10}, {-5, -5}, {-10, -5}}, true).image;
+  try {
+    SegmentBoundary(s.image, {});
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("no document found"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(SegmentBoundary(cv::Mat3b(600, 800, cv::Vec3b(128, 128, 128)), {}), InputError);
+}
+
+TEST(CornerHelpers, FourSharpestTurnsWinOverAFoldKink) {
+  // A clockwise square with a shallow kink (a fold) in its top side.
+  std::vector<cv::Point> contour;
+  auto edge = [&](cv::Point a, cv::Point b) {
+    const int n = std::max(std::abs(b.x - a.x), std::abs(b.y - a.y));
+    for (int k = 0; k < n; ++k) contour.emplace_back(a + (b - a) * (double(k) / n));
+  };
+  edge({0, 0}, {200, -25});
+  edge({200, -25}, {400, 0});
+  edge({400, 0}, {400, 400});
+  edge({400, 400}, {0, 400});
+  edge({0, 400}, {0, 0});
+  const auto idx = detail::FindCornerIndices(contour);
+  const std::vector<cv::Point> expected = {{0, 0}, {400, 0}, {400, 400}, {0, 400}};
+  for (int i = 0; i < 4; ++i) EXPECT_LE(cv::norm(contour[idx[i]] - expected[i]), 2.0) << i;
+}
+
+TEST(CornerHelpers, TopSideIsTheOneFacingUp) {
+  // Clockwise corners of a square turned by 30 degrees.
+  std::array<cv::Point2d, 4> c;
+  for (int i = 0; i < 4; ++i) {
+    const double a = (30 + 90 * i - 135) * CV_PI / 180;
+    c[i] = {500 + 100 * std::cos(a), 500 + 100 * std::sin(a)};
+  }
+  const int top = detail::GeometricTopSide(c);
+  const cv::Point2d mid = 0.5 * (c[top] + c[(top + 1) % 4]);
+  for (int i = 0; i < 4; ++i) EXPECT_LE(mid.y, 0.5 * (c[i].y + c[(i + 1) % 4].y) + 1e-9);
+}
+
+}  // namespace
+}  // namespace docunfold::boundary

@@ -1,0 +1,164 @@
+// detect-features on drawn pages whose lines are known exactly: text lines
+// (upright, upside down, and bent at a crease), table rules, the page outline
+// kept out; bad masks; and the geometric helpers.
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+#include "common/errors.h"
+#include "stages/detect-features/detect_features.h"
+#include "stages/detect-features/feature_parts.h"
+
+namespace docunfold::features {
+namespace {
+
+// Ordinary English: its letters have far more ascenders than descenders,
+// which is what tells the baseline side (a line crowded with g, j, p, q, y
+// would not).
+constexpr const char* kLine = "The committee reviewed the annual statement, and it was accepted.";
+
+struct Page {
+  cv::Mat3b image;
+  cv::Mat1b mask;
+  std::vector<double> baselines;  // y of each text line (image rows)
+  std::vector<double> rules;      // y of each rule's centre
+};
+
+// A grey table with a white page: text lines (Hershey font; putText's origin
+// is the baseline) and, below them, three horizontal rules 2 px thick.
+Page DrawPage() {
+  Page p;
+  p.image = cv::Mat3b(900, 1200, cv::Vec3b(90, 90, 90));
+  p.mask = cv::Mat1b::zeros(p.image.size());
+  const cv::Rect page(150, 80, 900, 760);
+  p.mask(page).setTo(255);
+  p.image(page).setTo(cv::Scalar(240, 240, 240));
+  for (int y = 160; y < 560; y += 30) {
+    cv::putText(p.image, kLine, {200, y}, cv::FONT_HERSHEY_COMPLEX, 0.7, cv::Scalar(20, 20, 20), 1,
+                cv::LINE_AA);
+    p.baselines.push_back(y);
+  }
+  for (int y = 640; y <= 760; y += 60) {
+    cv::rectangle(p.image, cv::Rect(200, y - 1, 800, 2), cv::Scalar(30, 30, 30), cv::FILLED);
+    p.rules.push_back(y - 0.5);
+  }
+  return p;
+}
+
+// Distance from a segment's points (every pixel) to the nearest of the
+// horizontal lines y = ys[i].
+double WorstOffset(const Segment& s, const std::vector<double>& ys) {
+  double worst = 0;
+  const cv::Point2d a = s.points.front(), b = s.points.back();
+  const int steps = std::max(1, int(cv::norm(b - a)));
+  for (int k = 0; k <= steps; ++k) {
+    const cv::Point2d q = a + (b - a) * (double(k) / steps);
+    double best = 1e300;
+    for (double y : ys) best = std::min(best, std::abs(q.y - y));
+    worst = std::max(worst, best);
+  }
+  return worst;
+}
+
+TEST(DetectFeatures, TextBaselinesAndRuleCentres) {
+  const Page p = DrawPage();
+  const FeaturesResult r = DetectFeatures(p.image, p.mask, {});
+  ASSERT_GT(r.text_segments, 0);
+  ASSERT_EQ(r.edge_segments, 3);
+  EXPECT_FALSE(r.text_upside_down);
+  double text_length = 0;
+  for (const Segment& s : r.segments) {
+    ASSERT_GE(s.points.size(), 2u);
+    if (s.kind == "text") {
+      // Antialiased strokes reach about a pixel past putText's baseline.
+      EXPECT_LE(WorstOffset(s, p.baselines), 1.5);
+      text_length += cv::norm(s.points.back() - s.points.front());
+    } else {
+      EXPECT_EQ(s.kind, "edge");
+      EXPECT_LE(WorstOffset(s, p.rules), 1.0);  // centre lines, not edges
+      EXPECT_GE(cv::norm(s.points.back() - s.points.front()), 700);
+    }
+  }
+  // Most of every line's length is found.
+  EXPECT_GE(text_length, 0.6 * 600 * double(p.baselines.size()));
+}
+
+TEST(DetectFeatures, UpsideDownTextStillGivesBaselines) {
+  Page p = DrawPage();
+  cv::rotate(p.image, p.image, cv::ROTATE_180);
+  cv::rotate(p.mask, p.mask, cv::ROTATE_180);
+  std::vector<double> baselines;
+  for (double y : p.baselines) baselines.push_back(p.image.rows - 1 - y);
+  const FeaturesResult r = DetectFeatures(p.image, p.mask, {});
+  ASSERT_GT(r.text_segments, 5);
+  EXPECT_TRUE(r.text_upside_down);
+  for (const Segment& s : r.segments) {
+    if (s.kind == "text") {
+      EXPECT_LE(WorstOffset(s, baselines), 1.5);
+    }
+  }
+}
+
+TEST(DetectFeatures, TextLinesAreCutAtACrease) {
+  // Bend the right half of the page up by 8 degrees about x = 600: every
+  // text line kinks there. No segment may bridge the kink.
+  const Page p = DrawPage();
+  const double angle = 8 * CV_PI / 180;
+  cv::Mat map_x(p.image.size(), CV_32F), map_y(p.image.size(), CV_32F);
+  for (int y = 0; y < p.image.rows; ++y)
+    for (int x = 0; x < p.image.cols; ++x) {
+      const double dx = x - 600.0;
+      const double sy = x > 600 ? y + dx * std::tan(angle) : y;  // source row
+      map_x.at<float>(y, x) = float(x);
+      map_y.at<float>(y, x) = float(sy);
+    }
+  cv::Mat3b bent;
+  cv::Mat1b bent_mask;
+  cv::remap(p.image, bent, map_x, map_y, cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar(90, 90, 90));
+  cv::remap(p.mask, bent_mask, map_x, map_y, cv::INTER_NEAREST);
+  const FeaturesResult r = DetectFeatures(bent, bent_mask, {});
+  ASSERT_GT(r.text_segments, 10);
+  for (const Segment& s : r.segments) {
+    if (s.kind != "text") continue;
+    const double x0 = std::min(s.points.front().x, s.points.back().x);
+    const double x1 = std::max(s.points.front().x, s.points.back().x);
+    // A segment may reach a few pixels past the crease, not more.
+    EXPECT_TRUE(x1 <= 606 || x0 >= 594) << "segment " << x0 << ".." << x1 << " bridges the crease";
+  }
+}
+
+TEST(DetectFeatures, PageOutlineIsNoFeature) {
+  // A blank page: its outline is a strong straight edge, but not a feature.
+  cv::Mat3b image(600, 800, cv::Vec3b(60, 60, 60));
+  cv::Mat1b mask = cv::Mat1b::zeros(image.size());
+  mask(cv::Rect(100, 100, 600, 400)).setTo(255);
+  image.setTo(cv::Scalar(240, 240, 240), mask);
+  EXPECT_TRUE(DetectFeatures(image, mask, {}).segments.empty());
+}
+
+TEST(DetectFeatures, BadMasksAreBadInput) {
+  const Page p = DrawPage();
+  EXPECT_THROW(DetectFeatures(p.image, cv::Mat1b::zeros(p.image.size()), {}), InputError);
+  EXPECT_THROW(DetectFeatures(p.image, cv::Mat1b(100, 100, uchar(255)), {}), InputError);
+}
+
+TEST(FeatureHelpers, SplitWhereBentCutsAtTheKink) {
+  std::vector<cv::Point2d> pts;
+  for (int x = 0; x <= 100; ++x) pts.emplace_back(x, 0);
+  for (int x = 101; x <= 200; ++x) pts.emplace_back(x, 0.1 * (x - 100));
+  const auto pieces = detail::SplitWhereBent(pts, 1.0);
+  ASSERT_EQ(pieces.size(), 2u);
+  EXPECT_NEAR(pieces[0].second, 100, 6);
+  const auto straight = detail::SplitWhereBent(std::vector<cv::Point2d>(pts.begin(), pts.begin() + 101), 1.0);
+  EXPECT_EQ(straight.size(), 1u);
+}
+
+TEST(FeatureHelpers, FitLineRecoversALine) {
+  std::vector<cv::Point2d> pts;
+  for (int k = 0; k < 50; ++k) pts.emplace_back(k, 3 + 0.5 * k + (k % 2 ? 0.2 : -0.2));
+  const detail::LineFit fit = detail::FitLine(pts);
+  EXPECT_NEAR(std::abs(fit.direction.y / fit.direction.x), 0.5, 1e-3);
+  EXPECT_NEAR(fit.rms, 0.2 / std::sqrt(1.25), 0.02);
+}
+
+}  // namespace
+}  // namespace docunfold::features

@@ -1,0 +1,122 @@
+// init-mesh on awkward inputs: an analytic curled sheet in front of a
+// camera (no data set needed), missing and corrupt files, points on part of
+// the page, an unusable boundary.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cstdio>
+#include <memory>
+#include <regex>
+
+#include <Eigen/Geometry>
+#include <Eigen/SVD>
+
+#include "common/grid_mesh.h"
+#include "common/isometry/metrics.h"
+#include "common/json_io.h"
+#include "tests/init-mesh/work_fixture.h"
+#include "tests/isometry/test_meshes.h"
+#include "tests/support/test_support.h"
+#include "tests/support/truth_frame.h"
+
+namespace docunfold::testing {
+namespace {
+
+// --- awkward inputs (an analytic sheet; no data needed) ----------------------
+
+TEST(InitMeshCli, SyntheticSheetIsReconstructed) {
+  TempDir dir;
+  const MeshPair truth = WriteSyntheticWork(dir.path());
+  const CommandResult r = RunCommand(InitMeshCommand(dir.path(), "--grid 8x12"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const MeshPair m = ReadMeshPair(dir / "40_init");
+  EXPECT_EQ(m.grid.NumQuads(), 96);
+  // The long side (0.297) runs along the grid rows: 12 quads there.
+  EXPECT_EQ(std::max(m.grid.nx, m.grid.ny), 13);
+  const double size = isometry::ModelSize(truth);
+  EXPECT_LT(SurfaceDistance(m, truth).mean, 0.01 * size);
+  EXPECT_LT(isometry::IsometryEdgeError(m).mean, 0.005);
+}
+
+TEST(InitMeshCli, MissingOrCorruptFilesAreBadInput) {
+  TempDir dir;
+  WriteSyntheticWork(dir.path(), 400);
+  {
+    fs::rename(dir / "10_sfm/points.ply", dir / "points.ply");
+    const CommandResult r = RunCommand(InitMeshCommand(dir.path()));
+    EXPECT_EQ(r.exit_code, 3) << r.output;
+    EXPECT_NE(r.output.find("points.ply"), std::string::npos) << r.output;
+    fs::rename(dir / "points.ply", dir / "10_sfm/points.ply");
+  }
+  {
+    WriteTextAtomic(dir / "10_sfm/cameras.json", "{\"format\": \"docunfold.cameras\", ");
+    const CommandResult r = RunCommand(InitMeshCommand(dir.path()));
+    EXPECT_EQ(r.exit_code, 3) << r.output;
+    EXPECT_NE(r.output.find("cameras.json"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(dir / "40_init/init.json"));
+  }
+  TempDir dir2;
+  WriteSyntheticWork(dir2.path(), 400);
+  {
+    WriteTextAtomic(dir2 / "20_boundary/mask.png", "not a png");
+    const CommandResult r = RunCommand(InitMeshCommand(dir2.path()));
+    EXPECT_EQ(r.exit_code, 3) << r.output;
+    EXPECT_NE(r.output.find("mask.png"), std::string::npos) << r.output;
+  }
+  {
+    WriteImageAtomic(dir2 / "20_boundary/mask.png", cv::Mat1b(480, 640, uchar(0)));
+    const CommandResult r = RunCommand(InitMeshCommand(dir2.path()));
+    EXPECT_EQ(r.exit_code, 3) << r.output;
+    EXPECT_NE(r.output.find("empty document region"), std::string::npos) << r.output;
+  }
+  {
+    WriteImageAtomic(dir2 / "20_boundary/mask.png", cv::Mat1b(100, 100, uchar(255)));
+    const CommandResult r = RunCommand(InitMeshCommand(dir2.path()));
+    EXPECT_EQ(r.exit_code, 3) << r.output;
+  }
+  {
+    const CommandResult r = RunCommand(InitMeshCommand(dir2.path(), "--grid 20by30"));
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+  }
+}
+
+TEST(InitMeshCli, PointsOnPartOfThePageNameTheMissingPart) {
+  TempDir dir;
+  WriteSyntheticWork(dir.path(), 1500, 0.6);  // nothing on the right 40 %
+  const CommandResult r = RunCommand(InitMeshCommand(dir.path()));
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("right third of the page"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(dir / "40_init/mesh3d.ply"));
+
+  TempDir few;
+  WriteSyntheticWork(few.path(), 12);
+  const CommandResult r2 = RunCommand(InitMeshCommand(few.path()));
+  EXPECT_EQ(r2.exit_code, 3) << r2.output;
+  EXPECT_NE(r2.output.find("inside the document region"), std::string::npos) << r2.output;
+}
+
+TEST(InitMeshCli, UnusableBoundaryFallsBackToTheMaskWithAWarning) {
+  TempDir dir;
+  const MeshPair truth = WriteSyntheticWork(dir.path());
+  Json doc = ReadJsonFile(dir / "20_boundary/boundary.json");
+  doc["corners"] = Json::array({{10, 10}, {20, 20}});
+  doc["sides"].erase("left");
+  WriteJsonAtomic(dir / "20_boundary/boundary.json", doc);
+  const CommandResult r = RunCommand(InitMeshCommand(dir.path(), "--grid 8x12"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("warning"), std::string::npos) << r.output;
+  const Json init = ReadJsonFile(dir / "40_init/init.json");
+  EXPECT_EQ(init["grid"]["source"], "mask_bbox");
+  // The real sides it still has are found on the bounding-box grid.
+  const std::string from = init["upright"]["from"];
+  EXPECT_EQ(from.rfind("real sides: ", 0), 0u) << from;
+  EXPECT_EQ(from.find("left"), std::string::npos) << from;
+  ASSERT_EQ(init["warnings"].size(), 1u);
+  // The bounding-box grid reaches beyond the page; where it covers the page
+  // it is still on the true surface.
+  const MeshPair m = ReadMeshPair(dir / "40_init");
+  EXPECT_LT(SurfaceDistance(truth, m).mean, 0.01 * isometry::ModelSize(truth));
+}
+
+}  // namespace
+}  // namespace docunfold::testing

@@ -1,0 +1,164 @@
+// Inputs of init-mesh made without the real sfm and segment-boundary: from
+// a data set's ground truth (10_sfm by WriteSfmFromTruth, 20_boundary from
+// the true page outline in the reference view), or from an analytic curled
+// sheet in front of a camera (no data needed).
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "common/atomic_file.h"
+#include "common/camera.h"
+#include "common/grid_mesh.h"
+#include "common/json_io.h"
+#include "common/ply.h"
+#include "common/raster.h"
+#include "tests/isometry/test_meshes.h"
+#include "tests/support/ground_truth.h"
+#include "tests/support/test_support.h"
+
+namespace docunfold::testing {
+
+// boundary.json + mask.png from four side polylines in the image.
+inline void WriteBoundary(const fs::path& dir, const std::string& image, int width, int height,
+                          const std::array<std::vector<Eigen::Vector2d>, 4>& sides,
+                          const cv::Mat1b& mask) {
+  // A side is real unless it runs along the image border somewhere.
+  auto inside = [&](const std::vector<Eigen::Vector2d>& s) {
+    for (const auto& p : s)
+      if (p.x() < 0.5 || p.y() < 0.5 || p.x() > width - 1.5 || p.y() > height - 1.5) return false;
+    return true;
+  };
+  auto to_json = [](const std::vector<Eigen::Vector2d>& s) {
+    Json a = Json::array();
+    for (const auto& p : s) a.push_back({p.x(), p.y()});
+    return a;
+  };
+  Json doc = MakeHeader("docunfold.boundary", 1, "truth-boundary");
+  doc["image"] = image;
+  doc["width"] = width;
+  doc["height"] = height;
+  std::vector<Eigen::Vector2d> contour = sides[0];
+  contour.insert(contour.end(), sides[1].begin() + 1, sides[1].end());
+  contour.insert(contour.end(), sides[2].rbegin() + 1, sides[2].rend());
+  contour.insert(contour.end(), sides[3].rbegin() + 1, sides[3].rend() - 1);
+  doc["contour"] = to_json(contour);
+  doc["corners"] = to_json({sides[0].front(), sides[0].back(), sides[2].back(), sides[2].front()});
+  const char* names[4] = {"top", "right", "bottom", "left"};
+  for (int s = 0; s < 4; ++s)
+    doc["sides"][names[s]] = {{"points", to_json(sides[s])}, {"real", inside(sides[s])}};
+  EnsureDirectory(dir);
+  WriteJsonAtomic(dir / "boundary.json", doc);
+  WriteImageAtomic(dir / "mask.png", mask);
+}
+
+// The true page border in a view: vertices of the true mesh with s or t at
+// 0 or 1, projected; sides top (t = 0, s up), right (s = 1, t up), bottom
+// (t = 1, s up), left (s = 0, t up), as boundary.json orders them.
+inline std::array<std::vector<Eigen::Vector2d>, 4> TrueSides(const GroundTruth& gt,
+                                                            const PinholeCamera& cam) {
+  const auto& s = gt.mesh.FindProperty("s")->values;
+  const auto& t = gt.mesh.FindProperty("t")->values;
+  std::array<std::vector<std::pair<double, Eigen::Vector2d>>, 4> raw;
+  const double eps = 1e-4;
+  for (size_t i = 0; i < gt.mesh.vertices.size(); ++i) {
+    const Eigen::Vector2d px = cam.Project(gt.mesh.vertices[i]);
+    if (t[i] < eps) raw[0].push_back({s[i], px});
+    if (s[i] > 1 - eps) raw[1].push_back({t[i], px});
+    if (t[i] > 1 - eps) raw[2].push_back({s[i], px});
+    if (s[i] < eps) raw[3].push_back({t[i], px});
+  }
+  // Where the page leaves the image, the visible outline runs along the
+  // image border (as segment-boundary sees it): clamp to the image.
+  auto clamp = [&](Eigen::Vector2d p) {
+    return Eigen::Vector2d(std::clamp(p.x(), 0.0, cam.width - 1.0),
+                           std::clamp(p.y(), 0.0, cam.height - 1.0));
+  };
+  std::array<std::vector<Eigen::Vector2d>, 4> sides;
+  for (int k = 0; k < 4; ++k) {
+    std::sort(raw[k].begin(), raw[k].end(),
+              [](const auto& a, const auto& b) { return a.first < b.first; });
+    for (size_t i = 0; i < raw[k].size(); i += 2) sides[k].push_back(clamp(raw[k][i].second));
+    if ((raw[k].size() - 1) % 2) sides[k].push_back(clamp(raw[k].back().second));
+  }
+  return sides;
+}
+
+// 10_sfm and 20_boundary of a data set from its truth, for `reference`.
+inline void WriteWorkFromTruth(const GroundTruth& gt, const std::string& reference,
+                               const fs::path& work, const SfmFromTruthOptions& sfm) {
+  WriteSfmFromTruth(gt, reference, work / "10_sfm", sfm);
+  const PinholeCamera& cam = *gt.cameras.Find(reference);
+  WriteBoundary(work / "20_boundary", "reference.png", cam.width, cam.height,
+                TrueSides(gt, cam), TruePageMask(gt, cam));
+}
+
+// An analytic scene: a curled sheet (0.21 x 0.297, curl radius 0.2) seen by
+// a 640x480 camera at the world origin, `points` SfM points on it (those
+// with flat x below `keep_left_fraction` of the width only, to make pages
+// with missing parts), 10_sfm and 20_boundary written to `work`. Returns the
+// true pair.
+inline MeshPair WriteSyntheticWork(const fs::path& work, int points = 1500,
+                                   double keep_left_fraction = 1.0) {
+  MeshPair sheet = CurledSheet(22, 30, 0.21, 0.297, 0.2);
+  for (auto& v : sheet.mesh3d) v.z() = 0.45 + 0.45 * (v.z() - 1.0) + 0.0;  // nearer camera
+  PinholeCamera cam;
+  cam.image = "ref.jpg";
+  cam.width = 640;
+  cam.height = 480;
+  cam.K << 900, 0, 319.5, 0, 900, 239.5, 0, 0, 1;
+  // Turn the sheet so its long side runs across the image.
+  for (auto& v : sheet.mesh3d) {
+    const double x = v.x(), y = v.y();
+    v.x() = y;
+    v.y() = -x;
+  }
+  const SampledPoints sample = SampleSurface(sheet, points, 0.0005, 0.0, 3);
+  PlyData cloud;
+  for (const auto& p : sample.points) {
+    // Keep points by their flat position: nearest vertex's M' x.
+    double best = 1e9;
+    int vi = 0;
+    for (size_t i = 0; i < sheet.mesh3d.size(); ++i)
+      if ((sheet.mesh3d[i] - p).norm() < best) {
+        best = (sheet.mesh3d[i] - p).norm();
+        vi = int(i);
+      }
+    if (sheet.mesh2d[vi].x() <= keep_left_fraction * 0.21) cloud.vertices.push_back(p);
+  }
+  cloud.colors.assign(cloud.vertices.size(), {100, 100, 100});
+  EnsureDirectory(work / "10_sfm");
+  WritePly(work / "10_sfm/points.ply", cloud);
+  Json doc = MakeHeader("docunfold.cameras", 1, "synthetic");
+  doc["reference"] = cam.image;
+  doc["views"] = Json::array({CameraToJson(cam)});
+  WriteJsonAtomic(work / "10_sfm/cameras.json", doc);
+  WriteImageAtomic(work / "10_sfm/reference.png", cv::Mat(cam.height, cam.width, CV_8UC3,
+                                                          cv::Scalar(90, 120, 90)));
+  // Sides from the border of the grid: top = row 0 (flat y = 0), etc.
+  std::array<std::vector<Eigen::Vector2d>, 4> sides;
+  const QuadGrid& g = sheet.grid;
+  for (int c = 0; c < g.nx; ++c) sides[0].push_back(cam.Project(sheet.mesh3d[g.Index(0, c)]));
+  for (int r = 0; r < g.ny; ++r)
+    sides[1].push_back(cam.Project(sheet.mesh3d[g.Index(r, g.nx - 1)]));
+  for (int c = 0; c < g.nx; ++c)
+    sides[2].push_back(cam.Project(sheet.mesh3d[g.Index(g.ny - 1, c)]));
+  for (int r = 0; r < g.ny; ++r) sides[3].push_back(cam.Project(sheet.mesh3d[g.Index(r, 0)]));
+  const RasterResult raster = RasterizeMesh(cam, sheet.mesh3d, g.Triangles());
+  cv::Mat1b mask = raster.face >= 0;
+  WriteBoundary(work / "20_boundary", "reference.png", cam.width, cam.height, sides, mask);
+  return sheet;
+}
+
+// The command line pipeline.mk uses, on a work folder.
+inline std::string InitMeshCommand(const fs::path& work, const std::string& extra = "") {
+  return Quote(StageBinary("init-mesh").string()) + " --sfm " + Quote((work / "10_sfm").string()) +
+         " --boundary " + Quote((work / "20_boundary").string()) + " --out " +
+         Quote((work / "40_init").string()) + " " + extra + " 2>&1";
+}
+
+}  // namespace docunfold::testing

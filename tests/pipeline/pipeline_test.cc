@@ -1,0 +1,141 @@
+// pipeline.mk end to end on a small sample: outputs exist and validate, a
+// second run does nothing, changing a stage's flags reruns exactly that stage
+// and what follows, and FEATURES= substitutes another detector's file.
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "common/json_io.h"
+#include "tests/support/ground_truth.h"
+#include "tests/support/test_support.h"
+
+namespace docunfold::testing {
+namespace {
+
+const char* kSample = "set01";
+
+// Each case works on its own copy of the e2e run's work directory of the
+// sample (timestamps kept), so make sees a finished pipeline.
+class Pipeline : public ::testing::Test {
+ protected:
+  fs::path Work() const { return dir_.path() / "work"; }
+  CommandResult Make(const std::string& args) const {
+    return RunCommand("make --no-print-directory -f " +
+                      Quote((SourceDir() / "pipeline.mk").string()) + " DATA=" + kSample +
+                      " WORK=" + Quote(Work().string()) + " NO_BUILD=1" +
+                      " BUILD=" + Quote(fs::path(DOCUNFOLD_BIN_DIR).parent_path().string()) +
+                      " " + args);
+  }
+  fs::file_time_type MTime(const std::string& rel) const {
+    return fs::last_write_time(Work() / rel);
+  }
+  void SetUp() override {
+    if (!fs::is_directory(SampleDir(kSample))) GTEST_SKIP() << "no sample " << kSample;
+    const fs::path e2e = fs::path(DOCUNFOLD_BIN_DIR).parent_path() / "e2e/work" / kSample;
+    ASSERT_TRUE(fs::is_directory(e2e)) << e2e << " (did the e2e_run fixture run?)";
+    CommandResult copy = RunCommand("cp -a " + Quote(e2e.string()) + " " + Quote(Work().string()));
+    ASSERT_EQ(copy.exit_code, 0) << copy.output;
+    // The first make adds what the benchmark run does not make (evaluate's
+    // metrics.json and the report) and reruns nothing else.
+    first_ = Make("all EVAL_FLAGS=--no-ocr");
+    ASSERT_EQ(first_.exit_code, 0) << first_.output;
+  }
+  TempDir dir_;
+  CommandResult first_;
+};
+
+TEST_F(Pipeline, WritesEveryStageOutputAndTheyValidate) {
+  for (const char* stage : {"bin/sfm", "bin/segment-boundary", "bin/detect-features",
+                            "bin/init-mesh", "bin/optimize", "bin/render"})
+    EXPECT_EQ(first_.output.find(stage), std::string::npos) << first_.output;
+  for (const char* f : {"10_sfm/cameras.json", "10_sfm/points.ply", "10_sfm/reference.png",
+                        "20_boundary/boundary.json", "20_boundary/mask.png",
+                        "20_boundary/overlay.png", "30_features/features.json",
+                        "30_features/overlay.png", "40_init/mesh3d.ply",
+                        "50_optimize/log.json", "50_optimize/scene.glb", "60_render/rectified.png",
+                        "70_eval/metrics.json", "report.html"})
+    EXPECT_TRUE(fs::is_regular_file(Work() / f)) << f;
+  for (const auto& e : fs::recursive_directory_iterator(Work())) {
+    if (e.path().extension() != ".json" || e.path().string().find("/colmap/") != std::string::npos)
+      continue;
+    CommandResult r = RunCommand(Quote((SourceDir() / "scripts/validate-json").string()) + " " +
+                                 Quote(e.path().string()));
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+  }
+  // No temporary files are left behind by atomic writes.
+  for (const auto& e : fs::recursive_directory_iterator(Work()))
+    EXPECT_EQ(e.path().filename().string().find(".tmp."), std::string::npos) << e.path();
+}
+
+TEST_F(Pipeline, SecondRunDoesNothingAndFlagsRerunOnlyDownstream) {
+  const auto sfm_time = MTime("10_sfm/cameras.json");
+  const auto boundary_time = MTime("20_boundary/boundary.json");
+  CommandResult again = Make("all EVAL_FLAGS=--no-ocr");
+  ASSERT_EQ(again.exit_code, 0) << again.output;
+  EXPECT_EQ(again.output.find("bin/sfm"), std::string::npos) << again.output;
+  EXPECT_EQ(again.output.find("bin/segment-boundary"), std::string::npos) << again.output;
+  EXPECT_EQ(MTime("10_sfm/cameras.json"), sfm_time);
+
+  // A different (equivalent) boundary flag reruns boundary and features only.
+  CommandResult changed = Make("all EVAL_FLAGS=--no-ocr BOUNDARY_FLAGS='--verbose'");
+  ASSERT_EQ(changed.exit_code, 0) << changed.output;
+  EXPECT_EQ(changed.output.find("bin/sfm"), std::string::npos) << changed.output;
+  EXPECT_NE(changed.output.find("bin/segment-boundary"), std::string::npos) << changed.output;
+  EXPECT_NE(changed.output.find("bin/detect-features"), std::string::npos) << changed.output;
+  EXPECT_EQ(MTime("10_sfm/cameras.json"), sfm_time);
+  EXPECT_NE(MTime("20_boundary/boundary.json"), boundary_time);
+  // Back to the default flags: reruns once more, then is stable.
+  ASSERT_EQ(Make("all EVAL_FLAGS=--no-ocr").exit_code, 0);
+  CommandResult stable = Make("all EVAL_FLAGS=--no-ocr");
+  EXPECT_EQ(stable.output.find("bin/segment-boundary"), std::string::npos) << stable.output;
+}
+
+TEST_F(Pipeline, FeaturesFromAnotherDetectorAreValidatedAndUsed) {
+  // The perfect external detector: true lines projected into the reference view.
+  auto gt = LoadGroundTruth(SampleDir(kSample));
+  ASSERT_TRUE(gt);
+  CameraSet sfm = ReadCameras(Work() / "10_sfm/cameras.json");
+  const PinholeCamera* ref = gt->cameras.Find(sfm.reference);
+  ASSERT_NE(ref, nullptr);
+  Json doc = {{"format", "docunfold.features"}, {"version", 1}, {"segments", Json::array()}};
+  for (const TrueLine& l : TrueLinesInView(*gt, *ref, 20.0)) {
+    Json pts = Json::array();
+    for (const auto& p : l.points) pts.push_back({p.x(), p.y()});
+    doc["segments"].push_back({{"kind", l.kind == "text" ? "text" : "edge"}, {"points", pts}});
+  }
+  ASSERT_FALSE(doc["segments"].empty());
+  const fs::path theirs = dir_.path() / "their_lines.json";
+  std::ofstream(theirs) << doc.dump();
+  CommandResult r = Make("all EVAL_FLAGS=--no-ocr FEATURES=" + Quote(theirs.string()));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(r.output.find("bin/detect-features"), std::string::npos) << r.output;
+  EXPECT_EQ(ReadJsonFile(Work() / "30_features/features.json"), doc);
+
+  // A wrong file stops with file:/json/pointer and leaves the last good one.
+  Json bad = doc;
+  bad["segments"][0]["kind"] = "baseline";
+  const fs::path wrong = dir_.path() / "wrong.json";
+  std::ofstream(wrong) << bad.dump();
+  r = Make("all EVAL_FLAGS=--no-ocr FEATURES=" + Quote(wrong.string()));
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.output.find("wrong.json:/segments/0/kind: "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("Error 3"), std::string::npos) << r.output;
+  EXPECT_EQ(ReadJsonFile(Work() / "30_features/features.json"), doc);
+
+  // Without FEATURES the detector runs again.
+  r = Make("all EVAL_FLAGS=--no-ocr");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("bin/detect-features"), std::string::npos) << r.output;
+}
+
+TEST(PipelineInput, UnknownDataSetIsReported) {
+  CommandResult r = RunCommand("make --no-print-directory -f " +
+                               Quote((SourceDir() / "pipeline.mk").string()) +
+                               " DATA=no-such-set WORK=/tmp/docunfold-none sfm");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.output.find("DATA=no-such-set: no data set"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists("/tmp/docunfold-none/10_sfm/cameras.json"));
+}
+
+}  // namespace
+}  // namespace docunfold::testing

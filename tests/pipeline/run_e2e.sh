@@ -1,0 +1,24 @@
+#!/usr/bin/env bash
+# run_e2e.sh SOURCE BUILD OUT: the run behind the end-to-end tests. The whole
+# pipeline on every data set with ground truth (samples/*, and the
+# independently rendered ../shared/realistic/* when present), with the rows
+# the checks compare against (homography, oracle, docunfold-init), through
+# scripts/bench.sh; two sets side by side. OCR is left out (the metrics
+# reference test covers it). Exits non-zero only when the run itself fails;
+# each set's outcome is for the tests to judge.
+set -uo pipefail
+src=$1 build=$2 out=$3
+sets=()
+for d in "$src"/samples/*/; do [[ -d $d/images && -f $d/ground_truth/flat.png ]] && sets+=("${d%/}"); done
+realistic=${DOCUNFOLD_REALISTIC_DIR:-$src/../shared/realistic}
+if [[ -d $realistic ]]; then
+  for d in "$realistic"/*/; do [[ -d $d/images && -f $d/ground_truth/flat.png ]] && sets+=("${d%/}"); done
+fi
+rm -rf "$out"
+mkdir -p "$out"
+BUILD=$build BENCH_WORK=$out/work BENCH_OUT=$out BENCH_JOBS=${E2E_JOBS:-2} \
+  BENCH_ONLY="homography oracle docunfold docunfold-init" BENCH_EVAL_FLAGS=--no-ocr \
+  BENCH_OCR_SIZE=native "$src/scripts/bench.sh" "${sets[@]}" > "$out/bench.log" 2>&1
+rc=$?
+tail -n 40 "$out/bench.log"
+exit $rc

@@ -1,0 +1,191 @@
+// The render binary: outputs, flags, exit codes, no partial outputs.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "common/grid_mesh.h"
+#include "common/json_io.h"
+#include "common/ply.h"
+#include "tests/render/render_fixtures.h"
+#include "tests/support/test_support.h"
+
+namespace docunfold::testing {
+namespace {
+
+class RenderCli : public ::testing::Test {
+ protected:
+  // One scene on disk for every test (10_sfm, 20_boundary, 40_init).
+  static void SetUpTestSuite() {
+    scene_dir_ = std::make_unique<TempDir>();
+    WriteScene(MakeScene({}), scene_dir_->path());
+  }
+  static void TearDownTestSuite() { scene_dir_.reset(); }
+
+  // A private copy of the scene for a test that changes it.
+  fs::path CopyScene() {
+    fs::copy(scene_dir_->path(), dir_.path() / "work",
+             fs::copy_options::recursive);
+    return dir_.path() / "work";
+  }
+
+  static CommandResult Render(const fs::path& work, const fs::path& out,
+                              const std::string& flags = "",
+                              const std::string& meshes = "40_init") {
+    return RunCommand(Quote(StageBinary("render").string()) + " --sfm " +
+                      Quote((work / "10_sfm").string()) + " --boundary " +
+                      Quote((work / "20_boundary").string()) + " --meshes " +
+                      Quote((work / meshes).string()) + " --out " +
+                      Quote(out.string()) + " " + flags);
+  }
+
+  // The run failed cleanly: the exit code, a message naming `names`, and
+  // nothing written.
+  void ExpectFailure(const CommandResult& r, int code, const std::string& names,
+                     const fs::path& out) {
+    EXPECT_EQ(r.exit_code, code) << r.output;
+    EXPECT_NE(r.output.find(names), std::string::npos) << r.output;
+    std::error_code ec;
+    EXPECT_FALSE(fs::exists(out / "rectified.png", ec));
+    EXPECT_FALSE(fs::exists(out / "rectified_grid.png", ec));
+    EXPECT_FALSE(fs::exists(out / "render.json", ec));
+  }
+
+  static fs::path scene() { return scene_dir_->path(); }
+
+  TempDir dir_;
+  static std::unique_ptr<TempDir> scene_dir_;
+};
+
+std::unique_ptr<TempDir> RenderCli::scene_dir_;
+
+TEST_F(RenderCli, WritesTheImagesAndAValidReport) {
+  const fs::path out = dir_ / "60_render";
+  const CommandResult r = Render(scene(), out);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("render: wrote"), std::string::npos) << r.output;
+  const cv::Mat image = cv::imread((out / "rectified.png").string());
+  const cv::Mat grid = cv::imread((out / "rectified_grid.png").string());
+  ASSERT_FALSE(image.empty());
+  ASSERT_EQ(grid.size(), image.size());
+  EXPECT_GT(cv::norm(image, grid, cv::NORM_L1), 0);
+  const Json report = ReadJsonFile(out / "render.json");
+  EXPECT_EQ(report["width"].get<int>(), image.cols);
+  EXPECT_EQ(report["height"].get<int>(), image.rows);
+  EXPECT_EQ(report["crop"]["rule"], "boundary-lines");
+  EXPECT_EQ(report["size_rule"], "reference-density");
+  EXPECT_TRUE(report["timing_s"].contains("read"));
+  const CommandResult v =
+      RunCommand(Quote((SourceDir() / "scripts/validate-json").string()) + " " +
+                 Quote((out / "render.json").string()));
+  EXPECT_EQ(v.exit_code, 0) << v.output;
+  // Nothing but the three outputs (no temporary files left behind).
+  int files = 0;
+  for (const auto& e : fs::directory_iterator(out)) {
+    (void)e;
+    ++files;
+  }
+  EXPECT_EQ(files, 3);
+}
+
+TEST_F(RenderCli, WidthFlagSetsTheOutputWidth) {
+  const fs::path out = dir_ / "out";
+  const CommandResult r =
+      Render(scene(), out, "--width 150 --fill white --no-deskew");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const cv::Mat image = cv::imread((out / "rectified.png").string());
+  EXPECT_EQ(image.cols, 150);
+  const Json report = ReadJsonFile(out / "render.json");
+  EXPECT_EQ(report["size_rule"], "width");
+  EXPECT_EQ(report["fill_rgb"], Json::array({255, 255, 255}));
+}
+
+TEST_F(RenderCli, ContradictoryFlagsAreUsageErrors) {
+  const fs::path out = dir_ / "out";
+  ExpectFailure(Render(scene(), out, "--width 100 --dpi 300"), 2, "excludes",
+                out);
+  ExpectFailure(Render(scene(), out, "--dpi 300"), 2, "--page-width-mm", out);
+  ExpectFailure(Render(scene(), out, "--fill purple"), 2, "--fill", out);
+  ExpectFailure(Render(scene(), out, "--width 100000"), 2, "--max-pixels", out);
+}
+
+TEST_F(RenderCli, MissingMeshesAreBadInput) {
+  const fs::path out = dir_ / "out";
+  ExpectFailure(Render(scene(), out, "", "50_optimize"), 3, "50_optimize", out);
+  const fs::path work = CopyScene();
+  fs::remove(work / "40_init" / "mesh2d.ply");
+  ExpectFailure(Render(work, out), 3, "mesh2d.ply", out);
+}
+
+TEST_F(RenderCli, MeshesOfDifferentGridsAreBadInput) {
+  const fs::path work = CopyScene();
+  PlyData m2 = ReadPly(work / "40_init" / "mesh2d.ply");
+  // Drop the last row: a 43x56 grid beside mesh3d's 43x57.
+  const auto grid = m2.GridSize();
+  ASSERT_TRUE(grid);
+  const int nx = (*grid)[0], ny = (*grid)[1] - 1;
+  m2.vertices.resize(size_t(nx) * ny);
+  QuadGrid g{nx, ny};
+  m2.faces = g.Faces();
+  m2.comments.clear();
+  m2.SetGridSize(nx, ny);
+  WritePly(work / "40_init" / "mesh2d.ply", m2);
+  const fs::path out = dir_ / "out";
+  ExpectFailure(Render(work, out), 3, "differs from mesh3d.ply", out);
+}
+
+TEST_F(RenderCli, MeshBehindTheCameraIsBadInput) {
+  const fs::path work = CopyScene();
+  MeshPair m = ReadMeshPair(work / "40_init");
+  for (auto& v : m.mesh3d) v.z() = -v.z();
+  WriteMeshPair(work / "40_init", m);
+  const fs::path out = dir_ / "out";
+  ExpectFailure(Render(work, out), 3, "behind the reference camera", out);
+}
+
+TEST_F(RenderCli, BoundaryOfAnotherImageIsBadInput) {
+  const fs::path work = CopyScene();
+  Json b = ReadJsonFile(work / "20_boundary" / "boundary.json");
+  b["width"] = 1600;
+  b["height"] = 1200;
+  WriteJsonAtomic(work / "20_boundary" / "boundary.json", b);
+  const fs::path out = dir_ / "out";
+  ExpectFailure(Render(work, out), 3,
+                "boundary.json: made for a 1600x1200 image", out);
+  fs::remove(work / "20_boundary" / "boundary.json");
+  ExpectFailure(Render(work, out), 3, "boundary.json", out);
+}
+
+TEST_F(RenderCli, BrokenSfmOutputIsBadInput) {
+  const fs::path work = CopyScene();
+  const fs::path out = dir_ / "out";
+  std::ofstream(work / "10_sfm" / "reference.png", std::ios::trunc).close();
+  ExpectFailure(Render(work, out), 3, "reference.png", out);
+  fs::remove(work / "10_sfm" / "cameras.json");
+  ExpectFailure(Render(work, out), 3, "cameras.json", out);
+}
+
+TEST_F(RenderCli, UnwritableOutputExits4WithoutPartialFiles) {
+  // --out below a regular file.
+  std::ofstream(dir_ / "file").close();
+  const CommandResult r = Render(scene(), dir_ / "file" / "out");
+  EXPECT_EQ(r.exit_code, 4) << r.output;
+  // One target that cannot be replaced: none of the three is written.
+  const fs::path out = dir_ / "out";
+  fs::create_directories(out / "rectified_grid.png");
+  const CommandResult r2 = Render(scene(), out);
+  EXPECT_EQ(r2.exit_code, 4) << r2.output;
+  EXPECT_FALSE(fs::exists(out / "rectified.png"));
+  EXPECT_FALSE(fs::exists(out / "render.json"));
+  int files = 0;
+  for (const auto& e : fs::directory_iterator(out)) {
+    (void)e;
+    ++files;
+  }
+  EXPECT_EQ(files, 1);  // only the directory that was in the way
+}
+
+}  // namespace
+}  // namespace docunfold::testing

@@ -1,0 +1,382 @@
+// render on analytic scenes whose exact result is known: a textured page,
+// flat or bent into a cylinder, seen by one camera.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "common/atomic_file.h"
+#include "common/errors.h"
+#include "stages/render/crop.h"
+#include "stages/render/render.h"
+#include "tests/render/render_fixtures.h"
+#include "tests/support/test_support.h"
+
+namespace docunfold::testing {
+namespace {
+
+// The texture as the rendering should show it: the crop of the page,
+// resized (area filter) to the output size.
+cv::Mat ExpectedImage(const SyntheticScene& s, const render::RenderResult& r) {
+  const double px_per_unit = s.texture.cols / s.page_w;
+  const cv::Rect2d crop(r.crop_x0 * px_per_unit, r.crop_y0 * px_per_unit,
+                        (r.crop_x1 - r.crop_x0) * px_per_unit,
+                        (r.crop_y1 - r.crop_y0) * px_per_unit);
+  // Area-resample the crop: map output pixels to texture with an affine
+  // warp after pre-smoothing by the scale factor.
+  const double f = r.pixels_per_unit / px_per_unit;  // output px per texture px
+  cv::Mat small;
+  cv::resize(s.texture, small, cv::Size(), f, f, cv::INTER_AREA);
+  const double ax = double(s.texture.cols) / small.cols * f;  // ~1
+  const cv::Matx23d out_to_small(1 / ax, 0, crop.x * f / ax + 0.5 / ax - 0.5, 0,
+                                 1 / ax, crop.y * f / ax + 0.5 / ax - 0.5);
+  cv::Mat out;
+  cv::warpAffine(small, out, out_to_small, r.rectified.size(),
+                 cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_REPLICATE);
+  return out;
+}
+
+double MeanAbsGreyDifference(const cv::Mat& a, const cv::Mat& b,
+                             const cv::Mat1b& mask) {
+  cv::Mat ga, gb, diff;
+  cv::cvtColor(a, ga, cv::COLOR_BGR2GRAY);
+  cv::cvtColor(b, gb, cv::COLOR_BGR2GRAY);
+  cv::absdiff(ga, gb, diff);
+  return cv::mean(diff, mask)[0];
+}
+
+void Keep(const std::string& name, const cv::Mat& image) {
+  if (std::getenv("DOCUNFOLD_KEEP_TEST_DIRS"))
+    cv::imwrite("/tmp/render-unit-" + name + ".png", image);
+}
+
+cv::Mat1b Inner(const cv::Mat1b& mask, int margin) {
+  cv::Mat1b out;
+  cv::erode(mask, out, cv::Mat(), cv::Point(-1, -1), margin);
+  return out;
+}
+
+TEST(RenderScene, BentPageReproducesItsTexture) {
+  const SyntheticScene s = MakeScene({});
+  const render::RenderResult r = render::Run({}, InputsOf(s));
+  EXPECT_EQ(r.crop_rule, "boundary-lines");
+  const double px = 1 / r.pixels_per_unit;
+  EXPECT_NEAR(r.crop_x0, 0, px);
+  EXPECT_NEAR(r.crop_y0, 0, px);
+  EXPECT_NEAR(r.crop_x1, s.page_w, px);
+  EXPECT_NEAR(r.crop_y1, s.page_h, px);
+  EXPECT_NEAR(r.rotation_deg, 0, 0.02);
+  EXPECT_EQ(r.hidden_fraction, 0);
+  EXPECT_GT(r.page_fraction, 0.99);
+  const cv::Mat expected = ExpectedImage(s, r);
+  const cv::Mat1b mask = Inner(r.page_mask, 3);
+  const cv::Mat1f a = Detail(expected), b = Detail(r.rectified);
+  EXPECT_GT(Correlation(a, b, mask), 0.9);
+  const TileOffsets off = FindTileOffsets(a, b, mask, 32, 6);
+  ASSERT_GT(off.tiles, 10);
+  EXPECT_EQ(off.matched, off.tiles);
+  EXPECT_LT(off.median, 0.3);
+  EXPECT_LT(off.max, 1.0);
+  EXPECT_LT(MeanAbsGreyDifference(expected, r.rectified, mask), 12);
+  // The grid overlay is the same picture with lines on it.
+  ASSERT_EQ(r.rectified_grid.size(), r.rectified.size());
+  cv::Mat diff;
+  cv::absdiff(r.rectified_grid, r.rectified, diff);
+  cv::cvtColor(diff, diff, cv::COLOR_BGR2GRAY);
+  const double changed = cv::countNonZero(diff > 30) / double(diff.total());
+  EXPECT_GT(changed, 0.02);
+  EXPECT_LT(changed, 0.5);
+}
+
+TEST(RenderScene, DefaultSizeKeepsTheReferenceDensity) {
+  // A frontal flat page at depth 1: f pixels per unit everywhere.
+  SceneOptions o;
+  o.radius = 0;
+  o.tilt_deg = 0;
+  o.focal = 500;
+  o.page_origin = {-0.2, -0.25, 1.0};
+  o.page_w = 0.4;
+  o.page_h = 0.5;
+  const SyntheticScene s = MakeScene(o);
+  const render::RenderResult r = render::Run({}, InputsOf(s));
+  EXPECT_NEAR(r.reference_pixels_per_unit, 500, 0.5);
+  EXPECT_NEAR(r.pixels_per_unit, 500, 1.0);
+  EXPECT_NEAR(r.rectified.cols, 0.4 * 500, 1);
+  EXPECT_NEAR(r.rectified.rows, 0.5 * 500, 1);
+  EXPECT_EQ(r.size_rule, "reference-density");
+  // Frontal at the same density: neither magnified nor minified.
+  EXPECT_LT(r.minified_fraction, 0.01);
+}
+
+TEST(RenderScene, SizeOptions) {
+  const SyntheticScene s = MakeScene({});
+  const render::RenderInputs in = InputsOf(s);
+  const double aspect = s.page_w / s.page_h;
+  {
+    render::RenderOptions o;
+    o.width = 300;
+    const auto r = render::Run(o, in);
+    EXPECT_EQ(r.rectified.cols, 300);
+    EXPECT_NEAR(r.rectified.rows, 300 / aspect, 1.0);
+    EXPECT_EQ(r.size_rule, "width");
+  }
+  {
+    render::RenderOptions o;
+    o.height = 200;
+    const auto r = render::Run(o, in);
+    EXPECT_EQ(r.rectified.rows, 200);
+    EXPECT_NEAR(r.rectified.cols, 200 * aspect, 1.0);
+  }
+  {
+    render::RenderOptions o;
+    o.dpi = 50;
+    o.page_width_mm = 210;
+    const auto r = render::Run(o, in);
+    EXPECT_NEAR(r.rectified.cols, 210 / 25.4 * 50, 1.0);
+    EXPECT_EQ(r.size_rule, "dpi");
+  }
+  {
+    render::RenderOptions o;
+    o.scale = 0.5;
+    const auto r = render::Run(o, in);
+    EXPECT_NEAR(r.pixels_per_unit, 0.5 * r.reference_pixels_per_unit, 1e-6);
+  }
+  {
+    render::RenderOptions o;
+    o.max_pixels = 20000;
+    const auto r = render::Run(o, in);
+    EXPECT_TRUE(r.capped);
+    EXPECT_LE(r.rectified.total(), 20000u);
+    EXPECT_GT(r.rectified.total(), 19000u);
+  }
+  render::RenderOptions both;
+  both.width = 100;
+  both.scale = 2;
+  EXPECT_THROW(render::Run(both, in), UsageError);
+  render::RenderOptions dpi_alone;
+  dpi_alone.dpi = 300;
+  EXPECT_THROW(render::Run(dpi_alone, in), UsageError);
+  render::RenderOptions too_big;
+  too_big.width = 100000;
+  EXPECT_THROW(render::Run(too_big, in), UsageError);
+  render::RenderOptions bad_fill;
+  bad_fill.fill = "#12345";
+  EXPECT_THROW(render::Run(bad_fill, in), UsageError);
+  render::RenderOptions hex_fill;
+  hex_fill.fill = "#102030";
+  EXPECT_EQ(render::Run(hex_fill, in).fill, cv::Vec3b(0x30, 0x20, 0x10));
+}
+
+TEST(RenderScene, MinifyingFiltersTheFootprint) {
+  // The page at a slant, rendered at a third of its density: fine stripes
+  // and text must come out as their area average, not as moire.
+  const SyntheticScene s = MakeScene({});
+  const render::RenderInputs in = InputsOf(s);
+  render::RenderOptions o;
+  o.scale = 1.0 / 3;
+  const auto filtered = render::Run(o, in);
+  o.antialias = false;
+  const auto aliased = render::Run(o, in);
+  ASSERT_EQ(filtered.rectified.size(), aliased.rectified.size());
+  EXPECT_GT(filtered.minified_fraction, 0.9);
+  EXPECT_EQ(aliased.minified_fraction, 0);
+  const cv::Mat expected = ExpectedImage(s, filtered);
+  const cv::Mat1b mask = Inner(filtered.page_mask, 2);
+  const double err_filtered =
+      MeanAbsGreyDifference(expected, filtered.rectified, mask);
+  const double err_aliased =
+      MeanAbsGreyDifference(expected, aliased.rectified, mask);
+  // What an area resize of the full-density rendering achieves: the best
+  // the blur already in the photo allows.
+  const auto full = render::Run({}, in);
+  cv::Mat area;
+  cv::resize(full.rectified, area, filtered.rectified.size(), 0, 0,
+             cv::INTER_AREA);
+  const double err_area = MeanAbsGreyDifference(expected, area, mask);
+  std::printf(
+      "minify: mean |grey difference| filtered %.2f, aliased %.2f, area resize "
+      "%.2f\n",
+      err_filtered, err_aliased, err_area);
+  EXPECT_LT(err_filtered, 1.15 * err_area);
+  EXPECT_LT(err_filtered, 0.7 * err_aliased);
+}
+
+TEST(RenderScene, CutOffPageIsCroppedByItsRealSidesAndWhatTheViewSees) {
+  SceneOptions o;
+  o.page_origin = {-0.6, -0.3, 1.0};  // the left part runs off the image
+  const SyntheticScene s = MakeScene(o);
+  ASSERT_FALSE(s.real[3]);
+  ASSERT_TRUE(s.real[0] && s.real[1] && s.real[2]);
+  const render::RenderResult r = render::Run({}, InputsOf(s));
+  EXPECT_EQ(r.crop_rule, "real-sides-and-visible-mesh");
+  EXPECT_FALSE(r.sides[3].used);
+  EXPECT_TRUE(r.sides[0].used);
+  EXPECT_TRUE(r.sides[1].used);
+  EXPECT_TRUE(r.sides[2].used);
+  // The image's left border meets the flat part of the page at
+  // a = k z - x_origin with k = (-0.5 - cx) / f, farthest (largest z) at the
+  // bottom row: that is where the seen part of M' begins.
+  const double tilt = o.tilt_deg * M_PI / 180;
+  const double k = (-0.5 - s.camera.K(0, 2)) / s.camera.K(0, 0);
+  const double x0 =
+      k * (o.page_origin.z() + o.page_h * std::sin(tilt)) - o.page_origin.x();
+  const double px = 1 / r.pixels_per_unit;
+  EXPECT_NEAR(r.crop_x0, x0, 2 * px);
+  EXPECT_NEAR(r.crop_x1, s.page_w, px);
+  EXPECT_NEAR(r.crop_y0, 0, px);
+  EXPECT_NEAR(r.crop_y1, s.page_h, px);
+  // Unseen corners of the crop get the fill (the median page colour).
+  EXPECT_GT(r.hidden_fraction, 0.005);
+  EXPECT_NEAR(r.page_fraction + r.hidden_fraction, 1.0, 0.01);
+  const cv::Vec3b paper = r.fill;
+  EXPECT_GT(paper[0], 200);
+  for (int y = 0; y < r.rectified.rows; y += 7)
+    for (int x = 0; x < r.rectified.cols; x += 7)
+      if (!r.page_mask(y, x)) ASSERT_EQ(r.rectified.at<cv::Vec3b>(y, x), paper);
+  // The seen part is still the texture (mostly the bent half, seen at a
+  // slant and so blurred in the photo).
+  Keep("cutoff", r.rectified_grid);
+  const cv::Mat1b mask = Inner(r.page_mask, 3);
+  const cv::Mat1f a = Detail(ExpectedImage(s, r)), b = Detail(r.rectified);
+  EXPECT_GT(Correlation(a, b, mask), 0.8);
+  const TileOffsets off = FindTileOffsets(a, b, mask, 32, 6);
+  ASSERT_GT(off.tiles, 5);
+  EXPECT_EQ(off.matched, off.tiles);
+  EXPECT_LT(off.median, 0.5);
+}
+
+TEST(RenderScene, PartsTheReferenceViewCannotSeeAreFilled) {
+  // The right half rolls into a tube: much of it faces away from the camera
+  // or hides behind itself.
+  SceneOptions o;
+  o.radius = 0.05;
+  SyntheticScene s = MakeScene(o);
+  // The outline of the page region: the roll is no page edge, so the right
+  // side is not real, and only the flat halves of the top and bottom are.
+  s.real[1] = false;
+  s.sides[0].resize(s.sides[0].size() / 2);
+  s.sides[2].resize(s.sides[2].size() / 2);
+  const render::RenderInputs in = InputsOf(s);
+  const render::RenderResult r = render::Run({}, in);
+  EXPECT_GT(r.hidden_fraction, 0.2);
+  Keep("tube", r.rectified_grid);
+  // The flat half, seen directly, is intact.
+  cv::Mat1b left = cv::Mat1b::zeros(r.page_mask.size());
+  left(cv::Rect(0, 0, int(r.rectified.cols * 0.45), r.rectified.rows))
+      .setTo(255);
+  const cv::Mat1b mask = Inner(r.page_mask, 3) & left;
+  EXPECT_GT(cv::countNonZero(mask), 0.3 * mask.total());
+  EXPECT_GT(Correlation(Detail(ExpectedImage(s, r)), Detail(r.rectified), mask),
+            0.9);
+  // Sides drawn over the roll map onto other parts of M: they must not tilt
+  // or cut the crop.
+  SyntheticScene full = MakeScene(o);
+  full.real[1] = false;
+  const render::RenderResult outline = render::Run({}, InputsOf(full));
+  EXPECT_LT(std::abs(outline.rotation_deg), 0.25);
+  EXPECT_NEAR(outline.crop_y0, 0, 1 / outline.pixels_per_unit);
+  EXPECT_NEAR(outline.crop_y1, o.page_h, 1 / outline.pixels_per_unit);
+  // With --sample-hidden those pixels show whatever the view has there.
+  render::RenderOptions sample;
+  sample.sample_hidden = true;
+  const render::RenderResult all = render::Run(sample, in);
+  EXPECT_GT(cv::countNonZero(all.page_mask), cv::countNonZero(r.page_mask));
+}
+
+TEST(RenderScene, TiltedFlatMeshIsTurnedUpright) {
+  SyntheticScene s = MakeScene({});
+  const double angle = 3 * M_PI / 180;
+  for (auto& q : s.meshes.mesh2d) q = Eigen::Rotation2Dd(angle) * q;
+  const render::RenderResult r = render::Run({}, InputsOf(s));
+  EXPECT_NEAR(r.rotation_deg, -3, 0.05);
+  EXPECT_EQ(r.crop_rule, "boundary-lines");
+  EXPECT_NEAR(r.crop_x1 - r.crop_x0, s.page_w, 2 / r.pixels_per_unit);
+  EXPECT_NEAR(r.crop_y1 - r.crop_y0, s.page_h, 2 / r.pixels_per_unit);
+  render::RenderOptions keep;
+  keep.deskew = false;
+  const render::RenderResult tilted = render::Run(keep, InputsOf(s));
+  EXPECT_EQ(tilted.rotation_deg, 0);
+  // Inscribed in the tilted page: smaller on both axes.
+  EXPECT_LT(tilted.crop_x1 - tilted.crop_x0, s.page_w * 0.97);
+  EXPECT_LT(tilted.crop_y1 - tilted.crop_y0, s.page_h * 0.97);
+}
+
+TEST(RenderInputs, InconsistentInputsAreRejected) {
+  const SyntheticScene s = MakeScene({});
+  {
+    render::RenderInputs in = InputsOf(s);
+    for (auto& v : in.meshes.mesh3d) v.z() = -v.z();
+    try {
+      render::Run({}, in);
+      FAIL() << "no error for a mesh behind the camera";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("behind the reference camera"),
+                std::string::npos);
+      EXPECT_NE(std::string(e.what()).find("mesh3d.ply"), std::string::npos);
+    }
+  }
+  {
+    render::RenderInputs in = InputsOf(s);
+    in.boundary.width = 1600;
+    EXPECT_THROW(render::Run({}, in), InputError);
+  }
+  {
+    render::RenderInputs in = InputsOf(s);
+    cv::resize(s.photo, in.reference, cv::Size(320, 240));
+    EXPECT_THROW(render::Run({}, in), InputError);
+  }
+  {
+    render::RenderInputs in = InputsOf(s);
+    for (auto& v : in.meshes.mesh3d) v.x() += 10;  // far outside the view
+    EXPECT_THROW(render::Run({}, in), InputError);
+  }
+  {
+    render::RenderInputs in = InputsOf(s);
+    for (auto& q : in.meshes.mesh2d) q.y() = 0;
+    EXPECT_THROW(render::Run({}, in), InputError);
+  }
+}
+
+TEST(RenderCrop, SideLinesIgnoreOutliersAndWrongOrderIsDropped) {
+  std::vector<Eigen::Vector2d> top, bottom;
+  for (int i = 0; i <= 100; ++i) {
+    top.emplace_back(i * 0.01, 0.1 + 0.001 * i * 0.01);
+    bottom.emplace_back(i * 0.01, 1.2);
+  }
+  top[50].y() += 0.2;  // a stray sample
+  const render::SideFit t = render::FitSideLine(0, true, top, 101);
+  EXPECT_TRUE(t.used);
+  EXPECT_EQ(t.mapped, 100);
+  EXPECT_LT(t.rms, 1e-9);
+  EXPECT_NEAR(t.direction.y() / t.direction.x(), 0.001, 1e-9);
+  EXPECT_GT(t.direction.x(), 0);
+  // Too few of the samples mapped: not used.
+  EXPECT_FALSE(render::FitSideLine(2, true, bottom, 1000).used);
+  // Not real: never used.
+  EXPECT_FALSE(render::FitSideLine(2, false, bottom, 101).used);
+
+  std::array<render::SideFit, 4> sides;
+  sides[0] = render::FitSideLine(2, true, bottom, 101);  // "top" below "bottom"
+  sides[2] = render::FitSideLine(0, true, top, 101);
+  render::ChooseCrop(&sides, Eigen::Vector4d(0, 0, 1, 1.3));
+  EXPECT_FALSE(sides[0].used);
+  EXPECT_FALSE(sides[2].used);
+  EXPECT_FALSE(sides[0].note.empty());
+
+  std::array<render::SideFit, 4> good;
+  good[0] = render::FitSideLine(0, true, top, 101);
+  good[2] = render::FitSideLine(2, true, bottom, 101);
+  const render::CropRect crop =
+      render::ChooseCrop(&good, Eigen::Vector4d(-0.1, 0, 1.1, 1.3));
+  EXPECT_EQ(crop.rule, "real-sides-and-visible-mesh");
+  EXPECT_NEAR(crop.x0, -0.1, 1e-12);
+  EXPECT_NEAR(crop.x1, 1.1, 1e-12);
+  EXPECT_NEAR(crop.y0, 0.1 + 0.001 * 1.1, 1e-9);  // the top line's lowest point
+  EXPECT_NEAR(crop.y1, 1.2, 1e-9);
+  // Weighted by the samples each line keeps (100 and 101).
+  EXPECT_NEAR(render::TiltOfSides(good), std::atan(0.001) * 100 / 201, 1e-9);
+}
+
+}  // namespace
+}  // namespace docunfold::testing

@@ -1,0 +1,266 @@
+// The sfm command line: a good run on a small copy of a data set, --ref,
+// replacing an earlier output, and every kind of bad input (exit code, one
+// line naming the cause, no partial output left behind).
+#include <algorithm>
+#include <fstream>
+#include <regex>
+#include <set>
+#include <sstream>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "common/camera.h"
+#include "common/ply.h"
+#include "stages/sfm/subprocess.h"
+#include "tests/sfm/sfm_eval.h"
+#include "tests/support/test_support.h"
+
+namespace docunfold::testing {
+namespace {
+
+CommandResult Sfm(const std::string& args) {
+  return RunCommand(Quote(StageBinary("sfm").string()) + " " + args);
+}
+
+std::string Args(const fs::path& data, const fs::path& out, const std::string& more = "") {
+  return "--data " + Quote(data.string()) + " --out " + Quote(out.string()) +
+         (more.empty() ? "" : " " + more);
+}
+
+// Names of everything directly in `dir`.
+std::set<std::string> Listing(const fs::path& dir) {
+  std::set<std::string> names;
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(dir, ec)) names.insert(e.path().filename().string());
+  return names;
+}
+
+int CountLines(const std::string& s) { return int(std::count(s.begin(), s.end(), '\n')); }
+
+// A failed run: the exit code, exactly one line on stderr saying what is
+// wrong (containing `needle`), and nothing left in `out`'s parent that was
+// not there before.
+void ExpectFailure(const CommandResult& r, int code, const std::string& needle,
+                   const fs::path& out, const std::set<std::string>& parent_before) {
+  EXPECT_EQ(r.exit_code, code) << r.output;
+  EXPECT_NE(r.output.find(needle), std::string::npos) << r.output;
+  // Our progress lines are allowed before the error; the error is one line.
+  const std::regex error_line("^sfm: (bad input|usage error|error|cannot write output): ");
+  int errors = 0;
+  std::istringstream lines(r.output);
+  for (std::string line; std::getline(lines, line);)
+    errors += std::regex_search(line, error_line);
+  EXPECT_EQ(errors, 1) << r.output;
+  EXPECT_EQ(Listing(out.parent_path()), parent_before) << "left behind in " << out.parent_path();
+}
+
+cv::Mat Noise(int w, int h, unsigned seed) {
+  cv::Mat im(h, w, CV_8UC3);
+  cv::RNG rng(seed);
+  rng.fill(im, cv::RNG::UNIFORM, 0, 256);
+  cv::GaussianBlur(im, im, cv::Size(3, 3), 0);
+  return im;
+}
+
+class SfmCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (!fs::exists(StageBinary("sfm"))) GTEST_SKIP() << "sfm not built";
+  }
+  // 3 views of a data set with ground truth at 800 px: a quick real run.
+  fs::path SmallSet(int views = 3) {
+    const fs::path source = AnyDataSet();
+    if (source.empty()) return {};
+    return MakeSmallDataSet(source, tmp_ / "small", views, 800);
+  }
+  bool HaveColmap() const { return !sfm::FindExecutable("colmap").empty(); }
+  TempDir tmp_;
+};
+
+TEST_F(SfmCli, HelpListsFlagsWithDefaults) {
+  const CommandResult r = Sfm("--help");
+  EXPECT_EQ(r.exit_code, 0);
+  for (const char* s : {"--data", "--out", "--ref", "--max-image-size", "1600",
+                        "--camera-model", "SIMPLE_RADIAL", "--threads", "--verbose",
+                        "--max-reprojection-error", "--min-points", "--colmap", "Exit codes"})
+    EXPECT_NE(r.output.find(s), std::string::npos) << s;
+}
+
+TEST_F(SfmCli, UsageErrorsExit2) {
+  const fs::path out = tmp_ / "out";
+  for (const std::string& args :
+       {std::string("--out ") + Quote(out.string()), std::string("--data x"),
+        Args("x", out, "--camera-model FISHEYE"), Args("x", out, "--max-image-size 0"),
+        Args("x", out, "--no-such-flag"), Args("x", out, "--threads many")}) {
+    const CommandResult r = Sfm(args);
+    EXPECT_EQ(r.exit_code, 2) << args << "\n" << r.output;
+    EXPECT_FALSE(fs::exists(out));
+  }
+}
+
+TEST_F(SfmCli, NoDataSetFolder) {
+  const fs::path out = tmp_ / "work" / "10_sfm";
+  fs::create_directories(out.parent_path());
+  ExpectFailure(Sfm(Args(tmp_ / "missing", out)), 3, (tmp_ / "missing").string(), out, {});
+  EXPECT_FALSE(fs::exists(out));
+}
+
+TEST_F(SfmCli, NoImagesFolder) {
+  fs::create_directories(tmp_ / "set" / "ground_truth");
+  const fs::path out = tmp_ / "work" / "10_sfm";
+  fs::create_directories(out.parent_path());
+  ExpectFailure(Sfm(Args(tmp_ / "set", out)), 3, "images", out, {});
+}
+
+TEST_F(SfmCli, FewerThanTwoImages) {
+  fs::create_directories(tmp_ / "set" / "images");
+  cv::imwrite((tmp_ / "set" / "images" / "only.jpg").string(), Noise(64, 48, 1));
+  const fs::path out = tmp_ / "work" / "10_sfm";
+  fs::create_directories(out.parent_path());
+  ExpectFailure(Sfm(Args(tmp_ / "set", out)), 3, "at least 2", out, {});
+}
+
+TEST_F(SfmCli, UnreadableImageIsNamed) {
+  fs::create_directories(tmp_ / "set" / "images");
+  cv::imwrite((tmp_ / "set" / "images" / "a.jpg").string(), Noise(64, 48, 1));
+  cv::imwrite((tmp_ / "set" / "images" / "b.jpg").string(), Noise(64, 48, 2));
+  std::ofstream(tmp_ / "set" / "images" / "broken.jpg") << "\xff\xd8 this is not a JPEG";
+  std::ofstream(tmp_ / "set" / "images" / "empty.png");
+  const fs::path out = tmp_ / "work" / "10_sfm";
+  fs::create_directories(out.parent_path());
+  ExpectFailure(Sfm(Args(tmp_ / "set", out)), 3, "broken.jpg", out, {});
+  fs::remove(tmp_ / "set" / "images" / "broken.jpg");
+  ExpectFailure(Sfm(Args(tmp_ / "set", out)), 3, "empty.png", out, {});
+}
+
+TEST_F(SfmCli, PhotosOfDifferentSizes) {
+  fs::create_directories(tmp_ / "set" / "images");
+  cv::imwrite((tmp_ / "set" / "images" / "a.jpg").string(), Noise(64, 48, 1));
+  cv::imwrite((tmp_ / "set" / "images" / "b.jpg").string(), Noise(48, 64, 2));
+  const fs::path out = tmp_ / "work" / "10_sfm";
+  fs::create_directories(out.parent_path());
+  ExpectFailure(Sfm(Args(tmp_ / "set", out)), 3, "b.jpg", out, {});
+}
+
+TEST_F(SfmCli, RefThatDoesNotExist) {
+  fs::create_directories(tmp_ / "set" / "images");
+  cv::imwrite((tmp_ / "set" / "images" / "a.jpg").string(), Noise(64, 48, 1));
+  cv::imwrite((tmp_ / "set" / "images" / "b.jpg").string(), Noise(64, 48, 2));
+  const fs::path out = tmp_ / "work" / "10_sfm";
+  fs::create_directories(out.parent_path());
+  ExpectFailure(Sfm(Args(tmp_ / "set", out, "--ref c.jpg")), 3, "c.jpg", out, {});
+}
+
+TEST_F(SfmCli, ColmapMissingSaysHowToInstallIt) {
+  fs::create_directories(tmp_ / "set" / "images");
+  cv::imwrite((tmp_ / "set" / "images" / "a.jpg").string(), Noise(64, 48, 1));
+  cv::imwrite((tmp_ / "set" / "images" / "b.jpg").string(), Noise(64, 48, 2));
+  const fs::path out = tmp_ / "work" / "10_sfm";
+  fs::create_directories(out.parent_path());
+  ExpectFailure(Sfm(Args(tmp_ / "set", out, "--colmap /nonexistent/colmap")), 1,
+                "apt-get install colmap", out, {});
+  // Not in PATH either.
+  const CommandResult r = RunCommand("PATH=/nonexistent " + Quote(StageBinary("sfm").string()) +
+                                     " " + Args(tmp_ / "set", out));
+  ExpectFailure(r, 1, "scripts/install-deps.sh", out, {});
+}
+
+TEST_F(SfmCli, RefusesToReplaceAFolderItDidNotWrite) {
+  fs::create_directories(tmp_ / "set" / "images");
+  cv::imwrite((tmp_ / "set" / "images" / "a.jpg").string(), Noise(64, 48, 1));
+  cv::imwrite((tmp_ / "set" / "images" / "b.jpg").string(), Noise(64, 48, 2));
+  const fs::path out = tmp_ / "home";
+  fs::create_directories(out);
+  std::ofstream(out / "thesis.tex") << "precious";
+  const CommandResult r = Sfm(Args(tmp_ / "set", out));
+  EXPECT_EQ(r.exit_code, 4) << r.output;
+  EXPECT_NE(r.output.find("not an sfm output"), std::string::npos) << r.output;
+  EXPECT_EQ(Listing(out), std::set<std::string>{"thesis.tex"});
+}
+
+TEST_F(SfmCli, NothingRegisters) {
+  if (!HaveColmap()) GTEST_SKIP() << "COLMAP not installed";
+  fs::create_directories(tmp_ / "set" / "images");
+  cv::imwrite((tmp_ / "set" / "images" / "a.jpg").string(), Noise(320, 240, 1));
+  cv::imwrite((tmp_ / "set" / "images" / "b.jpg").string(), Noise(320, 240, 2));
+  const fs::path out = tmp_ / "work" / "10_sfm";
+  fs::create_directories(out.parent_path());
+  ExpectFailure(Sfm(Args(tmp_ / "set", out)), 3, "fewer than 2 views registered", out, {});
+}
+
+TEST_F(SfmCli, GoodRunThenRefThenFailedRunKeepsTheOutput) {
+  if (!HaveColmap()) GTEST_SKIP() << "COLMAP not installed";
+  const fs::path data = SmallSet();
+  if (data.empty()) GTEST_SKIP() << "no data set with ground truth";
+  const fs::path out = tmp_ / "work" / "10_sfm";
+  const CommandResult r = Sfm(Args(data, out, "--threads 2"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  // Progress, not COLMAP's chatter: a few dozen lines at most, all ours.
+  EXPECT_LT(CountLines(r.output), 30) << r.output;
+  EXPECT_EQ(r.output.find('\r'), std::string::npos);
+  std::istringstream lines(r.output);
+  for (std::string line; std::getline(lines, line);) EXPECT_EQ(line.rfind("sfm: ", 0), 0u) << line;
+  EXPECT_NE(r.output.find("sfm: extracting features"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("3/3 views registered"), std::string::npos) << r.output;
+  EXPECT_EQ(Listing(out.parent_path()), std::set<std::string>{"10_sfm"});
+  for (const char* f : {"cameras.json", "points.ply", "reference.png", "colmap/database.db",
+                        "colmap/sparse/0/cameras.bin", "colmap/sparse/0/images.bin",
+                        "colmap/sparse/0/points3D.bin", "colmap/feature_extractor.log",
+                        "colmap/exhaustive_matcher.log", "colmap/mapper.log"})
+    EXPECT_TRUE(fs::is_regular_file(out / f)) << f;
+  const CameraSet first = ReadCameras(out / "cameras.json");
+  EXPECT_EQ(first.views.size(), 3u);
+  const PlyData ply = ReadPly(out / "points.ply");
+  EXPECT_GE(ply.vertices.size(), 100u);
+  EXPECT_TRUE(std::any_of(ply.comments.begin(), ply.comments.end(), [](const std::string& c) {
+    return c.find("reference view") != std::string::npos;
+  }));
+
+  // --ref: another view becomes the frame; the old output is replaced.
+  std::string other;
+  for (const PinholeCamera& c : first.views)
+    if (c.image != first.reference) other = c.image;
+  const CommandResult r2 = Sfm(Args(data, out, "--threads 2 --ref " + other));
+  ASSERT_EQ(r2.exit_code, 0) << r2.output;
+  const CameraSet second = ReadCameras(out / "cameras.json");
+  EXPECT_EQ(second.reference, other);
+  EXPECT_TRUE(second.Find(other)->R.isIdentity(0));
+  EXPECT_TRUE(second.Find(other)->t.isZero(0));
+  EXPECT_EQ(Listing(out.parent_path()), std::set<std::string>{"10_sfm"});
+
+  // A failing run leaves the last good output as it was.
+  std::ifstream before_file(out / "cameras.json");
+  const std::string before((std::istreambuf_iterator<char>(before_file)), {});
+  ExpectFailure(Sfm(Args(data, out, "--ref missing.jpg")), 3, "missing.jpg", out, {"10_sfm"});
+  std::ifstream after_file(out / "cameras.json");
+  const std::string after((std::istreambuf_iterator<char>(after_file)), {});
+  EXPECT_EQ(before, after);
+}
+
+TEST_F(SfmCli, RefNotRegistered) {
+  if (!HaveColmap()) GTEST_SKIP() << "COLMAP not installed";
+  const fs::path data = SmallSet(3);
+  if (data.empty()) GTEST_SKIP() << "no data set with ground truth";
+  const cv::Mat sample = cv::imread((*fs::directory_iterator(data / "images")).path().string());
+  cv::imwrite((data / "images" / "zz_noise.jpg").string(), Noise(sample.cols, sample.rows, 3));
+  const fs::path out = tmp_ / "work" / "10_sfm";
+  fs::create_directories(out.parent_path());
+  ExpectFailure(Sfm(Args(data, out, "--threads 2 --ref zz_noise.jpg")), 3,
+                "could not register", out, {});
+}
+
+TEST_F(SfmCli, TooFewPoints) {
+  if (!HaveColmap()) GTEST_SKIP() << "COLMAP not installed";
+  const fs::path data = SmallSet(3);
+  if (data.empty()) GTEST_SKIP() << "no data set with ground truth";
+  const fs::path out = tmp_ / "work" / "10_sfm";
+  fs::create_directories(out.parent_path());
+  const CommandResult r = Sfm(Args(data, out, "--threads 2 --no-retry --min-points 1000000"));
+  ExpectFailure(r, 3, "fewer than --min-points 1000000", out, {});
+  EXPECT_TRUE(std::regex_search(r.output, std::regex("only \\d+ 3D points"))) << r.output;
+}
+
+}  // namespace
+}  // namespace docunfold::testing

@@ -1,0 +1,455 @@
+// Unit tests of sfm's parts: COLMAP's binary model reader and pixel
+// convention, the reference frame, the reference-view score, the image
+// checks, undistortion and the subprocess runner. No COLMAP needed.
+#include <cstdio>
+#include <fstream>
+#include <random>
+
+#include <Eigen/Core>
+#include <gtest/gtest.h>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "common/errors.h"
+#include "stages/sfm/colmap_model.h"
+#include "stages/sfm/reference_view.h"
+#include "stages/sfm/sfm.h"
+#include "stages/sfm/subprocess.h"
+#include "tests/sfm/sfm_eval.h"
+#include "tests/support/test_support.h"
+
+namespace docunfold::testing {
+namespace {
+
+using sfm::ColmapCamera;
+using sfm::ColmapImage;
+using sfm::ColmapModel;
+using sfm::ColmapPoint;
+
+// --- a writer of COLMAP's binary format, as COLMAP 3.8 lays it out ---------
+
+class Bytes {
+ public:
+  template <typename T>
+  void Put(T v) {
+    const char* p = reinterpret_cast<const char*>(&v);
+    data_.append(p, sizeof(T));
+  }
+  void PutString(const std::string& s) { data_.append(s.c_str(), s.size() + 1); }
+  void Save(const fs::path& path, size_t truncate_by = 0) const {
+    std::ofstream f(path, std::ios::binary);
+    f.write(data_.data(), std::streamsize(data_.size() - truncate_by));
+  }
+
+ private:
+  std::string data_;
+};
+
+struct FakePoint {
+  Eigen::Vector3d xyz;
+  std::vector<uint32_t> images;
+};
+
+// Writes a model with one camera, the given images (id = index + 1) and
+// points; each image lists a 2D point per observation.
+void WriteModel(const fs::path& dir, const ColmapCamera& camera,
+                const std::vector<ColmapImage>& images,
+                const std::vector<FakePoint>& points, size_t truncate_points_by = 0) {
+  fs::create_directories(dir);
+  Bytes c;
+  c.Put<uint64_t>(1);
+  c.Put<uint32_t>(camera.id);
+  c.Put<int32_t>(camera.model_id);
+  c.Put<uint64_t>(camera.width);
+  c.Put<uint64_t>(camera.height);
+  for (double p : camera.params) c.Put<double>(p);
+  c.Save(dir / "cameras.bin");
+  // Observations: image id -> list of point ids.
+  std::map<uint32_t, std::vector<uint64_t>> obs;
+  for (size_t i = 0; i < points.size(); ++i)
+    for (uint32_t im : points[i].images) obs[im].push_back(i + 1);
+  Bytes m;
+  m.Put<uint64_t>(images.size());
+  for (const ColmapImage& im : images) {
+    m.Put<uint32_t>(im.id);
+    m.Put<double>(im.q.w());
+    m.Put<double>(im.q.x());
+    m.Put<double>(im.q.y());
+    m.Put<double>(im.q.z());
+    for (int k = 0; k < 3; ++k) m.Put<double>(im.t[k]);
+    m.Put<uint32_t>(camera.id);
+    m.PutString(im.name);
+    const auto& mine = obs[im.id];
+    m.Put<uint64_t>(mine.size() + 1);  // one keypoint without a 3D point
+    for (uint64_t id : mine) {
+      m.Put<double>(10.0);
+      m.Put<double>(20.0);
+      m.Put<int64_t>(int64_t(id));
+    }
+    m.Put<double>(1.0);
+    m.Put<double>(2.0);
+    m.Put<int64_t>(-1);
+  }
+  m.Save(dir / "images.bin");
+  Bytes p;
+  p.Put<uint64_t>(points.size());
+  std::map<uint32_t, uint32_t> next_idx;
+  for (size_t i = 0; i < points.size(); ++i) {
+    p.Put<uint64_t>(i + 1);
+    for (int k = 0; k < 3; ++k) p.Put<double>(points[i].xyz[k]);
+    p.Put<uint8_t>(10);
+    p.Put<uint8_t>(20);
+    p.Put<uint8_t>(uint8_t(i));
+    p.Put<double>(0.25 * double(i % 4));
+    p.Put<uint64_t>(points[i].images.size());
+    for (uint32_t im : points[i].images) {
+      p.Put<uint32_t>(im);
+      p.Put<uint32_t>(next_idx[im]++);
+    }
+  }
+  p.Save(dir / "points3D.bin", truncate_points_by);
+}
+
+ColmapImage MakeImage(uint32_t id, const std::string& name, const Eigen::Matrix3d& R,
+                      const Eigen::Vector3d& t) {
+  ColmapImage im;
+  im.id = id;
+  im.camera_id = 1;
+  im.name = name;
+  im.q = Eigen::Quaterniond(R);
+  im.t = t;
+  return im;
+}
+
+// A camera at `center` looking at `target` (OpenCV axes, y roughly down).
+ColmapImage LookAt(uint32_t id, const std::string& name, const Eigen::Vector3d& center,
+                   const Eigen::Vector3d& target) {
+  const Eigen::Vector3d z = (target - center).normalized();
+  Eigen::Vector3d x = Eigen::Vector3d::UnitY().cross(z);
+  if (x.norm() < 1e-6) x = Eigen::Vector3d::UnitX();
+  x.normalize();
+  const Eigen::Vector3d y = z.cross(x);
+  Eigen::Matrix3d R;
+  R.row(0) = x;
+  R.row(1) = y;
+  R.row(2) = z;
+  return MakeImage(id, name, R, -R * center);
+}
+
+ColmapCamera SimpleRadial(double f, int w, int h, double k) {
+  ColmapCamera c;
+  c.id = 1;
+  c.model_id = 2;
+  c.width = w;
+  c.height = h;
+  c.params = {f, w / 2.0, h / 2.0, k};
+  return c;
+}
+
+// A page of points on z = 0 (0.2 x 0.3), seen by every image.
+std::vector<FakePoint> PagePoints(int n, const std::vector<uint32_t>& images,
+                                  unsigned seed = 7) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-0.5, 0.5);
+  std::vector<FakePoint> pts;
+  for (int i = 0; i < n; ++i) pts.push_back({{0.2 * u(rng), 0.3 * u(rng), 0.0}, images});
+  return pts;
+}
+
+TEST(ColmapModelTest, ReadsWhatColmapWrites) {
+  TempDir tmp;
+  const ColmapCamera cam = SimpleRadial(1000, 800, 600, 0.01);
+  const Eigen::Matrix3d R =
+      Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  std::vector<ColmapImage> images = {MakeImage(1, "a.jpg", Eigen::Matrix3d::Identity(),
+                                               Eigen::Vector3d(0, 0, 2)),
+                                     MakeImage(2, "b.jpg", R, Eigen::Vector3d(0.1, 0, 2))};
+  WriteModel(tmp.path(), cam, images,
+             {{{0, 0, 0}, {1, 2}}, {{0.1, 0, 0}, {1}}, {{0, 0.1, 0.1}, {2, 1}}});
+  const ColmapModel m = sfm::ReadColmapModel(tmp.path());
+  ASSERT_EQ(m.cameras.size(), 1u);
+  ASSERT_EQ(m.images.size(), 2u);
+  ASSERT_EQ(m.points.size(), 3u);
+  EXPECT_EQ(m.cameras.at(1).model_id, 2);
+  EXPECT_EQ(m.cameras.at(1).width, 800);
+  EXPECT_EQ(m.images.at(2).name, "b.jpg");
+  EXPECT_TRUE(m.images.at(2).R().isApprox(R, 1e-12));
+  EXPECT_TRUE(m.images.at(2).Center().isApprox(-R.transpose() * Eigen::Vector3d(0.1, 0, 2)));
+  EXPECT_EQ(m.images.at(1).num_points2d, 4u);  // 3 observations + 1 loose keypoint
+  EXPECT_EQ(m.images.at(1).num_points3d, 3u);
+  EXPECT_EQ(m.points[2].image_ids, (std::vector<uint32_t>{2, 1}));
+  EXPECT_EQ(m.points[2].rgb[2], 2);
+  EXPECT_EQ(m.NumObservations(), 5u);
+  // Mean over observations: errors 0, 0.25, 0.5 with 2, 1, 2 observations.
+  EXPECT_NEAR(m.MeanReprojectionError(), (0 * 2 + 0.25 * 1 + 0.5 * 2) / 5.0, 1e-12);
+}
+
+TEST(ColmapModelTest, TruncatedFileIsAnErrorNamingIt) {
+  TempDir tmp;
+  WriteModel(tmp.path(), SimpleRadial(1000, 800, 600, 0),
+             {MakeImage(1, "a.jpg", Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero())},
+             {{{0, 0, 1}, {1}}}, /*truncate_points_by=*/5);
+  try {
+    sfm::ReadColmapModel(tmp.path());
+    FAIL() << "no exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("points3D.bin"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(sfm::ReadColmapModel(tmp / "missing"), std::runtime_error);
+}
+
+TEST(ColmapModelTest, UnknownImageInTrackIsAnError) {
+  TempDir tmp;
+  WriteModel(tmp.path(), SimpleRadial(1000, 800, 600, 0),
+             {MakeImage(1, "a.jpg", Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero())},
+             {{{0, 0, 1}, {7}}});
+  EXPECT_THROW(sfm::ReadColmapModel(tmp.path()), std::runtime_error);
+}
+
+TEST(ColmapModelTest, PixelConventionAndDistortionMatchOpenCv) {
+  // COLMAP's principal point 400,300 for an 800x600 image is 399.5,299.5
+  // in our convention (pixel centres at integers).
+  const ColmapCamera cam = SimpleRadial(900, 800, 600, -0.05);
+  const Eigen::Matrix3d K = cam.PinholeK();
+  EXPECT_DOUBLE_EQ(K(0, 2), 399.5);
+  EXPECT_DOUBLE_EQ(K(1, 2), 299.5);
+  EXPECT_TRUE(cam.HasDistortion());
+  const auto d = cam.OpenCvDistortion();
+  cv::Mat cvK;
+  cv::eigen2cv(K, cvK);
+  const cv::Mat dist = (cv::Mat_<double>(1, 4) << d[0], d[1], d[2], d[3]);
+  std::vector<cv::Point3d> pts = {{0.1, -0.2, 1.0}, {-0.3, 0.25, 1.2}, {0, 0, 2}};
+  std::vector<cv::Point2d> projected;
+  cv::projectPoints(pts, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), cvK, dist, projected);
+  for (size_t i = 0; i < pts.size(); ++i) {
+    const Eigen::Vector2d ours = cam.Project({pts[i].x, pts[i].y, pts[i].z});
+    EXPECT_NEAR(ours.x(), projected[i].x, 1e-9);
+    EXPECT_NEAR(ours.y(), projected[i].y, 1e-9);
+  }
+  ColmapCamera pinhole;
+  pinhole.model_id = 1;
+  pinhole.params = {900, 910, 400, 300};
+  EXPECT_FALSE(pinhole.HasDistortion());
+  EXPECT_DOUBLE_EQ(pinhole.PinholeK()(1, 1), 910);
+  EXPECT_DOUBLE_EQ(pinhole.MeanFocal(), 905);
+  EXPECT_EQ(sfm::CameraModelId("RADIAL"), 3);
+  EXPECT_EQ(sfm::CameraModelId("OPENCV"), -1);
+}
+
+TEST(ReferenceFrameTest, ReferenceIsIdentityAtMedianDepthOneAndPixelsAreKept) {
+  ColmapModel m;
+  m.cameras[1] = SimpleRadial(1000, 800, 600, 0);
+  m.images[1] = LookAt(1, "v0.jpg", {0.3, -0.1, 5}, {0, 0, 0});
+  m.images[2] = LookAt(2, "v1.jpg", {-0.2, 0.4, 4}, {0.05, 0, 0});
+  m.images[3] = LookAt(3, "v2.jpg", {1.5, 0.2, 4.5}, {0, 0.1, 0});
+  for (const FakePoint& p : PagePoints(101, {1, 2, 3})) {
+    ColmapPoint q;
+    q.xyz = p.xyz * 10.0;  // COLMAP's arbitrary scale
+    q.image_ids = p.images;
+    m.points.push_back(q);
+  }
+  m.points.push_back({});  // a point only v1 and v2 see, far behind
+  m.points.back().xyz = {0, 0, -30};
+  m.points.back().image_ids = {2, 3};
+
+  CameraSet cams;
+  std::vector<Eigen::Vector3d> pts;
+  const double divisor = sfm::ToReferenceFrame(m, "v1.jpg", &cams, &pts);
+  EXPECT_GT(divisor, 0);
+  ASSERT_EQ(cams.views.size(), 3u);
+  EXPECT_EQ(cams.reference, "v1.jpg");
+  const PinholeCamera* ref = cams.Find("v1.jpg");
+  ASSERT_NE(ref, nullptr);
+  EXPECT_TRUE(ref->R.isIdentity(0));
+  EXPECT_TRUE(ref->t.isZero(0));
+  // Median depth of the points v1 sees is 1.
+  std::vector<double> depths;
+  for (size_t i = 0; i < pts.size(); ++i)
+    if (std::count(m.points[i].image_ids.begin(), m.points[i].image_ids.end(), 2u))
+      depths.push_back(pts[i].z());
+  std::nth_element(depths.begin(), depths.begin() + depths.size() / 2, depths.end());
+  EXPECT_NEAR(depths[depths.size() / 2], 1.0, 1e-12);
+  // Every point lands on the same pixel in every view as before.
+  for (const PinholeCamera& c : cams.views) {
+    const ColmapImage* im = nullptr;
+    for (const auto& [id, image] : m.images)
+      if (image.name == c.image) im = &image;
+    ASSERT_NE(im, nullptr);
+    EXPECT_TRUE((c.R * c.R.transpose()).isIdentity(1e-12));
+    for (size_t i = 0; i < 100; i += 7) {
+      const Eigen::Vector2d before = m.cameras[1].Project(im->R() * m.points[i].xyz + im->t);
+      const Eigen::Vector2d after = c.Project(pts[i]);
+      EXPECT_LT((before - after).norm(), 1e-9) << c.image;
+    }
+  }
+  EXPECT_THROW(sfm::ToReferenceFrame(m, "nope.jpg", &cams, &pts), std::invalid_argument);
+}
+
+TEST(ReferenceViewTest, NormalsOfAPlaneAreItsNormal) {
+  std::vector<Eigen::Vector3d> pts;
+  const Eigen::Matrix3d R =
+      Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, -1, 0.3).normalized()).toRotationMatrix();
+  for (const FakePoint& p : PagePoints(200, {1})) pts.push_back(R * p.xyz);
+  const auto normals = sfm::EstimateNormals(pts, 12);
+  for (const Eigen::Vector3d& n : normals)
+    EXPECT_GT(std::abs(n.dot(R.col(2))), 0.999);
+}
+
+TEST(ReferenceViewTest, PrefersTheFrontalViewThatSeesTheWholePage) {
+  ColmapModel m;
+  m.cameras[1] = SimpleRadial(1000, 800, 600, 0);
+  // Page 0.2 x 0.3 on z = 0; cameras above it (z < 0 is "up" for OpenCV's
+  // y-down convention does not matter here: LookAt handles it).
+  m.images[1] = LookAt(1, "oblique.jpg", {0.35, 0.0, -0.5}, {0, 0, 0});     // ~35 deg
+  m.images[2] = LookAt(2, "frontal.jpg", {0.05, 0.03, -0.6}, {0, 0, 0});    // ~5 deg
+  m.images[3] = LookAt(3, "too_close.jpg", {0.0, 0.0, -0.2}, {0, 0, 0});    // head-on, page cut
+  m.images[4] = LookAt(4, "slanted.jpg", {-0.3, 0.25, -0.45}, {0, 0, 0});   // ~40 deg
+  for (const FakePoint& p : PagePoints(400, {1, 2, 3, 4})) {
+    ColmapPoint q;
+    q.xyz = p.xyz;
+    // Views only observe what they can see in their image.
+    for (uint32_t id : p.images) {
+      const Eigen::Vector3d xc = m.images[id].R() * q.xyz + m.images[id].t;
+      const Eigen::Vector2d px = m.cameras[1].Project(xc);
+      if (xc.z() > 0 && px.x() >= 0 && px.y() >= 0 && px.x() < 800 && px.y() < 600)
+        q.image_ids.push_back(id);
+    }
+    m.points.push_back(q);
+  }
+  const auto scores = sfm::ScoreReferenceViews(m);
+  ASSERT_EQ(scores.size(), 4u);
+  EXPECT_EQ(scores[0].image, "frontal.jpg");
+  for (const auto& s : scores) {
+    SCOPED_TRACE(s.image);
+    EXPECT_GE(s.frontality, 0);
+    EXPECT_LE(s.frontality, 1);
+    if (s.image == "too_close.jpg") {
+      EXPECT_LT(s.coverage, 0.9);
+      EXPECT_GT(s.frontality, 0.95);
+    } else {
+      EXPECT_DOUBLE_EQ(s.coverage, 1.0);
+    }
+  }
+  auto find = [&](const std::string& name) {
+    return *std::find_if(scores.begin(), scores.end(),
+                         [&](const sfm::ViewScore& s) { return s.image == name; });
+  };
+  EXPECT_GT(find("frontal.jpg").frontality, find("oblique.jpg").frontality);
+  EXPECT_GT(find("oblique.jpg").frontality, find("slanted.jpg").frontality);
+}
+
+TEST(CheckImagesTest, AcceptsPhotosOfOneSizeAndNamesTheBadOne) {
+  TempDir tmp;
+  fs::create_directories(tmp / "set/images");
+  const cv::Mat a(60, 80, CV_8UC3, cv::Scalar(10, 200, 30));
+  cv::imwrite((tmp / "set/images/b.png").string(), a);
+  cv::imwrite((tmp / "set/images/a.jpg").string(), a);
+  std::ofstream(tmp / "set/images/notes.txt") << "not a photo";
+  int w = 0, h = 0;
+  EXPECT_EQ(sfm::CheckImages(tmp / "set", &w, &h),
+            (std::vector<std::string>{"a.jpg", "b.png"}));
+  EXPECT_EQ(w, 80);
+  EXPECT_EQ(h, 60);
+
+  cv::imwrite((tmp / "set/images/c.png").string(), cv::Mat(61, 80, CV_8UC3, cv::Scalar(0)));
+  try {
+    sfm::CheckImages(tmp / "set", &w, &h);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("c.png"), std::string::npos) << e.what();
+  }
+  fs::remove(tmp / "set/images/c.png");
+  std::ofstream(tmp / "set/images/d.jpg") << "garbage, not a JPEG";
+  try {
+    sfm::CheckImages(tmp / "set", &w, &h);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("d.jpg"), std::string::npos) << e.what();
+  }
+  fs::remove(tmp / "set/images/d.jpg");
+  fs::remove(tmp / "set/images/b.png");
+  EXPECT_THROW(sfm::CheckImages(tmp / "set", &w, &h), InputError);  // 1 photo
+  EXPECT_THROW(sfm::CheckImages(tmp / "nope", &w, &h), InputError);
+}
+
+TEST(UndistortTest, DistortedPixelMovesToThePinholeProjection) {
+  // A white dot where the distorted camera sees a 3D point ends up where
+  // the pinhole camera (same K) sees it.
+  const ColmapCamera cam = SimpleRadial(500, 640, 480, 0.08);
+  const Eigen::Vector3d X(0.45, -0.3, 1.0);
+  const Eigen::Vector2d distorted = cam.Project(X);
+  const Eigen::Vector3d kx = cam.PinholeK() * X;
+  const Eigen::Vector2d pinhole = kx.head<2>() / kx.z();
+  ASSERT_GT((distorted - pinhole).norm(), 5.0);  // the test means something
+  cv::Mat photo(480, 640, CV_8UC3, cv::Scalar(0, 0, 0));
+  cv::circle(photo, cv::Point(int(std::lround(distorted.x())), int(std::lround(distorted.y()))),
+             3, cv::Scalar(255, 255, 255), cv::FILLED);
+  const cv::Mat out = sfm::UndistortPhoto(photo, cam);
+  ASSERT_EQ(out.size(), photo.size());
+  cv::Mat grey;
+  cv::cvtColor(out, grey, cv::COLOR_BGR2GRAY);
+  const cv::Moments mo = cv::moments(grey, false);
+  const Eigen::Vector2d centroid(mo.m10 / mo.m00, mo.m01 / mo.m00);
+  EXPECT_LT((centroid - pinhole).norm(), 0.6)
+      << "centroid " << centroid.transpose() << " pinhole " << pinhole.transpose();
+  // A pinhole camera leaves the photo as it is.
+  ColmapCamera plain = cam;
+  plain.params[3] = 0;
+  EXPECT_EQ(cv::norm(sfm::UndistortPhoto(photo, plain), photo, cv::NORM_INF), 0);
+}
+
+TEST(SubprocessTest, CapturesLinesExitCodeAndLog) {
+  TempDir tmp;
+  std::vector<std::string> lines;
+  sfm::SubprocessOptions o;
+  o.log_file = tmp / "run.log";
+  o.on_line = [&](const std::string& l) { lines.push_back(l); };
+  const auto r = sfm::RunSubprocess(
+      {"sh", "-c", "echo one; echo two >&2; printf 'three'; exit 3"}, o);
+  EXPECT_EQ(r.exit_code, 3);
+  EXPECT_FALSE(r.timed_out);
+  EXPECT_FALSE(r.not_found);
+  EXPECT_EQ(lines, (std::vector<std::string>{"one", "two", "three"}));
+  std::ifstream f(o.log_file);
+  const std::string log((std::istreambuf_iterator<char>(f)), {});
+  EXPECT_NE(log.find("two"), std::string::npos);
+  EXPECT_NE(log.find("# exit 3"), std::string::npos);
+}
+
+TEST(SubprocessTest, TimeoutKillsTheWholeProcessGroup) {
+  TempDir tmp;
+  sfm::SubprocessOptions o;
+  o.log_file = tmp / "run.log";
+  o.timeout_seconds = 0.5;
+  const auto start = std::chrono::steady_clock::now();
+  // The child starts a grandchild; both must go.
+  const auto r = sfm::RunSubprocess({"sh", "-c", "sleep 30 & sleep 30; wait"}, o);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_TRUE(r.timed_out);
+  EXPECT_LT(seconds, 10);
+}
+
+TEST(SubprocessTest, MissingProgram) {
+  TempDir tmp;
+  sfm::SubprocessOptions o;
+  o.log_file = tmp / "run.log";
+  EXPECT_TRUE(sfm::RunSubprocess({"/nonexistent/colmap"}, o).not_found);
+  EXPECT_TRUE(sfm::RunSubprocess({"no-such-program-docunfold"}, o).not_found);
+  EXPECT_TRUE(sfm::FindExecutable("no-such-program-docunfold").empty());
+  EXPECT_FALSE(sfm::FindExecutable("sh").empty());
+}
+
+TEST(SfmEvalTest, PointTriangleDistance) {
+  const Eigen::Vector3d a(0, 0, 0), b(1, 0, 0), c(0, 1, 0);
+  EXPECT_DOUBLE_EQ(PointTriangleDistance({0.2, 0.2, 0.5}, a, b, c), 0.5);   // face
+  EXPECT_DOUBLE_EQ(PointTriangleDistance({-1, 0, 0}, a, b, c), 1.0);        // vertex a
+  EXPECT_DOUBLE_EQ(PointTriangleDistance({0.5, -2, 0}, a, b, c), 2.0);      // edge ab
+  EXPECT_NEAR(PointTriangleDistance({1, 1, 0}, a, b, c), std::sqrt(0.5), 1e-12);  // edge bc
+  EXPECT_DOUBLE_EQ(PointTriangleDistance({2, 0, 0}, a, b, c), 1.0);         // vertex b
+}
+
+}  // namespace
+}  // namespace docunfold::testing
