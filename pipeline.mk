@@ -27,16 +27,26 @@ DATA_DIR := $(patsubst %/images,%,$(firstword $(wildcard \
   $(ROOT)/samples/$(DATA)/images $(ROOT)/data/$(DATA)/images \
   $(abspath $(DATA))/images)))
 NAME := $(notdir $(patsubst %/,%,$(DATA)))
-WORK ?= $(ROOT)/work/$(NAME)
+WORK_ROOT ?= $(ROOT)/work
+WORK ?= $(WORK_ROOT)/$(NAME)
 IMAGES := $(sort $(wildcard $(DATA_DIR)/images/*))
 
 # ---- stage flags --------------------------------------------------------------
 REF ?=
 SFM_FLAGS ?=
+BOUNDARY_FLAGS ?=
+FEATURES_FLAGS ?=
+# FEATURES=file.json: use another detector's feature segments instead of
+# running detect-features (validated against schemas/, then copied).
+FEATURES ?=
+INIT_FLAGS ?=
+OPTIMIZE_FLAGS ?=
+RENDER_FLAGS ?=
+EVAL_FLAGS ?=
 
-# TIMER=<file>: run each stage under scripts/stage-timer, appending its wall
-# time and peak memory to <file> (used by the benchmark).
-TIMER ?=
+# Every stage runs under scripts/stage-timer, which appends its wall time and
+# peak memory to TIMER (the report shows them; the benchmark sets its own).
+TIMER ?= $(WORK)/timings.jsonl
 timed = $(if $(TIMER),$(ROOT)/scripts/stage-timer $(TIMER) $(1))
 
 # ---- helpers ------------------------------------------------------------------
@@ -49,8 +59,14 @@ $(WORK)/.flags/$(1): FORCE
 	@$$(shell mkdir -p $$(@D))$$(if $$(and $$(wildcard $$@),$$(call streq,$$(file <$$@),$(2))),,$$(file >$$@,$(2)))true
 endef
 $(eval $(call flags_rule,sfm,$(SFM_FLAGS) $(if $(REF),--ref $(REF))))
+$(eval $(call flags_rule,boundary,$(BOUNDARY_FLAGS)))
+$(eval $(call flags_rule,features,$(if $(FEATURES),FEATURES=$(abspath $(FEATURES)),$(FEATURES_FLAGS))))
+$(eval $(call flags_rule,init,$(INIT_FLAGS)))
+$(eval $(call flags_rule,optimize,$(OPTIMIZE_FLAGS)))
+$(eval $(call flags_rule,render,$(RENDER_FLAGS)))
+$(eval $(call flags_rule,evaluate,$(EVAL_FLAGS)))
 
-.PHONY: all sfm help clean deps build test bench check-data FORCE
+.PHONY: all sfm boundary features init optimize render evaluate report help clean deps build test bench check-data FORCE
 FORCE:
 
 # ---- build ----------------------------------------------------------------------
@@ -65,9 +81,16 @@ build: $(BUILD)/CMakeCache.txt deps
 
 # A stage binary is (re)built when its sources changed; stages that depend on
 # it rerun only when the binary actually changes.
+ifeq ($(NO_BUILD),)
 $(BIN)/%: $(BUILD)/CMakeCache.txt FORCE | deps
-	@cmake --build $(BUILD) --target $* -j$(JOBS) | grep -v -E '^(\[|make|Consolidate|Built target)' || true
+	@cmake --build $(BUILD) --target $* -j$(JOBS) > $(BUILD)/.build-$*.log 2>&1 || \
+	  { cat $(BUILD)/.build-$*.log >&2; echo "pipeline.mk: building $* failed" >&2; exit 1; }
 	@test -x $@
+else
+# Batches build once, up front; the per-data-set makes only check.
+$(BIN)/%:
+	@test -x $@ || { echo "pipeline.mk: $@ is missing; run make -f pipeline.mk build" >&2; exit 1; }
+endif
 
 test: build
 	cd $(BUILD) && ctest --output-on-failure -j$(JOBS)
@@ -79,8 +102,15 @@ bench: build
 	$(ROOT)/scripts/bench.sh $(BENCH_SETS)
 
 # ---- pipeline ---------------------------------------------------------------------
-all: sfm
-	@echo "docunfold: $(NAME) done; results in $(WORK)"
+# The chain of stages, in order. `all` runs every stage whose program exists
+# in stages/ (so the pipeline runs as far as it is implemented), plus
+# evaluate when the data set has ground truth.
+CHAIN := sfm:sfm boundary:segment-boundary features:detect-features \
+  init:init-mesh optimize:optimize render:render
+IMPLEMENTED := $(foreach s,$(CHAIN),$(if $(wildcard $(ROOT)/stages/$(word 2,$(subst :, ,$(s)))),$(word 1,$(subst :, ,$(s)))))
+HAS_GT := $(wildcard $(DATA_DIR)/ground_truth/flat.png)
+all: $(lastword $(IMPLEMENTED)) $(if $(and $(HAS_GT),$(wildcard $(ROOT)/stages/evaluate)),evaluate) $(if $(wildcard $(ROOT)/stages/report),report)
+	@echo "docunfold: $(NAME) done; results in $(WORK)$(if $(wildcard $(ROOT)/stages/report),; open $(WORK)/report.html)"
 
 check-data:
 	@test -n "$(DATA_DIR)" || { echo "pipeline.mk: DATA=$(DATA): no data set (looked for images/ in samples/$(DATA), data/$(DATA) and $(abspath $(DATA)))" >&2; exit 3; }
@@ -89,6 +119,74 @@ SFM_OUT := $(addprefix $(WORK)/10_sfm/,cameras.json points.ply reference.png)
 sfm: check-data $(SFM_OUT)
 $(SFM_OUT) &: $(BIN)/sfm $(WORK)/.flags/sfm $(IMAGES) | check-data
 	$(call timed,sfm) $(BIN)/sfm --data $(DATA_DIR) --out $(WORK)/10_sfm $(if $(REF),--ref $(REF)) $(SFM_FLAGS)
+
+BOUNDARY_OUT := $(addprefix $(WORK)/20_boundary/,boundary.json mask.png overlay.png)
+boundary: check-data $(BOUNDARY_OUT)
+$(BOUNDARY_OUT) &: $(BIN)/segment-boundary $(WORK)/.flags/boundary $(WORK)/10_sfm/reference.png
+	$(call timed,segment-boundary) $(BIN)/segment-boundary --image $(WORK)/10_sfm/reference.png --out $(WORK)/20_boundary $(BOUNDARY_FLAGS)
+
+ifeq ($(FEATURES),)
+FEATURES_OUT := $(addprefix $(WORK)/30_features/,features.json overlay.png)
+$(FEATURES_OUT) &: $(BIN)/detect-features $(WORK)/.flags/features $(WORK)/10_sfm/reference.png $(WORK)/20_boundary/mask.png
+	$(call timed,detect-features) $(BIN)/detect-features --image $(WORK)/10_sfm/reference.png --mask $(WORK)/20_boundary/mask.png --out $(WORK)/30_features $(FEATURES_FLAGS)
+else
+FEATURES_OUT := $(WORK)/30_features/features.json
+# The stale overlay of an earlier detector run would mislead: remove it.
+$(FEATURES_OUT): $(abspath $(FEATURES)) $(WORK)/.flags/features $(WORK)/10_sfm/reference.png
+	@test -f $< || { echo "$<: no such file (FEATURES=)" >&2; exit 3; }
+	$(ROOT)/scripts/validate-json --format docunfold.features $<
+	@mkdir -p $(@D) && rm -f $(@D)/overlay.png
+	cp $< $@.tmp && mv $@.tmp $@
+endif
+features: check-data boundary $(FEATURES_OUT)
+
+SFM_IN := $(addprefix $(WORK)/10_sfm/,cameras.json points.ply reference.png)
+BOUNDARY_IN := $(WORK)/20_boundary/boundary.json $(WORK)/20_boundary/mask.png
+
+INIT_OUT := $(addprefix $(WORK)/40_init/,mesh3d.ply mesh2d.ply init.json)
+init: check-data boundary $(INIT_OUT)
+$(INIT_OUT) &: $(BIN)/init-mesh $(WORK)/.flags/init $(SFM_IN) $(BOUNDARY_IN)
+	$(call timed,init-mesh) $(BIN)/init-mesh --sfm $(WORK)/10_sfm --boundary $(WORK)/20_boundary --out $(WORK)/40_init $(INIT_FLAGS)
+
+OPTIMIZE_OUT := $(addprefix $(WORK)/50_optimize/,mesh3d.ply mesh2d.ply lines.json log.json scene.glb)
+optimize: check-data features init $(OPTIMIZE_OUT)
+$(OPTIMIZE_OUT) &: $(BIN)/optimize $(WORK)/.flags/optimize $(INIT_OUT) $(SFM_IN) $(BOUNDARY_IN) $(WORK)/30_features/features.json
+	$(call timed,optimize) $(BIN)/optimize --sfm $(WORK)/10_sfm --boundary $(WORK)/20_boundary --features $(WORK)/30_features/features.json --init $(WORK)/40_init --out $(WORK)/50_optimize $(OPTIMIZE_FLAGS)
+
+# render textures the newest meshes there are: 50_optimize/ once optimize
+# exists, else 40_init/.
+MESH_STAGE := $(if $(wildcard $(ROOT)/stages/optimize),50_optimize,40_init)
+RENDER_OUT := $(addprefix $(WORK)/60_render/,rectified.png rectified_grid.png)
+render: check-data $(if $(wildcard $(ROOT)/stages/optimize),optimize,init) $(RENDER_OUT)
+$(RENDER_OUT) &: $(BIN)/render $(WORK)/.flags/render $(WORK)/$(MESH_STAGE)/mesh3d.ply $(WORK)/$(MESH_STAGE)/mesh2d.ply $(SFM_IN) $(BOUNDARY_IN)
+	$(call timed,render) $(BIN)/render --sfm $(WORK)/10_sfm --boundary $(WORK)/20_boundary --meshes $(WORK)/$(MESH_STAGE) --out $(WORK)/60_render $(RENDER_FLAGS)
+
+EVAL_OUT := $(WORK)/70_eval/metrics.json
+evaluate: check-data render $(EVAL_OUT)
+$(EVAL_OUT): $(BIN)/evaluate $(WORK)/.flags/evaluate $(WORK)/60_render/rectified.png
+	@test -n "$(HAS_GT)" || { echo "pipeline.mk: $(DATA_DIR): no ground_truth/flat.png to evaluate against" >&2; exit 3; }
+	$(call timed,evaluate) $(BIN)/evaluate --data $(DATA_DIR) --work $(WORK) --result $(WORK)/60_render/rectified.png --out $@ $(EVAL_FLAGS)
+
+# The report is redrawn whenever a stage's output is newer.
+REPORT_OUT := $(WORK)/report.html
+report: check-data $(REPORT_OUT)
+STAGE_OUTPUTS := sfm:SFM_OUT boundary:BOUNDARY_OUT features:FEATURES_OUT init:INIT_OUT \
+  optimize:OPTIMIZE_OUT render:RENDER_OUT
+REPORT_IN := $(foreach s,$(STAGE_OUTPUTS),$(if $(filter $(word 1,$(subst :, ,$(s))),$(IMPLEMENTED)),$($(word 2,$(subst :, ,$(s)))))) \
+  $(if $(and $(HAS_GT),$(wildcard $(ROOT)/stages/evaluate)),$(EVAL_OUT))
+$(REPORT_OUT): $(BIN)/report $(REPORT_IN) | check-data
+	$(BIN)/report --data $(DATA_DIR) --work $(WORK) --out $@
+
+# ---- batches ------------------------------------------------------------------
+# Several data sets at once, each in its own work directory; with -j2 two run
+# side by side. DATASETS takes names (samples/, data/) or paths.
+DATASETS ?= $(notdir $(patsubst %/images,%,$(wildcard $(ROOT)/samples/*/images)))
+.PHONY: all-samples datasets
+all-samples: datasets
+datasets: build
+	@$(MAKE) --no-print-directory -f $(ROOT)/pipeline.mk NO_BUILD=1 $(addprefix dataset/,$(DATASETS))
+dataset/%:
+	@$(MAKE) --no-print-directory -f $(ROOT)/pipeline.mk NO_BUILD=1 DATA=$* WORK=$(WORK_ROOT)/$(notdir $*) all
 
 # ---- housekeeping -------------------------------------------------------------------
 clean:
@@ -100,19 +198,36 @@ help:
 	@echo "Targets:"
 	@echo "  all (default)  run every implemented stage on DATA"
 	@echo "  sfm            COLMAP structure from motion -> work/<name>/10_sfm/"
+	@echo "  boundary       document region and its four sides -> 20_boundary/"
+	@echo "  features       straight text and edge segments -> 30_features/"
+	@echo "  init           initial 3D mesh M and flat mesh M' -> 40_init/"
+	@echo "  optimize       joint isometric optimisation with feature lines -> 50_optimize/"
+	@echo "  render         the rectified, cropped page -> 60_render/"
+	@echo "  evaluate       metrics against ground truth -> 70_eval/ (sets with ground_truth/)"
+	@echo "  report         one HTML page with every stage's output -> work/<name>/report.html"
 	@echo "  test           build, then run all tests (ctest)"
 	@echo "  build          configure and build build/bin/*"
 	@echo "  deps           install missing Debian packages (root) or print the apt-get line"
 	@echo "  bench          time every stage on every sample -> bench/results.md"
+	@echo "  all-samples    run every sample (or DATASETS=\"a b c\"), in parallel with -j2"
 	@echo "  clean          remove work/<name>/"
 	@echo
 	@echo "Variables:"
 	@echo "  DATA=set01     data set: samples/<DATA>, data/<DATA>, or a path (default set01)"
 	@echo "  WORK=dir       work directory (default work/<name>/)"
+	@echo "  WORK_ROOT=dir  where work directories go (default work/)"
+	@echo "  DATASETS=...   data sets for all-samples (default: every samples/*)"
 	@echo "  REF=img.jpg    reference view for sfm (default: chosen automatically)"
 	@echo "  SFM_FLAGS=...  extra flags for build/bin/sfm (see build/bin/sfm --help)"
+	@echo "  BOUNDARY_FLAGS=...  extra flags for build/bin/segment-boundary"
+	@echo "  FEATURES_FLAGS=...  extra flags for build/bin/detect-features"
+	@echo "  FEATURES=f.json     use another detector's segments (docunfold.features) instead"
+	@echo "  INIT_FLAGS=...      extra flags for build/bin/init-mesh"
+	@echo "  OPTIMIZE_FLAGS=...  extra flags for build/bin/optimize"
+	@echo "  RENDER_FLAGS=...    extra flags for build/bin/render"
+	@echo "  EVAL_FLAGS=...      extra flags for build/bin/evaluate"
 	@echo "  JOBS=2         parallel build jobs"
-	@echo "  TIMER=file     append per-stage time and peak memory to file (JSON lines)"
+	@echo "  TIMER=file     where per-stage time and peak memory go (default work/<name>/timings.jsonl)"
 	@echo "  BENCH_SETS=... samples for bench (default: all)"
 	@echo
 	@echo "Changing REF or a *_FLAGS variable reruns that stage and everything after it."

@@ -1,19 +1,247 @@
 #!/usr/bin/env bash
-# Benchmark: runs the pipeline from scratch on each sample (default: every
-# samples/set*) with per-stage timing, then writes bench/results.md and
-# bench/results.json. Speed and memory live here, never in tests.
-set -euo pipefail
+# Benchmark: runs the pipeline from scratch on each data set with per-stage
+# timing, makes the reference methods' images, evaluates every row against
+# the ground truth and writes bench/results.md and bench/results.json.
+# Speed, memory and accuracy live here, never in tests.
+#
+#   scripts/bench.sh [SET...]      (make -f pipeline.mk bench BENCH_SETS="...")
+#
+# SET is a name (samples/<SET>, data/<SET>) or a path (/work/shared/realistic/r01).
+# Default: every samples/* and data/* with ground_truth/flat.png.
+#
+# Environment:
+#   BUILD=dir            build directory with bin/ (default <root>/build)
+#   BENCH_WORK=dir       work directories, one per set (default <root>/work/bench)
+#   BENCH_OUT=dir        where results.{md,json} go (default <root>/bench)
+#   BENCH_FRONTEND=truth replace sfm and segment-boundary by the ground truth
+#                        (build/tests/truth-frontend): measures the later stages
+#                        alone, or shows the table before the front end exists
+#   BENCH_EVAL_FLAGS=... extra evaluate flags for every row (e.g. --no-ocr)
+#   BENCH_OCR_SIZE=native  OCR every result as it is; default "truth": OCR it
+#                        at flat.png's size (evaluate --ocr-at-truth-size), so
+#                        that CER compares geometry, not the output resolution
+#                        each method picked (render keeps the photo's density)
+#   BENCH_JOBS=N         data sets run side by side (default 1: timings are
+#                        then undisturbed; the end-to-end tests use 2)
+#   BENCH_ONLY="row ..." make only these built-in rows (default: all)
+#   BENCH_ROWS="name=path/in/work.png[:mesh dir in work] ..."
+#                        further rows: any image the pipeline leaves in the work
+#                        directory, evaluated like the others
+#
+# Rows per set: homography and oracle (build/bin/baseline), docunfold
+# (60_render/rectified.png) when render ran, and, when the binaries exist,
+# docunfold-init (render on 40_init), docunfold-nofeatures and
+# docunfold-boundary (optimize --no-features / --boundary-only, then render).
+# To add a built-in row, write a make_row_<name> function below and list it
+# in ROWS: it makes the image (through `timed`) and sets `image` (and
+# `mesh_dir` for geometry), or returns 1 with `reason` set when not applicable.
+set -uo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
+BUILD=${BUILD:-$root/build}
+bin=$BUILD/bin
+bench_work=${BENCH_WORK:-$root/work/bench}
+bench_out=${BENCH_OUT:-$root/bench}
+frontend=${BENCH_FRONTEND:-pipeline}
+read -r -a eval_flags <<< "${BENCH_EVAL_FLAGS:-}"
+ocr_size=${BENCH_OCR_SIZE:-truth}
+case $ocr_size in
+  truth) eval_flags+=(--ocr-at-truth-size) ;;
+  native) ;;
+  *) echo "bench: BENCH_OCR_SIZE=$ocr_size: expected truth or native" >&2; exit 2 ;;
+esac
+timer=$root/scripts/stage-timer
+
+case $frontend in pipeline|truth) ;; *)
+  echo "bench: BENCH_FRONTEND=$frontend: expected pipeline or truth" >&2; exit 2 ;;
+esac
+
+# ---- data sets -----------------------------------------------------------------
+resolve() {  # name or path -> absolute data-set folder ("" if none)
+  local s=$1
+  for d in "$root/samples/$s" "$root/data/$s" "$s"; do
+    if [[ -d $d/images ]]; then (cd "$d" && pwd); return; fi
+  done
+}
 sets=("$@")
 if [[ ${#sets[@]} -eq 0 ]]; then
-  for d in "$root"/samples/set*/; do sets+=("$(basename "$d")"); done
+  for d in "$root"/samples/*/ "$root"/data/*/; do
+    [[ -f $d/ground_truth/flat.png && -d $d/images ]] && sets+=("$d")
+  done
 fi
-bench_work="$root/work/bench"
-rm -rf "$bench_work"
+if [[ ${#sets[@]} -eq 0 ]]; then
+  echo "bench: no data set with ground truth in samples/ or data/" >&2; exit 3
+fi
+data_dirs=() names=()
 for s in "${sets[@]}"; do
-  echo "bench: $s" >&2
-  make -s -f "$root/pipeline.mk" DATA="$s" WORK="$bench_work/$s" \
-    TIMER="$bench_work/$s/timings.jsonl" all >&2 ||
-    echo "bench: $s failed (recorded)" >&2
+  d=$(resolve "$s")
+  if [[ -z $d ]]; then
+    echo "bench: $s: no data set (looked for images/ in samples/$s, data/$s and $s)" >&2; exit 3
+  fi
+  n=$(basename "$d")
+  # Two sets with the same folder name (samples/r01, realistic/r01) get
+  # distinct work directories.
+  while printf '%s\n' "${names[@]}" | grep -qx -- "$n"; do n="$n+"; done
+  data_dirs+=("$d") names+=("$n")
 done
-/usr/bin/python3 "$root/scripts/bench_report.py" "$root" "$bench_work" "${sets[@]}"
+if [[ $frontend == truth ]]; then
+  cmake --build "$BUILD" --target truth-frontend -j2 > /dev/null ||
+    { echo "bench: cannot build truth-frontend" >&2; exit 1; }
+fi
+for b in baseline evaluate; do
+  [[ -x $bin/$b ]] || { echo "bench: $bin/$b is missing; run make -f pipeline.mk build" >&2; exit 1; }
+done
+
+# ---- pipeline stages ----------------------------------------------------------------
+# The pipeline.mk targets to run: every stage whose program is built and whose
+# inputs some runnable stage makes (so a stage that is being written, or one
+# whose predecessor is, is simply absent). evaluate is the bench's own
+# business (one run per row).
+declare -A program_of=([sfm]=sfm [boundary]=segment-boundary [features]=detect-features
+                       [init]=init-mesh [optimize]=optimize [render]=render)
+declare -A needs=([sfm]="" [boundary]="sfm" [features]="sfm boundary" [init]="sfm boundary"
+                  [optimize]="features init" [render]="sfm boundary init")
+# pipeline.mk renders the optimised meshes as soon as stages/optimize exists.
+[[ -d $root/stages/optimize ]] && needs[render]+=" optimize"
+declare -A runnable=()
+if [[ $frontend == truth ]]; then runnable[sfm]=1 runnable[boundary]=1; fi
+pipeline_targets=() absent=()
+for s in sfm boundary features init optimize render; do
+  [[ -n ${runnable[$s]:-} ]] && continue
+  ok=1
+  [[ -x $bin/${program_of[$s]} ]] || ok=""
+  for n in ${needs[$s]}; do [[ -n ${runnable[$n]:-} ]] || ok=""; done
+  if [[ -n $ok ]]; then runnable[$s]=1; pipeline_targets+=("$s"); else absent+=("$s"); fi
+done
+echo "bench: front end: $frontend; stages run: ${pipeline_targets[*]:-none}; absent: ${absent[*]:-none}" >&2
+
+# ---- rows ------------------------------------------------------------------------
+# Set by run_set for the row functions: data, work, reason, image, mesh_dir.
+timed() {  # timed <row> <command...>: time one command of making a row's image
+  local row=$1; shift
+  "$timer" "$work/bench/timings.jsonl" "make:$row" "$@" >> "$work/bench/$row.log" 2>&1
+}
+have() { [[ -x $bin/$1 ]]; }
+
+make_row_homography() {
+  [[ -f $work/10_sfm/cameras.json && -f $work/20_boundary/boundary.json ]] ||
+    { reason="no 10_sfm/ or 20_boundary/boundary.json"; return 1; }
+  image=$work/bench/homography.png
+  timed homography "$bin/baseline" --method homography --data "$data" --work "$work" --out "$image"
+}
+make_row_oracle() {
+  [[ -f $work/10_sfm/cameras.json ]] || { reason="no 10_sfm/cameras.json"; return 1; }
+  [[ -f $data/ground_truth/mesh.ply ]] || { reason="no ground_truth/mesh.ply"; return 1; }
+  image=$work/bench/oracle.png
+  timed oracle "$bin/baseline" --method oracle --data "$data" --work "$work" --out "$image"
+}
+make_row_docunfold() {
+  [[ -f $work/60_render/rectified.png ]] || { reason="render did not run"; return 1; }
+  image=$work/60_render/rectified.png
+}
+make_row_docunfold-init() {
+  have render || { reason="no render binary"; return 1; }
+  [[ -f $work/40_init/mesh3d.ply ]] || { reason="no 40_init/mesh3d.ply"; return 1; }
+  [[ -d $work/50_optimize ]] || { reason="same as docunfold (no optimize)"; return 1; }
+  mesh_dir=$work/40_init
+  timed docunfold-init "$bin/render" --sfm "$work/10_sfm" --boundary "$work/20_boundary" \
+    --meshes "$work/40_init" --out "$work/60_render_init" || return
+  image=$work/60_render_init/rectified.png
+}
+optimize_variant() {  # optimize_variant <row> <suffix> <optimize flag>
+  local row=$1 suffix=$2 flag=$3
+  { have optimize && have render; } || { reason="no optimize or render binary"; return 1; }
+  [[ -f $work/40_init/mesh3d.ply && -f $work/30_features/features.json ]] ||
+    { reason="no 40_init/ or 30_features/"; return 1; }
+  mesh_dir=$work/50_optimize_$suffix
+  timed "$row" "$bin/optimize" --sfm "$work/10_sfm" --boundary "$work/20_boundary" \
+    --features "$work/30_features/features.json" --init "$work/40_init" \
+    --out "$mesh_dir" "$flag" || return
+  timed "$row" "$bin/render" --sfm "$work/10_sfm" --boundary "$work/20_boundary" \
+    --meshes "$mesh_dir" --out "$work/60_render_$suffix" || return
+  image=$work/60_render_$suffix/rectified.png
+}
+make_row_docunfold-nofeatures() { optimize_variant docunfold-nofeatures nofeatures --no-features; }
+make_row_docunfold-boundary() { optimize_variant docunfold-boundary boundary --boundary-only; }
+
+ROWS=(homography oracle docunfold docunfold-init docunfold-nofeatures docunfold-boundary)
+if [[ -n ${BENCH_ONLY:-} ]]; then read -r -a ROWS <<< "$BENCH_ONLY"; fi
+read -r -a extra_rows <<< "${BENCH_ROWS:-}"
+
+# Appends one line to the set's rows.tsv: method status image metrics mesh_dir note.
+record() { printf '%s\t%s\t%s\t%s\t%s\t%s\n' "$@" >> "$work/bench/rows.tsv"; }
+
+evaluate_row() {  # evaluate_row <method> <image> <mesh dir or "">
+  local method=$1 img=$2 mesh=$3 metrics=$work/70_eval/metrics-$1.json geometry=()
+  if [[ -n $mesh ]]; then geometry=(--mesh-dir "$mesh")
+  elif [[ $method != docunfold ]]; then geometry=(--no-geometry); fi
+  if "$timer" "$work/bench/timings.jsonl" "evaluate:$method" "$bin/evaluate" --data "$data" \
+       --work "$work" --result "$img" --out "$metrics" --method "$method" \
+       "${geometry[@]}" "${eval_flags[@]}" >> "$work/bench/$method.log" 2>&1; then
+    record "$method" ok "$img" "$metrics" "$mesh" ""
+  else
+    record "$method" failed "$img" "" "$mesh" "evaluate failed: $(tail -n 1 "$work/bench/$method.log")"
+  fi
+}
+
+run_set() {  # run_set <data dir> <work dir>
+  data=$1 work=$2
+  rm -rf "$work"
+  mkdir -p "$work/bench" "$work/70_eval"
+  : > "$work/bench/rows.tsv"
+  local make_args=(-f "$root/pipeline.mk" NO_BUILD=1 BUILD="$BUILD" DATA="$data" WORK="$work"
+                   TIMER="$work/timings.jsonl")
+  local targets=("${pipeline_targets[@]}")
+  if [[ $frontend == truth ]]; then
+    "$timer" "$work/timings.jsonl" truth-frontend "$BUILD/tests/truth-frontend" "$data" "$work" \
+      >> "$work/bench/pipeline.log" 2>&1 || echo "bench: truth front end failed" >&2
+    # make must not remake (nor rerun anything because of) the front end's files.
+    for f in 10_sfm/cameras.json 10_sfm/points.ply 10_sfm/reference.png \
+             20_boundary/boundary.json 20_boundary/mask.png 20_boundary/overlay.png; do
+      make_args+=(-o "$work/$f")
+    done
+  fi
+  local status=0
+  if [[ ${#targets[@]} -gt 0 ]]; then
+    make -s "${make_args[@]}" "${targets[@]}" >> "$work/bench/pipeline.log" 2>&1 || status=$?
+  fi
+  echo "$status" > "$work/bench/pipeline.exit"
+  [[ $status -eq 0 ]] || echo "bench: pipeline failed (exit $status; see $work/bench/pipeline.log)" >&2
+  if [[ ! -f $data/ground_truth/flat.png ]]; then
+    record "-" skipped "" "" "" "no ground_truth/flat.png: not evaluated"
+    return
+  fi
+  local row
+  for row in "${ROWS[@]}"; do
+    image="" mesh_dir="" reason=""
+    if "make_row_$row"; then
+      if [[ -f $image ]]; then evaluate_row "$row" "$image" "$mesh_dir"
+      else record "$row" failed "" "" "" "no image made"; fi
+    elif [[ -n $reason ]]; then
+      record "$row" skipped "" "" "" "$reason"
+    else
+      record "$row" failed "" "" "" "making the image failed: $(tail -n 1 "$work/bench/$row.log" 2>/dev/null)"
+    fi
+  done
+  local spec name rest path mesh
+  for spec in "${extra_rows[@]}"; do
+    name=${spec%%=*} rest=${spec#*=}
+    path=${rest%%:*} mesh=""
+    [[ $rest == *:* ]] && mesh=$work/${rest#*:}
+    if [[ -f $work/$path ]]; then evaluate_row "$name" "$work/$path" "$mesh"
+    else record "$name" skipped "" "" "" "no $path in the work directory"; fi
+  done
+}
+
+jobs=${BENCH_JOBS:-1}
+for i in "${!data_dirs[@]}"; do
+  # At most $jobs sets at once; each set's run is a subshell of its own.
+  while [[ $(jobs -rp | wc -l) -ge $jobs ]]; do wait -n; done
+  echo "bench: ${names[$i]} (${data_dirs[$i]})" >&2
+  run_set "${data_dirs[$i]}" "$bench_work/${names[$i]}" &
+done
+wait
+
+args=()
+for i in "${!data_dirs[@]}"; do args+=("${names[$i]}=${data_dirs[$i]}"); done
+/usr/bin/python3 "$root/scripts/bench_report.py" --root "$root" --work "$bench_work" \
+  --out "$bench_out" --frontend "$frontend" --eval-flags="${eval_flags[*]}" "${args[@]}"

@@ -1,21 +1,80 @@
-"""Turns work/bench/<set>/timings.jsonl into bench/results.{json,md}."""
+"""Writes bench/results.json (docunfold.bench) and bench/results.md from the
+work directories scripts/bench.sh filled:
+
+  <work>/<set>/timings.jsonl       pipeline stages (scripts/stage-timer lines)
+  <work>/<set>/bench/timings.jsonl making ("make:<row>") and evaluating
+                                   ("evaluate:<row>") each row
+  <work>/<set>/bench/rows.tsv      method, status, image, metrics file, mesh dir, note
+  <work>/<set>/bench/pipeline.exit exit code of the pipeline run
+
+usage: bench_report.py --root R --work W --out O [--frontend F] [--eval-flags S] NAME=DATA_DIR...
+"""
+import argparse
 import datetime
 import json
+import math
 import os
 import platform
+import struct
 import subprocess
-import sys
+
+# Pipeline stages in chain order (names as pipeline.mk's TIMER records them).
+STAGE_ORDER = ["truth-frontend", "sfm", "segment-boundary", "detect-features", "init-mesh",
+               "optimize", "render", "evaluate"]
+# Figures of a row, in table order: (key in metrics, column title, format).
+FIGURES = [("ms_ssim", "MS-SSIM ↑", "%.4f"), ("ld", "LD ↓", "%.2f"), ("li_d", "Li-D ↓", "%.2f"),
+           ("cer", "CER ↓", "%.4f"), ("wer", "WER ↓", "%.4f"),
+           ("surface_mean_pct", "surface mean % ↓", "%.3f"),
+           ("isometry_mean", "isometry ↓", "%.4f")]
+ROW_ORDER = ["homography", "oracle", "docunfold", "docunfold-init", "docunfold-nofeatures",
+             "docunfold-boundary"]
 
 
-def image_size(root, name):
-    """Width x height of the first image of a sample, from its ground-truth cameras."""
-    path = os.path.join(root, "samples", name, "ground_truth", "cameras.json")
-    try:
+def read_jsonl(path):
+    out = []
+    if os.path.exists(path):
         with open(path) as f:
-            v = json.load(f)["views"]
-        return "%dx%d" % (v[0]["width"], v[0]["height"]), len(v)
-    except (OSError, KeyError, ValueError, IndexError):
-        return "?", 0
+            for line in f:
+                line = line.strip()
+                if line:
+                    try:
+                        out.append(json.loads(line))
+                    except ValueError:
+                        pass
+    return out
+
+
+def image_header_size(path):
+    """(width, height) of a PNG or JPEG from its header, or None."""
+    try:
+        with open(path, "rb") as f:
+            head = f.read(26)
+            if head[:8] == b"\x89PNG\r\n\x1a\n":
+                return struct.unpack(">II", head[16:24])
+            if head[:2] != b"\xff\xd8":
+                return None
+            f.seek(2)
+            while True:
+                marker = f.read(2)
+                if len(marker) < 2 or marker[0] != 0xFF:
+                    return None
+                if marker[1] in (0xD8, 0x01) or 0xD0 <= marker[1] <= 0xD7:
+                    continue
+                length = struct.unpack(">H", f.read(2))[0]
+                if marker[1] in (0xC0, 0xC1, 0xC2, 0xC3, 0xC5, 0xC6, 0xC7, 0xC9, 0xCA, 0xCB,
+                                 0xCD, 0xCE, 0xCF):
+                    h, w = struct.unpack(">xHH", f.read(5))
+                    return w, h
+                f.seek(length - 2, 1)
+    except (OSError, struct.error):
+        return None
+
+
+def describe_images(data):
+    images = sorted(n for n in os.listdir(os.path.join(data, "images"))
+                    if n.lower().endswith((".jpg", ".jpeg", ".png", ".tif", ".tiff")))
+    size = image_header_size(os.path.join(data, "images", images[0])) if images else None
+    return len(images), ("%dx%d" % size if size else "?")
 
 
 def cpu_name():
@@ -29,52 +88,256 @@ def cpu_name():
     return platform.processor() or "unknown"
 
 
-def main(root, work, sets):
+def git_commit(root):
+    try:
+        rev = subprocess.run(["git", "-C", root, "rev-parse", "--short", "HEAD"],
+                             capture_output=True, text=True).stdout.strip()
+        dirty = subprocess.run(["git", "-C", root, "status", "--porcelain", "--untracked-files=no"],
+                               capture_output=True, text=True).stdout.strip()
+        return rev + ("+modified" if dirty else "") if rev else "unknown"
+    except OSError:
+        return "unknown"
+
+
+def program_version(root):
+    try:
+        with open(os.path.join(root, "CMakeLists.txt")) as f:
+            for line in f:
+                if line.startswith("project(") and "VERSION" in line:
+                    return line.split("VERSION")[1].split()[0]
+    except OSError:
+        pass
+    return "unknown"
+
+
+def finite(v):
+    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+
+
+def summarize_timing(entries):
+    """Several commands of one row (optimize + render) add up."""
+    if not entries:
+        return None
+    return {"seconds": round(sum(e["seconds"] for e in entries), 2),
+            "max_rss_mb": round(max(e["max_rss_mb"] for e in entries), 1),
+            "exit": next((e["exit"] for e in entries if e["exit"] != 0), 0)}
+
+
+def collect_set(name, data, work):
+    set_work = os.path.join(work, name)
+    views, size = describe_images(data)
+    stages = read_jsonl(os.path.join(set_work, "timings.jsonl"))
+    row_timings = read_jsonl(os.path.join(set_work, "bench", "timings.jsonl"))
+    exit_path = os.path.join(set_work, "bench", "pipeline.exit")
+    pipeline_exit = None
+    if os.path.exists(exit_path):
+        with open(exit_path) as f:
+            pipeline_exit = int(f.read().strip() or 0)
     rows = []
+    tsv = os.path.join(set_work, "bench", "rows.tsv")
+    if os.path.exists(tsv):
+        with open(tsv) as f:
+            for line in f:
+                fields = line.rstrip("\n").split("\t")
+                if len(fields) < 6:
+                    continue
+                method, status, image, metrics_file, mesh_dir, note = fields[:6]
+                row = {"method": method, "status": status}
+                if image:
+                    row["image"] = image
+                if mesh_dir:
+                    row["mesh_dir"] = mesh_dir
+                if note:
+                    row["note"] = note
+                row["make"] = summarize_timing(
+                    [t for t in row_timings if t["stage"] == "make:" + method])
+                row["evaluate"] = summarize_timing(
+                    [t for t in row_timings if t["stage"] == "evaluate:" + method])
+                row["metrics"] = None
+                if metrics_file and os.path.exists(metrics_file):
+                    row["metrics_file"] = metrics_file
+                    with open(metrics_file) as mf:
+                        doc = json.load(mf)
+                    row["metrics"] = {k: v for k, v in doc.get("metrics", {}).items()}
+                rows.append(row)
+    rows.sort(key=lambda r: (ROW_ORDER.index(r["method"]) if r["method"] in ROW_ORDER
+                             else len(ROW_ORDER), r["method"]))
+    failed_stage = next((s["stage"] for s in stages if s.get("exit", 0) != 0), None)
+    return {"name": name, "path": data, "views": views, "image_size": size,
+            "has_ground_truth": os.path.exists(os.path.join(data, "ground_truth", "flat.png")),
+            "pipeline": {"exit": pipeline_exit, "failed_stage": failed_stage},
+            "stages": stages, "rows": rows}
+
+
+def summarize(sets):
+    methods = []
     for s in sets:
-        size, views = image_size(root, s)
-        timings = []
-        path = os.path.join(work, s, "timings.jsonl")
-        if os.path.exists(path):
-            with open(path) as f:
-                timings = [json.loads(line) for line in f if line.strip()]
-        rows.append({"set": s, "image_size": size, "views": views, "stages": timings})
+        for r in s["rows"]:
+            if r["status"] == "ok" and r["method"] not in methods:
+                methods.append(r["method"])
+    methods.sort(key=lambda m: (ROW_ORDER.index(m) if m in ROW_ORDER else len(ROW_ORDER), m))
+    summary = []
+    for m in methods:
+        rows = [r for s in sets for r in s["rows"] if r["method"] == m and r["status"] == "ok"]
+        means = {}
+        for key, _, _ in FIGURES:
+            values = [r["metrics"][key] for r in rows if r["metrics"] and finite(r["metrics"].get(key))]
+            means[key] = sum(values) / len(values) if values else None
+            means[key + "_sets"] = len(values)
+        summary.append({"method": m, "sets": len(rows), "means": means})
+    return summary
+
+
+def fmt(v, f):
+    return f % v if finite(v) else "–"
+
+
+def markdown(result):
+    sets, lines = result["sets"], []
+    m = result["machine"]
+    lines += ["# Benchmark results", "",
+              "Made by `make -f pipeline.mk bench` on %s (%s, %d cores), commit %s." % (
+                  result["date"], m["cpu"], m["cores"], result["commit"]),
+              ("Front end: **ground truth** (`truth-frontend` wrote 10_sfm/ and 20_boundary/; "
+               "sfm and segment-boundary did not run)." if result["frontend"] == "truth" else
+               "Front end: the pipeline's own (sfm, segment-boundary)."),
+              "",
+              "MS-SSIM as on the DocUNet benchmark (ground truth at 598 400 pixels); LD and Li-D "
+              "from DeepFlow (a stand-in for SIFT flow), in pixels at half that size; CER and WER "
+              "of Tesseract (eng) on the result%s against Tesseract on flat.png; surface mean "
+              "distance of M to the true surface in %% of the page diagonal; isometry = mean "
+              "relative edge-length error between M and M'. "
+              "Rows: `homography` = reference photo warped by the 4 page corners (scanner app); "
+              "`oracle` = reference photo textured through the true surface and camera (ceiling "
+              "for one-view texturing); `docunfold` = 60_render/rectified.png." % (
+                  " resized to flat.png's size" if "--ocr-at-truth-size" in result["producer"]
+                  ["options"]["eval_flags"] else " as it is"),
+              "Evaluate flags: `%s`." % (result["producer"]["options"]["eval_flags"] or "(none)"),
+              ""]
+    lines += ["## Quality", "",
+              "| set | method | " + " | ".join(t for _, t, _ in FIGURES) + " |",
+              "|---|---|" + "---:|" * len(FIGURES)]
+    notes = []
+    for s in sets:
+        for r in s["rows"]:
+            if r["status"] == "ok":
+                cells = [fmt(r["metrics"].get(k), f) for k, _, f in FIGURES]
+                lines.append("| %s | %s | %s |" % (s["name"], r["method"], " | ".join(cells)))
+            elif r["status"] == "failed":
+                lines.append("| %s | %s | failed: %s |" % (
+                    s["name"], r["method"], r.get("note", "").replace("|", "/")) +
+                    " |" * (len(FIGURES) - 1))
+            else:
+                notes.append((r["method"], r.get("note", ""), s["name"]))
+    lines += ["", "**Means per method** (over the sets where the row exists):", "",
+              "| method | sets | " + " | ".join(t for _, t, _ in FIGURES) + " |",
+              "|---|---:|" + "---:|" * len(FIGURES)]
+    for e in result["summary"]:
+        lines.append("| %s | %d | %s |" % (e["method"], e["sets"], " | ".join(
+            fmt(e["means"][k], f) for k, _, f in FIGURES)))
+    lines.append("")
+    lines.append("Summary: " + "; ".join(
+        "%s %s" % (e["method"], ", ".join("%s %s" % (t.split()[0], fmt(e["means"][k], f))
+                                          for k, t, f in FIGURES[:4] if finite(e["means"][k])))
+        for e in result["summary"]) + ".")
+    if notes:
+        # One entry per method and reason, naming the sets unless it is all.
+        grouped = {}
+        for method, note, name in notes:
+            grouped.setdefault((method, note), []).append(name)
+        lines += ["", "Rows not made: " + "; ".join(
+            "%s: %s (%s)" % (method, note, "all sets" if len(names) == len(sets) and len(sets) > 1
+                             else ", ".join(names))
+            for (method, note), names in grouped.items()) + "."]
+
     stages = []
-    for r in rows:
-        for t in r["stages"]:
+    for s in sets:
+        for t in s["stages"]:
             if t["stage"] not in stages:
                 stages.append(t["stage"])
-    result = {
-        "format": "docunfold.bench", "version": 1,
-        "date": datetime.date.today().isoformat(),
-        "machine": {"cpu": cpu_name(), "cores": os.cpu_count()},
-        "sets": rows,
-    }
-    os.makedirs(os.path.join(root, "bench"), exist_ok=True)
-    with open(os.path.join(root, "bench", "results.json"), "w") as f:
-        json.dump(result, f, indent=1)
-        f.write("\n")
-    lines = ["# Benchmark results", "",
-             "Made by `make -f pipeline.mk bench` on %s (%s, %d cores)." % (
-                 result["date"], result["machine"]["cpu"], result["machine"]["cores"]),
-             "Each stage runs from scratch; time is wall-clock seconds, memory is peak RSS.", "",
-             "| set | images | " + " | ".join("%s s / MB" % s for s in stages) + " |",
-             "|---|---|" + "---|" * len(stages)]
-    for r in rows:
-        cells = []
-        for s in stages:
-            t = [x for x in r["stages"] if x["stage"] == s]
-            if not t:
-                cells.append("–")
-            else:
+    stages.sort(key=lambda x: STAGE_ORDER.index(x) if x in STAGE_ORDER else len(STAGE_ORDER))
+    lines += ["", "## Time and memory per stage", "",
+              "Wall-clock seconds / peak RSS in MB of each pipeline stage, from scratch. Stages "
+              "not implemented yet are absent.", ""]
+    if stages:
+        lines += ["| set | images | " + " | ".join(stages) + " | total s |",
+                  "|---|---|" + "---:|" * (len(stages) + 1)]
+        for s in sets:
+            cells, total = [], 0.0
+            for st in stages:
+                t = [x for x in s["stages"] if x["stage"] == st]
+                if not t:
+                    cells.append("–")
+                    continue
                 t = t[-1]
+                total += t["seconds"]
                 cells.append("%.1f / %.0f%s" % (t["seconds"], t["max_rss_mb"],
                                                  "" if t["exit"] == 0 else " (exit %d)" % t["exit"]))
-        lines.append("| %s | %d × %s | %s |" % (r["set"], r["views"], r["image_size"], " | ".join(cells)))
-    with open(os.path.join(root, "bench", "results.md"), "w") as f:
-        f.write("\n".join(lines) + "\n")
-    print("\n".join(lines))
+            lines.append("| %s | %d × %s | %s | %.1f |" % (s["name"], s["views"], s["image_size"],
+                                                          " | ".join(cells), total))
+    else:
+        lines.append("(no pipeline stage ran)")
+    failed = [s for s in sets if s["pipeline"]["exit"]]
+    for s in failed:
+        lines.append("")
+        lines.append("%s: the pipeline stopped with exit %s%s (log: %s)." % (
+            s["name"], s["pipeline"]["exit"],
+            " in " + s["pipeline"]["failed_stage"] if s["pipeline"]["failed_stage"] else "",
+            os.path.join(result["work"], s["name"], "bench", "pipeline.log")))
+
+    lines += ["", "## Making and evaluating each row", "",
+              "| set | method | make s / MB | evaluate s / MB |", "|---|---|---:|---:|"]
+    for s in sets:
+        for r in s["rows"]:
+            if r["status"] == "skipped":
+                continue
+            mk = r["make"]
+            ev = r["evaluate"]
+            lines.append("| %s | %s | %s | %s |" % (
+                s["name"], r["method"],
+                "%.1f / %.0f" % (mk["seconds"], mk["max_rss_mb"]) if mk else "(pipeline)",
+                "%.1f / %.0f" % (ev["seconds"], ev["max_rss_mb"]) if ev else "–"))
+    return "\n".join(lines) + "\n"
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--root", required=True)
+    p.add_argument("--work", required=True)
+    p.add_argument("--out", required=True)
+    p.add_argument("--frontend", default="pipeline", choices=["pipeline", "truth"])
+    p.add_argument("--eval-flags", default="")
+    p.add_argument("sets", nargs="+", help="NAME=DATA_DIR")
+    a = p.parse_args()
+    sets = []
+    for spec in a.sets:
+        name, data = spec.split("=", 1)
+        sets.append(collect_set(name, data, a.work))
+    result = {
+        "format": "docunfold.bench", "version": 1,
+        "producer": {"program": "docunfold", "stage": "bench", "version": program_version(a.root),
+                     "options": {"frontend": a.frontend, "eval_flags": a.eval_flags,
+                                 "sets": [s["path"] for s in sets]}},
+        "date": datetime.date.today().isoformat(),
+        "commit": git_commit(a.root),
+        "machine": {"cpu": cpu_name(), "cores": os.cpu_count()},
+        "frontend": a.frontend,
+        "work": a.work,
+        "sets": sets,
+        "summary": summarize(sets),
+    }
+    os.makedirs(a.out, exist_ok=True)
+    # NaN never reaches JSON: evaluate writes null for figures it lacks.
+    with open(os.path.join(a.out, "results.json.tmp"), "w") as f:
+        json.dump(result, f, indent=1, ensure_ascii=False, allow_nan=False)
+        f.write("\n")
+    os.replace(os.path.join(a.out, "results.json.tmp"), os.path.join(a.out, "results.json"))
+    text = markdown(result)
+    with open(os.path.join(a.out, "results.md.tmp"), "w") as f:
+        f.write(text)
+    os.replace(os.path.join(a.out, "results.md.tmp"), os.path.join(a.out, "results.md"))
+    print(text, end="")
 
 
 if __name__ == "__main__":
-    main(sys.argv[1], sys.argv[2], sys.argv[3:])
+    main()

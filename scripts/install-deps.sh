@@ -21,12 +21,21 @@ packages=(
   libnanoflann-dev
   # structure from motion
   colmap
+  # sparse Cholesky (CHOLMOD) for Gauss-Newton steps; L-BFGS as the
+  # alternative solver. (CGAL, OpenMesh and Ceres are not needed: see the
+  # README's dependency table for why.)
+  libsuitesparse-dev liblbfgspp-dev
+  # OCR for the CER/WER metrics
+  libtesseract-dev tesseract-ocr-eng
   # fonts for synth's pages
   fonts-dejavu-core fonts-dejavu-extra fonts-liberation2 fonts-freefont-ttf
   # JSON Schema validation of every file the pipeline reads or writes
   python3 python3-jsonschema
-  # tests
-  googletest libgtest-dev
+  # stage timing for the benchmark and the report (/usr/bin/time)
+  time
+  # tests (assimp reads our PLYs as an independent check; chromium opens the
+  # HTML report)
+  googletest libgtest-dev assimp-utils chromium
 )
 
 if [[ "${1:-}" == "--list" ]]; then
@@ -39,7 +48,24 @@ for p in "${packages[@]}"; do
   status=$(dpkg-query -W -f='${Status}' "$p" 2>/dev/null || true)
   [[ "$status" == "install ok installed" ]] || missing+=("$p")
 done
-[[ ${#missing[@]} -eq 0 ]] && exit 0
+# Node.js and npm run the test tools (glTF validator, Playwright); any
+# installation will do, Debian's packages when there is none.
+command -v node >/dev/null && command -v npm >/dev/null || missing+=(nodejs npm)
+
+# The npm test tools of tests/tools (pinned by its package-lock.json).
+install_test_tools() {
+  local tools
+  tools="$(cd "$(dirname "$0")/.." && pwd)/tests/tools"
+  if [[ ! -d "$tools/node_modules/gltf-validator" || ! -d "$tools/node_modules/playwright-core" ]]; then
+    echo "docunfold: installing the npm test tools in tests/tools" >&2
+    (cd "$tools" && npm ci --no-audit --no-fund --loglevel=error >&2)
+  fi
+}
+
+if [[ ${#missing[@]} -eq 0 ]]; then
+  install_test_tools
+  exit 0
+fi
 
 cmd="apt-get install -y --no-install-recommends ${missing[*]}"
 if [[ $(id -u) -ne 0 ]]; then
@@ -54,3 +80,4 @@ if ! apt-get install -y --no-install-recommends "${missing[@]}" >/dev/null 2>&1;
   apt-get update -qq
   apt-get install -y --no-install-recommends "${missing[@]}"
 fi
+install_test_tools
