@@ -348,7 +348,8 @@ std::vector<double> TurningAngles(const std::vector<cv::Point>& contour, int rea
   return angle;
 }
 
-std::array<int, 4> FindCornerIndices(const std::vector<cv::Point>& contour) {
+std::array<int, 4> FindCornerIndices(const std::vector<cv::Point>& contour,
+                                     const FoldTest& is_fold) {
   const int n = int(contour.size());
   if (n < 8) return {{0, n / 4, n / 2, 3 * n / 4}};
   double perimeter = 0;
@@ -372,6 +373,19 @@ std::array<int, 4> FindCornerIndices(const std::vector<cv::Point>& contour) {
   std::sort(candidates.begin(), candidates.end(),
             [&](int a, int b) { return angle[a] > angle[b]; });
   if (candidates.size() > 12) candidates.resize(12);
+  if (is_fold && candidates.size() > 4) {
+    // Both ends of a fold are kinks of the outline, often as sharp as a
+    // corner of a foreshortened panel: drop them while four others remain.
+    std::vector<bool> fold_end(candidates.size(), false);
+    for (size_t i = 0; i < candidates.size(); ++i)
+      for (size_t j = i + 1; j < candidates.size(); ++j)
+        if (is_fold(contour[candidates[i]], contour[candidates[j]]))
+          fold_end[i] = fold_end[j] = true;
+    std::vector<int> kept;
+    for (size_t i = 0; i < candidates.size(); ++i)
+      if (!fold_end[i]) kept.push_back(candidates[i]);
+    if (kept.size() >= 4) candidates = kept;
+  }
   std::array<int, 4> best{{0, n / 4, n / 2, 3 * n / 4}};
   if (candidates.size() < 4) {
     // Not four distinct turns (a blob, a rounded shape): the quadrilateral
@@ -430,6 +444,81 @@ std::array<int, 4> FindCornerIndices(const std::vector<cv::Point>& contour) {
           }
         }
   return best;
+}
+
+bool IsShadingStep(const cv::Mat1f& grey, const cv::Mat1b& mask, double scale,
+                   const cv::Point& a, const cv::Point& b) {
+  const cv::Point2d p = cv::Point2d(a) * scale, q = cv::Point2d(b) * scale;
+  const double length = cv::norm(q - p);
+  if (length < 20) return false;
+  const cv::Point2d along = (q - p) / length, normal(-along.y, along.x);
+  // Far enough from the line to leave a crease's own shading ramp, near
+  // enough to stay on the two panels next to it.
+  const double offset = std::max(4.0, 0.02 * length);
+  auto inside = [&](const cv::Point2d& x) {
+    const int ix = int(std::lround(x.x)), iy = int(std::lround(x.y));
+    return ix >= 0 && iy >= 0 && ix < mask.cols && iy < mask.rows && mask(iy, ix) > 0;
+  };
+  constexpr int kSamples = 15;
+  constexpr double kStep = 0.05;  // relative brightness difference across
+  int valid = 0, brighter = 0, darker = 0;
+  for (int k = 0; k < kSamples; ++k) {
+    const cv::Point2d x = p + (q - p) * (0.15 + 0.7 * k / (kSamples - 1));
+    // Paper on both sides, well clear of the outline: a page side has the
+    // table on one of them.
+    if (!inside(x + 2 * offset * normal) || !inside(x - 2 * offset * normal)) continue;
+    ++valid;
+    const double g1 = SampleBilinear(grey, (x + offset * normal).x, (x + offset * normal).y);
+    const double g2 = SampleBilinear(grey, (x - offset * normal).x, (x - offset * normal).y);
+    const double step = (g1 - g2) / std::max({g1, g2, 1.0});
+    brighter += step > kStep;
+    darker += step < -kStep;
+  }
+  return valid >= 0.8 * kSamples && std::max(brighter, darker) >= 0.7 * valid;
+}
+
+cv::Point2d RefineCorner(const std::vector<cv::Point>& contour, int index, int reach) {
+  const int n = int(contour.size());
+  const cv::Point2d corner = contour[index];
+  if (n < 16 || reach < 2) return corner;
+  // A straight line through the outline on one side of the corner: the
+  // longest window (starting past the rounding) that the line fits within
+  // a pixel or two, so that a kink or a notch further along does not tilt it.
+  auto fit_side = [&](int direction, cv::Vec4f* line) {
+    const int start = std::max(1, reach / 3);
+    for (double factor : {4.0, 3.0, 2.0, 1.5, 1.0}) {
+      const int end = std::min(n / 3, int(factor * reach));
+      if (end - start < 4) continue;
+      std::vector<cv::Point2f> pts;
+      for (int k = start; k <= end; ++k) pts.emplace_back(contour[((index + direction * k) % n + n) % n]);
+      cv::fitLine(pts, *line, cv::DIST_HUBER, 0, 0.01, 0.01);
+      const cv::Point2d d((*line)[0], (*line)[1]), o((*line)[2], (*line)[3]);
+      double sum2 = 0, worst = 0;
+      for (const auto& pt : pts) {
+        const cv::Point2d r = cv::Point2d(pt) - o;
+        const double e = d.x * r.y - d.y * r.x;
+        sum2 += e * e;
+        worst = std::max(worst, std::abs(e));
+      }
+      if (std::sqrt(sum2 / pts.size()) <= 1.5 && worst <= 3.0) return true;
+    }
+    return false;
+  };
+  cv::Vec4f before, after;
+  if (!fit_side(-1, &before) || !fit_side(+1, &after)) return corner;
+  const cv::Point2d d1(before[0], before[1]), o1(before[2], before[3]);
+  const cv::Point2d d2(after[0], after[1]), o2(after[2], after[3]);
+  const double cross = d1.x * d2.y - d1.y * d2.x;
+  if (std::abs(cross) < std::sin(20.0 * CV_PI / 180)) return corner;  // nearly parallel
+  const cv::Point2d w = o2 - o1;
+  const double t = (w.x * d2.y - w.y * d2.x) / cross;
+  const cv::Point2d x = o1 + t * d1;
+  // The rounding the mask leaves is a few pixels: a far intersection means
+  // the fits are not of this corner's sides.
+  double step = 0;
+  for (int k = -reach; k < reach; ++k)
+    step += cv::norm(contour[((index + k) % n + n) % n] - contour[((index + k + 1) % n + n) % n]);
+  return cv::norm(x - corner) <= 0.5 * step ? x : corner;
 }
 
 int GeometricTopSide(const std::array<cv::Point2d, 4>& corners) {
@@ -533,7 +622,19 @@ BoundaryResult SegmentBoundary(const cv::Mat& image, const BoundaryOptions& opti
   result.contour = Simplify(ToDouble(contour), options.contour_epsilon_px, true);
 
   // 3. Corners: clockwise, then rotated so that the top side is first.
-  std::array<int, 4> idx = detail::FindCornerIndices(contour);
+  cv::Mat1b grey_bytes;
+  cv::cvtColor(small, grey_bytes, cv::COLOR_BGR2GRAY);
+  cv::Mat1f grey;
+  grey_bytes.convertTo(grey, CV_32F);
+  cv::GaussianBlur(grey, grey, cv::Size(), 3.0);  // text away, panels' shading kept
+  cv::Mat1b small_mask;
+  cv::resize(mask, small_mask, small.size(), 0, 0, cv::INTER_AREA);
+  small_mask = small_mask > 127;
+  const auto is_fold = [&](const cv::Point& a, const cv::Point& b) {
+    return detail::IsShadingStep(grey, small_mask, double(small.cols) / full.cols, a, b);
+  };
+  std::array<int, 4> idx = detail::FindCornerIndices(contour, is_fold);
+  const int corner_reach = std::max(2, int(0.025 * contour.size()));
   std::array<cv::Point2d, 4> corners;
   for (int i = 0; i < 4; ++i) corners[i] = contour[idx[i]];
   step("corners");
@@ -552,7 +653,10 @@ BoundaryResult SegmentBoundary(const cv::Mat& image, const BoundaryOptions& opti
   }
   step("orientation by " + result.orientation.method);
   std::rotate(idx.begin(), idx.begin() + top, idx.end());
-  for (int i = 0; i < 4; ++i) result.corners[i] = contour[idx[i]];
+  for (int i = 0; i < 4; ++i) {
+    const cv::Point2d c = detail::RefineCorner(contour, idx[i], corner_reach);
+    result.corners[i] = {std::clamp(c.x, 0.0, mask.cols - 1.0), std::clamp(c.y, 0.0, mask.rows - 1.0)};
+  }
 
   // 4. Sides along the outline, and which parts of them lie on the image border.
   const double tol = options.border_tolerance_px;
@@ -595,6 +699,9 @@ BoundaryResult SegmentBoundary(const cv::Mat& image, const BoundaryOptions& opti
     side.real = side.cut_fraction <= options.max_cut_fraction;
     side.points = Simplify(ToDouble(path), options.contour_epsilon_px, false);
     if (side.points.size() < 2) side.points = {cv::Point2d(path.front()), cv::Point2d(path.back())};
+    // A side runs from corner to corner, sharpened as the corners are.
+    side.points.front() = result.corners[reversed ? (i + 1) % 4 : i];
+    side.points.back() = result.corners[reversed ? i : (i + 1) % 4];
     if (side.real) side.real_parts = {side.points};
     result.sides[i] = std::move(side);
   }

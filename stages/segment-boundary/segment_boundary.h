@@ -12,6 +12,7 @@
 #pragma once
 
 #include <array>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -107,7 +108,24 @@ std::vector<double> TurningAngles(const std::vector<cv::Point>& contour, int rea
 // order: the four sharpest convex turns of the outline (page corners turn by
 // 60-120 degrees, folds far less); the largest quadrilateral on the convex
 // hull when there are not four turns.
-std::array<int, 4> FindCornerIndices(const std::vector<cv::Point>& contour);
+// `is_fold(a, b)`, when given, says whether the straight line between two
+// outline points is a fold across the page: candidates joined by a fold are
+// kinks where the fold meets a side, not corners, and are passed over while
+// four other candidates remain.
+using FoldTest = std::function<bool(const cv::Point&, const cv::Point&)>;
+std::array<int, 4> FindCornerIndices(const std::vector<cv::Point>& contour,
+                                     const FoldTest& is_fold = nullptr);
+// Whether the segment a-b (full-resolution pixels) runs inside the page and
+// separates two differently shaded parts of it along most of its length, as
+// a fold does (text is blurred away first). `grey` is the page image at
+// `scale` work pixels per full pixel; `mask` the page region at that size.
+bool IsShadingStep(const cv::Mat1f& grey, const cv::Mat1b& mask, double scale,
+                   const cv::Point& a, const cv::Point& b);
+// Sharpens a corner found on the outline: the intersection of straight lines
+// fitted to the outline just before and just after it (a corner the mask
+// rounds off, or a ragged outline, moves the point of sharpest turn away).
+// Returns the outline point itself when the fits disagree with it.
+cv::Point2d RefineCorner(const std::vector<cv::Point>& contour, int index, int reach);
 // Rotates corner order so that the side whose outward normal points most
 // towards image-up is the top; corners must be clockwise.
 int GeometricTopSide(const std::array<cv::Point2d, 4>& corners);

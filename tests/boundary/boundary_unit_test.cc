@@ -153,6 +153,88 @@ TEST(CornerHelpers, FourSharpestTurnsWinOverAFoldKink) {
   for (int i = 0; i < 4; ++i) EXPECT_LE(cv::norm(contour[idx[i]] - expected[i]), 2.0) << i;
 }
 
+// The outline of a page whose top panel is folded up and seen foreshortened
+// (as in samples/set01): a hexagon whose fold kinks turn more sharply than
+// the panel's own corners.
+std::vector<cv::Point> FoldedPageOutline() {
+  std::vector<cv::Point> contour;
+  auto edge = [&](cv::Point a, cv::Point b) {
+    const int n = std::max(std::abs(b.x - a.x), std::abs(b.y - a.y));
+    for (int k = 0; k < n; ++k) contour.emplace_back(a + (b - a) * (double(k) / n));
+  };
+  edge({220, 60}, {480, 60});    // top side of the folded panel
+  edge({480, 60}, {600, 140});   // right side, panel part
+  edge({600, 140}, {600, 500});  // right side below the fold kink
+  edge({600, 500}, {100, 500});
+  edge({100, 500}, {100, 140});  // left side below the fold kink
+  edge({100, 140}, {220, 60});   // left side, panel part
+  return contour;
+}
+
+TEST(CornerHelpers, FoldKinksAreNotCornersWhenTheFoldIsSeen) {
+  const std::vector<cv::Point> contour = FoldedPageOutline();
+  const auto near = [](const cv::Point& p, const cv::Point& q) { return cv::norm(p - q) <= 3; };
+  const detail::FoldTest fold = [&](const cv::Point& a, const cv::Point& b) {
+    return (near(a, {100, 140}) && near(b, {600, 140})) ||
+           (near(b, {100, 140}) && near(a, {600, 140}));
+  };
+  const std::vector<cv::Point> expected = {{220, 60}, {480, 60}, {600, 500}, {100, 500}};
+  // From the outline alone the kinks win: the case the fold test is for.
+  const auto blind = detail::FindCornerIndices(contour);
+  int kinks = 0;
+  for (int i = 0; i < 4; ++i)
+    kinks += near(contour[blind[i]], {100, 140}) || near(contour[blind[i]], {600, 140});
+  EXPECT_GT(kinks, 0);
+  const auto idx = detail::FindCornerIndices(contour, fold);
+  for (int i = 0; i < 4; ++i)
+    EXPECT_LE(cv::norm(contour[idx[i]] - expected[i]), 3.0) << i << " " << contour[idx[i]];
+}
+
+TEST(CornerHelpers, ShadingStepTellsAFoldFromAFlatPageAndASide) {
+  // The folded page of FoldedPageOutline: panel above y = 140 darker.
+  cv::Mat1b mask = cv::Mat1b::zeros(560, 700);
+  std::vector<cv::Point> outline = FoldedPageOutline();
+  cv::fillPoly(mask, std::vector<std::vector<cv::Point>>{outline}, 255);
+  cv::Mat1f grey(mask.size(), 60.0f);
+  grey.setTo(210.0f, mask);
+  grey(cv::Rect(0, 0, 700, 140)).setTo(150.0f, mask(cv::Rect(0, 0, 700, 140)));
+  EXPECT_TRUE(detail::IsShadingStep(grey, mask, 1.0, {100, 140}, {600, 140}));
+  EXPECT_FALSE(detail::IsShadingStep(grey, mask, 1.0, {100, 300}, {600, 300}));  // flat
+  EXPECT_FALSE(detail::IsShadingStep(grey, mask, 1.0, {600, 500}, {100, 500}));  // a side
+  EXPECT_FALSE(detail::IsShadingStep(grey, mask, 1.0, {100, 500}, {480, 60}));   // crosses it
+  // Full-resolution points on a half-size image.
+  cv::Mat1f grey_half;
+  cv::Mat1b mask_half;
+  cv::resize(grey, grey_half, cv::Size(), 0.5, 0.5, cv::INTER_AREA);
+  cv::resize(mask, mask_half, cv::Size(), 0.5, 0.5, cv::INTER_NEAREST);
+  EXPECT_TRUE(detail::IsShadingStep(grey_half, mask_half, 0.5, {100, 140}, {600, 140}));
+}
+
+TEST(CornerHelpers, RefinedCornerIsWhereTheSidesMeet) {
+  // A square whose corners the mask rounded off (radius 12 px).
+  cv::Mat1b mask = cv::Mat1b::zeros(400, 400);
+  cv::rectangle(mask, cv::Rect(50, 50, 300, 300), 255, cv::FILLED);
+  const cv::Mat kernel = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(25, 25));
+  cv::morphologyEx(mask, mask, cv::MORPH_OPEN, kernel);
+  std::vector<std::vector<cv::Point>> contours;
+  cv::findContours(mask, contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE);
+  ASSERT_EQ(contours.size(), 1u);
+  std::vector<cv::Point> contour = contours[0];
+  const int reach = std::max(2, int(0.025 * contour.size()));
+  const auto idx = detail::FindCornerIndices(contour);
+  const std::vector<cv::Point2d> truth = {{50, 50}, {349, 50}, {349, 349}, {50, 349}};
+  for (int i = 0; i < 4; ++i) {
+    const cv::Point2d refined = detail::RefineCorner(contour, idx[i], reach);
+    double nearest = 1e9, before = 1e9;
+    for (const auto& t : truth) {
+      nearest = std::min(nearest, cv::norm(refined - t));
+      before = std::min(before, cv::norm(cv::Point2d(contour[idx[i]]) - t));
+    }
+    EXPECT_LE(nearest, 1.5) << i;
+    EXPECT_GT(before, 3.0) << i << ": the rounding should have moved the outline's turn";
+  }
+}
+
 TEST(CornerHelpers, TopSideIsTheOneFacingUp) {
   // Clockwise corners of a square turned by 30 degrees.
   std::array<cv::Point2d, 4> c;

@@ -146,24 +146,37 @@ TEST_P(EndToEnd, BoundaryMatchesThePageInTheReferenceView) {
     double nearest = 1e9;
     for (const Eigen::Vector2d& c : b.corners) nearest = std::min(nearest, (c - corners[i]).norm());
     worst = std::max(worst, nearest / diagonal);
+    std::printf("%s: true corner %d at (%.0f, %.0f), nearest detected %.2f %% away\n",
+                set_.c_str(), i, corners[i].x(), corners[i].y(), 100 * nearest / diagonal);
   }
   std::printf("%s: boundary IoU %.4f, worst visible corner %.2f %% of the diagonal, %d real "
               "sides\n", set_.c_str(), iou, 100 * worst, b.RealSides());
   RecordProperty("iou", std::to_string(iou));
   RecordProperty("worst_corner_pct", std::to_string(100 * worst));
-  // Measured 2026-11-23: IoU >= 0.99 on every whole page, but corners on
-  // folded pages land on fold kinks (2.6-8.9 % off) and the cut-off set08
-  // reaches IoU 0.58: the 1 % corner target of issue 3 is not met yet, so
-  // corners are reported, and IoU is asserted where the page is whole.
+  // Measured 2026-11-23 (with fold kinks told from corners and corners
+  // sharpened): IoU >= 0.99 on every whole page; corners within 0.3 % on six
+  // samples, but 5.1 % on set02 (a corner curled up, seen nearly edge-on)
+  // and 2.6 % on set04 (a ragged outline on granite), and the cut-off set08
+  // reaches IoU 0.58 (its far panel is as dark as the granite): the 1 %
+  // corner target of issue 3 is not met everywhere, so corners are
+  // reported, and IoU is asserted where the page is whole.
   if (!cut) EXPECT_GE(iou, 0.97) << set_;
   if (cut) EXPECT_LT(b.RealSides(), 4) << set_ << ": the page is cut off, some side is not real";
-  // A side flagged not real runs along the image border.
+  // A side flagged not real runs along the image border for most of its
+  // length (its simplified polyline may end in a few short vertices where
+  // the outline leaves the border, so count length, not vertices).
+  auto near_border = [&](const Eigen::Vector2d& p) {
+    return p.x() < 4 || p.y() < 4 || p.x() > b.width - 5 || p.y() > b.height - 5;
+  };
   for (const BoundarySide& s : b.sides) {
     if (s.real) continue;
-    int near_border = 0;
-    for (const Eigen::Vector2d& p : s.points)
-      near_border += p.x() < 4 || p.y() < 4 || p.x() > b.width - 5 || p.y() > b.height - 5;
-    EXPECT_GE(near_border, int(s.points.size()) / 2) << set_;
+    double along = 0, total = 0;
+    for (size_t k = 1; k < s.points.size(); ++k) {
+      const double l = (s.points[k] - s.points[k - 1]).norm();
+      total += l;
+      if (near_border(s.points[k]) && near_border(s.points[k - 1])) along += l;
+    }
+    EXPECT_GE(along, 0.5 * total) << set_;
   }
 }
 
