@@ -46,6 +46,40 @@ int AddAccessor(tinygltf::Model* model, int view, int component, int type,
   return int(model->accessors.size() - 1);
 }
 
+// Positions in glTF's axes (y up, z towards the viewer: OpenCV's y and z
+// flipped), with the bounds the specification requires; the accessor index.
+int AddPositions(tinygltf::Model* model, const std::vector<Eigen::Vector3d>& positions) {
+  std::vector<float> pos;
+  std::vector<double> lo(3, 1e300), hi(3, -1e300);
+  for (const Eigen::Vector3d& p : positions) {
+    const double q[3] = {p.x(), -p.y(), -p.z()};
+    for (int k = 0; k < 3; ++k) {
+      pos.push_back(float(q[k]));
+      lo[k] = std::min(lo[k], double(float(q[k])));
+      hi[k] = std::max(hi[k], double(float(q[k])));
+    }
+  }
+  return AddAccessor(
+      model, AddView(model, pos.data(), pos.size() * 4, TINYGLTF_TARGET_ARRAY_BUFFER),
+      TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, positions.size(), lo, hi);
+}
+
+// One primitive with its material, as a named mesh in a node of `scene`.
+void AddNode(tinygltf::Model* model, tinygltf::Scene* scene, const std::string& name,
+             tinygltf::Primitive prim, const tinygltf::Material& material) {
+  model->materials.push_back(material);
+  prim.material = int(model->materials.size() - 1);
+  tinygltf::Mesh mesh;
+  mesh.name = name;
+  mesh.primitives.push_back(prim);
+  model->meshes.push_back(mesh);
+  tinygltf::Node node;
+  node.name = name;
+  node.mesh = int(model->meshes.size() - 1);
+  model->nodes.push_back(node);
+  scene->nodes.push_back(int(model->nodes.size() - 1));
+}
+
 }  // namespace
 
 void WriteGlb(const std::filesystem::path& path,
@@ -59,16 +93,6 @@ void WriteGlb(const std::filesystem::path& path,
   for (const GltfMesh& m : meshes) {
     if (m.positions.empty() || m.triangles.empty())
       throw std::invalid_argument("WriteGlb: empty mesh " + m.name);
-    std::vector<float> pos;
-    std::vector<double> lo(3, 1e300), hi(3, -1e300);
-    for (const Eigen::Vector3d& p : m.positions) {
-      const double q[3] = {p.x(), -p.y(), -p.z()};
-      for (int k = 0; k < 3; ++k) {
-        pos.push_back(float(q[k]));
-        lo[k] = std::min(lo[k], double(float(q[k])));
-        hi[k] = std::max(hi[k], double(float(q[k])));
-      }
-    }
     std::vector<uint32_t> idx;
     for (const Triangle& t : m.triangles)
       // Flipping two axes keeps handedness, so the winding stays as given.
@@ -76,9 +100,7 @@ void WriteGlb(const std::filesystem::path& path,
 
     tinygltf::Primitive prim;
     prim.mode = TINYGLTF_MODE_TRIANGLES;
-    prim.attributes["POSITION"] = AddAccessor(
-        &model, AddView(&model, pos.data(), pos.size() * 4, TINYGLTF_TARGET_ARRAY_BUFFER),
-        TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, m.positions.size(), lo, hi);
+    prim.attributes["POSITION"] = AddPositions(&model, m.positions);
     prim.indices = AddAccessor(
         &model, AddView(&model, idx.data(), idx.size() * 4, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER),
         TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR, idx.size(),
@@ -118,35 +140,13 @@ void WriteGlb(const std::filesystem::path& path,
       material.pbrMetallicRoughness.baseColorTexture.index =
           int(model.textures.size() - 1);
     }
-    model.materials.push_back(material);
-    prim.material = int(model.materials.size() - 1);
-    tinygltf::Mesh mesh;
-    mesh.name = m.name;
-    mesh.primitives.push_back(prim);
-    model.meshes.push_back(mesh);
-    tinygltf::Node node;
-    node.name = m.name;
-    node.mesh = int(model.meshes.size() - 1);
-    model.nodes.push_back(node);
-    scene.nodes.push_back(int(model.nodes.size() - 1));
+    AddNode(&model, &scene, m.name, prim, material);
   }
   for (const GltfPoints& c : clouds) {
     if (c.positions.empty()) continue;
-    std::vector<float> pos;
-    std::vector<double> lo(3, 1e300), hi(3, -1e300);
-    for (const Eigen::Vector3d& p : c.positions) {
-      const double q[3] = {p.x(), -p.y(), -p.z()};
-      for (int k = 0; k < 3; ++k) {
-        pos.push_back(float(q[k]));
-        lo[k] = std::min(lo[k], double(float(q[k])));
-        hi[k] = std::max(hi[k], double(float(q[k])));
-      }
-    }
     tinygltf::Primitive prim;
     prim.mode = TINYGLTF_MODE_POINTS;
-    prim.attributes["POSITION"] = AddAccessor(
-        &model, AddView(&model, pos.data(), pos.size() * 4, TINYGLTF_TARGET_ARRAY_BUFFER),
-        TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, c.positions.size(), lo, hi);
+    prim.attributes["POSITION"] = AddPositions(&model, c.positions);
     if (!c.colors.empty()) {
       if (c.colors.size() != c.positions.size())
         throw std::invalid_argument("WriteGlb: point colours size mismatch");
@@ -161,17 +161,7 @@ void WriteGlb(const std::filesystem::path& path,
     material.name = c.name;
     material.pbrMetallicRoughness.metallicFactor = 0.0;
     material.pbrMetallicRoughness.roughnessFactor = 1.0;
-    model.materials.push_back(material);
-    prim.material = int(model.materials.size() - 1);
-    tinygltf::Mesh mesh;
-    mesh.name = c.name;
-    mesh.primitives.push_back(prim);
-    model.meshes.push_back(mesh);
-    tinygltf::Node node;
-    node.name = c.name;
-    node.mesh = int(model.meshes.size() - 1);
-    model.nodes.push_back(node);
-    scene.nodes.push_back(int(model.nodes.size() - 1));
+    AddNode(&model, &scene, c.name, prim, material);
   }
   model.scenes.push_back(scene);
   model.defaultScene = 0;
