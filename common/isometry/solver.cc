@@ -31,6 +31,14 @@ using internal::StepData;
 using internal::Vec5;
 
 namespace internal {
+namespace {
+
+// Adds the squares of the first `n` rows' values to `sum`, one by one.
+void AddSquares(const Row* rows, int n, double* sum) {
+  for (int i = 0; i < n; ++i) *sum += rows[i].value * rows[i].value;
+}
+
+}  // namespace
 
 TermValues EvaluateTerms(const State& s, const StepData& data, int threads) {
   double iso = 0, dist = 0, fair3d = 0, fair2d = 0, line = 0, ray = 0;
@@ -41,28 +49,18 @@ TermValues EvaluateTerms(const State& s, const StepData& data, int threads) {
   {
     Row rows[4];
 #pragma omp for schedule(static) reduction(+ : iso) nowait
-    for (int q = 0; q < quads; ++q) {
-      const int n = IsoRows(s, data.iso_scale, q, rows);
-      for (int i = 0; i < n; ++i) iso += rows[i].value * rows[i].value;
-    }
+    for (int q = 0; q < quads; ++q) AddSquares(rows, IsoRows(s, data.iso_scale, q, rows), &iso);
 #pragma omp for schedule(static) reduction(+ : dist) nowait
-    for (int p = 0; p < points; ++p) {
-      const int n = DistRows(s, data, p, rows);
-      for (int i = 0; i < n; ++i) dist += rows[i].value * rows[i].value;
-    }
+    for (int p = 0; p < points; ++p) AddSquares(rows, DistRows(s, data, p, rows), &dist);
 #pragma omp for schedule(static) reduction(+ : fair3d, fair2d) nowait
     for (int t = 0; t < triplets; ++t) {
-      int n = FairRows(s, t, false, rows);
-      for (int i = 0; i < n; ++i) fair3d += rows[i].value * rows[i].value;
-      n = FairRows(s, t, true, rows);
-      for (int i = 0; i < n; ++i) fair2d += rows[i].value * rows[i].value;
+      AddSquares(rows, FairRows(s, t, false, rows), &fair3d);
+      AddSquares(rows, FairRows(s, t, true, rows), &fair2d);
     }
 #pragma omp for schedule(static) reduction(+ : line, ray) nowait
     for (int m = 0; m < markers; ++m) {
-      int n = LineRows(s, data, m, rows);
-      for (int i = 0; i < n; ++i) line += rows[i].value * rows[i].value;
-      n = RayRows(s, data, m, rows);
-      for (int i = 0; i < n; ++i) ray += rows[i].value * rows[i].value;
+      AddSquares(rows, LineRows(s, data, m, rows), &line);
+      AddSquares(rows, RayRows(s, data, m, rows), &ray);
     }
   }
   TermValues t;
