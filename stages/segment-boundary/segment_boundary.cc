@@ -323,6 +323,12 @@ std::vector<cv::Point2d> Simplify(const std::vector<cv::Point2d>& pts, double ep
   return std::vector<cv::Point2d>(out.begin(), out.end());
 }
 
+// Outline points on either side of a point over which its turning is
+// measured, and its corner's sides fitted: a few percent of the outline.
+int CornerReach(size_t outline_points) {
+  return std::max(2, int(0.025 * double(outline_points)));
+}
+
 double PolylineLength(const std::vector<cv::Point2d>& p) {
   double l = 0;
   for (size_t i = 1; i < p.size(); ++i) l += cv::norm(p[i] - p[i - 1]);
@@ -356,7 +362,7 @@ std::array<int, 4> FindCornerIndices(const std::vector<cv::Point>& contour,
   for (int k = 0; k < n; ++k) perimeter += cv::norm(contour[(k + 1) % n] - contour[k]);
   // Turning at the scale of a few percent of the outline: page corners turn
   // by 60-120 degrees there, folds and curls by much less, pixel noise not.
-  const int reach = std::max(2, int(0.025 * n));
+  const int reach = CornerReach(contour.size());
   const std::vector<double> angle = TurningAngles(contour, reach);
   // Candidates: convex local maxima of the turning.
   std::vector<int> candidates;
@@ -481,6 +487,7 @@ cv::Point2d RefineCorner(const std::vector<cv::Point>& contour, int index, int r
   const int n = int(contour.size());
   const cv::Point2d corner = contour[index];
   if (n < 16 || reach < 2) return corner;
+  auto at = [&](int offset) { return cv::Point2d(contour[((index + offset) % n + n) % n]); };
   // A straight line through the outline on one side of the corner: the
   // longest window (starting past the rounding) that the line fits within
   // a pixel or two, so that a kink or a notch further along does not tilt it.
@@ -490,7 +497,7 @@ cv::Point2d RefineCorner(const std::vector<cv::Point>& contour, int index, int r
       const int end = std::min(n / 3, int(factor * reach));
       if (end - start < 4) continue;
       std::vector<cv::Point2f> pts;
-      for (int k = start; k <= end; ++k) pts.emplace_back(contour[((index + direction * k) % n + n) % n]);
+      for (int k = start; k <= end; ++k) pts.emplace_back(at(direction * k));
       cv::fitLine(pts, *line, cv::DIST_HUBER, 0, 0.01, 0.01);
       const cv::Point2d d((*line)[0], (*line)[1]), o((*line)[2], (*line)[3]);
       double sum2 = 0, worst = 0;
@@ -516,8 +523,7 @@ cv::Point2d RefineCorner(const std::vector<cv::Point>& contour, int index, int r
   // The rounding the mask leaves is a few pixels: a far intersection means
   // the fits are not of this corner's sides.
   double step = 0;
-  for (int k = -reach; k < reach; ++k)
-    step += cv::norm(contour[((index + k) % n + n) % n] - contour[((index + k + 1) % n + n) % n]);
+  for (int k = -reach; k < reach; ++k) step += cv::norm(at(k + 1) - at(k));
   return cv::norm(x - corner) <= 0.5 * step ? x : corner;
 }
 
@@ -634,7 +640,6 @@ BoundaryResult SegmentBoundary(const cv::Mat& image, const BoundaryOptions& opti
     return detail::IsShadingStep(grey, small_mask, double(small.cols) / full.cols, a, b);
   };
   std::array<int, 4> idx = detail::FindCornerIndices(contour, is_fold);
-  const int corner_reach = std::max(2, int(0.025 * contour.size()));
   std::array<cv::Point2d, 4> corners;
   for (int i = 0; i < 4; ++i) corners[i] = contour[idx[i]];
   step("corners");
@@ -654,7 +659,7 @@ BoundaryResult SegmentBoundary(const cv::Mat& image, const BoundaryOptions& opti
   step("orientation by " + result.orientation.method);
   std::rotate(idx.begin(), idx.begin() + top, idx.end());
   for (int i = 0; i < 4; ++i) {
-    const cv::Point2d c = detail::RefineCorner(contour, idx[i], corner_reach);
+    const cv::Point2d c = detail::RefineCorner(contour, idx[i], CornerReach(contour.size()));
     result.corners[i] = {std::clamp(c.x, 0.0, mask.cols - 1.0), std::clamp(c.y, 0.0, mask.rows - 1.0)};
   }
 
