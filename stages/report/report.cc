@@ -128,8 +128,9 @@ void PhotosSection(const ReportOptions& o, const DataSet& data, const Json& came
   if (!cameras.is_object()) {
     page->Add(Missing("sfm has not run yet (10_sfm/cameras.json is missing)."));
   } else {
-    std::string why = "Chosen automatically by sfm: the registered view that sees the most of "
-                      "the page most frontally.";
+    std::string why = "Chosen automatically by sfm: the registered view that sees the whole "
+                      "page and resolves its worst-seen tenth best (resolution = pixels per "
+                      "unit of page length across the foreshortening).";
     const std::string flags = ReadText(o.work / ".flags/sfm");
     if (flags.find("--ref") != std::string::npos)
       why = "Chosen by the user (<code>REF=</code>).";

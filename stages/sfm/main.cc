@@ -10,7 +10,7 @@ int main(int argc, char** argv) {
   CLI::App app{
       "Recovers the cameras and a sparse point cloud of the page with COLMAP (CPU SIFT, "
       "exhaustive matching, incremental mapper), picks the reference view (the one that "
-      "sees the whole page most frontally) unless --ref names it, and writes "
+      "sees the whole page and resolves its worst-seen part best) unless --ref names it, and writes "
       "cameras.json, points.ply and the undistorted reference.png in the reference "
       "camera's frame scaled to median depth 1, plus COLMAP's workspace in colmap/. "
       "Exit codes: 0 ok, 1 COLMAP missing or failing, 2 usage, 3 bad input (data set, "

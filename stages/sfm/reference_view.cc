@@ -25,7 +25,8 @@ using KdTree = nanoflann::KDTreeSingleIndexAdaptor<
     3, size_t>;
 
 // Weighted median of (value, weight) pairs; 0 when empty.
-double WeightedMedian(std::vector<std::pair<double, double>> v) {
+// The q-quantile of (value, weight) pairs.
+double WeightedQuantile(std::vector<std::pair<double, double>> v, double q) {
   if (v.empty()) return 0;
   std::sort(v.begin(), v.end());
   double total = 0;
@@ -33,7 +34,7 @@ double WeightedMedian(std::vector<std::pair<double, double>> v) {
   double acc = 0;
   for (const auto& p : v) {
     acc += p.second;
-    if (acc >= 0.5 * total) return p.first;
+    if (acc >= q * total) return p.first;
   }
   return v.back().first;
 }
@@ -286,8 +287,18 @@ std::vector<ViewScore> ScoreReferenceViews(const ColmapModel& model,
       if (v.empty() || v.back() != i) v.push_back(i);  // once per point
     }
 
+  // Normals point to the side the cameras are on (every photo shows the
+  // page's front), so a view that sees a part from behind (a curled corner)
+  // can tell it is hidden.
+  Eigen::Vector3d cameras_mean = Eigen::Vector3d::Zero();
+  for (const auto& [id, image] : model.images) cameras_mean += image.Center();
+  if (!model.images.empty()) cameras_mean /= double(model.images.size());
+  std::vector<Eigen::Vector3d> oriented = normals;
+  for (size_t i = 0; i < xyz.size(); ++i)
+    if ((cameras_mean - xyz[i]).dot(oriented[i]) < 0) oriented[i] = -oriented[i];
+
   std::vector<ViewScore> scores;
-  double max_pixels = 1e-300;
+  double max_pixels = 1e-300, max_resolution = 1e-300;
   for (const auto& [id, image] : model.images) {
     const ColmapCamera& camera = model.cameras.at(image.camera_id);
     const Eigen::Matrix3d R = image.R();
@@ -302,15 +313,23 @@ std::vector<ViewScore> ScoreReferenceViews(const ColmapModel& model,
     const double margin =
         options.margin_fraction * std::min(camera.width, camera.height);
     int inside = 0;
-    std::vector<std::pair<double, double>> cosines;  // (|cos|, weight)
+    double hidden_area = 0, total_area = 0;
+    std::vector<std::pair<double, double>> cosines;     // (|cos|, pixels)
+    std::vector<std::pair<double, double>> resolution;  // (px per unit, page area)
     for (size_t i = 0; i < xyz.size(); ++i) {
+      total_area += area[i];
       const Eigen::Vector3d xc = R * xyz[i] + image.t;
-      if (xc.z() <= 0) continue;
-      const Eigen::Vector2d px = camera.Project(xc);
+      const Eigen::Vector2d px = xc.z() > 0 ? camera.Project(xc) : Eigen::Vector2d(-1, -1);
       if (px.x() < 0 || px.y() < 0 || px.x() > camera.width - 1 ||
-          px.y() > camera.height - 1)
+          px.y() > camera.height - 1) {
+        resolution.push_back({0, area[i]});  // not in the picture at all
         continue;
-      const double c = std::abs((xyz[i] - center).normalized().dot(normals[i]));
+      }
+      const double signed_cos = (center - xyz[i]).normalized().dot(oriented[i]);
+      const double c = std::abs(signed_cos);
+      if (signed_cos < 0) hidden_area += area[i];
+      // Pixels per unit length across the foreshortened direction.
+      resolution.push_back({camera.MeanFocal() * std::max(signed_cos, 0.0) / xc.z(), area[i]});
       // The pixels this point's patch covers: area * |cos| / depth^2.
       const double weight = area[i] * c / (xc.z() * xc.z());
       cosines.push_back({c, weight});
@@ -320,14 +339,16 @@ std::vector<ViewScore> ScoreReferenceViews(const ColmapModel& model,
           px.y() <= camera.height - 1 - margin)
         ++inside;
     }
-    s.frontality = WeightedMedian(std::move(cosines));
+    s.frontality = WeightedQuantile(std::move(cosines), 0.5);
+    s.resolution = WeightedQuantile(std::move(resolution), options.resolution_quantile);
+    s.hidden = total_area > 0 ? hidden_area / total_area : 0;
     s.coverage = page_indices.empty() ? 0 : double(inside) / double(page_indices.size());
     max_pixels = std::max(max_pixels, s.page_pixels);
+    max_resolution = std::max(max_resolution, s.resolution);
     scores.push_back(s);
   }
   for (ViewScore& s : scores)
-    s.score = std::pow(s.coverage, 4) * s.frontality *
-              std::pow(s.page_pixels / max_pixels, 0.05);
+    s.score = std::pow(s.coverage, 4) * s.resolution / max_resolution;
   std::stable_sort(scores.begin(), scores.end(),
                    [](const ViewScore& a, const ViewScore& b) {
                      if (a.score != b.score) return a.score > b.score;

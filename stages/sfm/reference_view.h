@@ -1,5 +1,5 @@
 // Automatic choice of the reference view: the registered view that sees the
-// most of the page, most frontally, with the whole page inside the picture.
+// whole page inside the picture and resolves its worst-seen part best.
 #pragma once
 
 #include <map>
@@ -29,12 +29,21 @@ struct ViewScore {
   // Area of the page in the image, pixels (from the points' patches): how
   // much detail the view has.
   double page_pixels = 0;
+  // Pixels per unit of page length in the most foreshortened direction,
+  // f·cos/depth, at the `resolution_quantile` over the page's area (parts
+  // outside the picture or seen from behind count 0): how sharp the
+  // rectified page can be where this view sees it worst.
+  double resolution = 0;
+  // Fraction of the page's area this view sees from behind (a curled corner
+  // turned away from it).
+  double hidden = 0;
   double score = 0;        // see ScoreReferenceViews
 };
 
 struct ReferenceOptions {
   int normal_neighbours = 12;    // points in each local plane fit
   double margin_fraction = 0.02; // of the image's short side
+  double resolution_quantile = 0.1;  // of ViewScore::resolution
 };
 
 // Which points are the page's: a textured table gives COLMAP as many points
@@ -53,11 +62,13 @@ std::vector<bool> PagePoints(const ColmapModel& model,
                              const std::map<std::string, cv::Mat1b>& masks);
 
 // Scores every registered view, best first, on the page's points:
-//   score = coverage^4 * frontality * (page_pixels / max page_pixels)^0.05
+//   score = coverage^4 * resolution / max resolution
 // coverage dominates (a page cut off by the border cannot be rectified
-// whole), then frontality (least foreshortening); the page's size in the
-// image breaks near-ties in favour of the view with more detail (half the
-// size costs as much as 3.4 % less frontality).
+// whole), then the resolution of the worst-seen tenth of the page. Not the
+// median frontality: a view square to one panel of a folded page often sees
+// the other panel nearly edge-on, and that panel's smeared texture and thin
+// sliver of image decide the result. Measured by running the pipeline with
+// every view as reference (README, "Reference view").
 std::vector<ViewScore> ScoreReferenceViews(
     const ColmapModel& model, const std::map<std::string, cv::Mat1b>& masks = {},
     const ReferenceOptions& options = {});

@@ -361,6 +361,8 @@ Json CamerasJson(const SfmResult& r, const SfmOptions& options) {
                       {"coverage", s.coverage},
                       {"frontality", s.frontality},
                       {"page_pixels", s.page_pixels},
+                      {"resolution", s.resolution},
+                      {"hidden", s.hidden},
                       {"points_seen", s.points_seen}});
   doc["reference_selection"] = {{"method", r.reference_choice},
                                 {"page_points", r.page_points},

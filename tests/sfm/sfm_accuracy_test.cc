@@ -32,10 +32,15 @@ namespace {
 
 constexpr double kMaxCameraRms = 0.01;        // of the page diagonal
 constexpr double kMaxMedianDistance = 0.005;  // of the page diagonal
-// The reference may be this much less frontal (|cos| of the viewing angle)
-// than the most frontal view that sees the whole page: 0.05 is the
-// difference between 18 and 26 degrees.
-constexpr double kFrontalitySlack = 0.05;
+// The reference's true resolution where it sees the page worst (10 %
+// quantile of pixels per metre across the foreshortening, hidden parts 0) is
+// at least this fraction of the best whole-page view's. sfm estimates it from
+// the sparse page points, which miss blank and curled parts: measured, the
+// chosen view is the truly best on 9 of 12 sets, 0.81 of it on r03 and 0.43
+// on set02 (a curled corner with few points). The most frontal view, chosen
+// before, reached 0.35 (set01), 0.06 (set05) and 0 (set02, set07: part of
+// the page seen from behind), which this bound rejects.
+constexpr double kResolutionFraction = 0.4;
 
 class SfmAccuracy : public ::testing::TestWithParam<fs::path> {};
 
@@ -76,7 +81,7 @@ TEST_P(SfmAccuracy, MatchesGroundTruth) {
     EXPECT_TRUE(f.reference_whole_page)
         << name << ": reference " << f.reference << " cuts the page off, "
         << f.best_true_view << " shows all of it";
-    EXPECT_GE(f.reference_frontality, f.best_true_frontality - kFrontalitySlack)
+    EXPECT_GE(f.reference_resolution, kResolutionFraction * f.best_true_resolution)
         << name << ": reference " << f.reference << " vs " << f.best_true_view;
   }
 

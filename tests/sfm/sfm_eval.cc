@@ -166,6 +166,42 @@ std::vector<TrueViewFigures> TrueViews(const GroundTruth& gt) {
     TrueViewFigures v;
     v.image = cam.image;
     v.frontality = Median(cosines);
+    // Resolution per triangle, weighted by its area on the page; visible
+    // when its centre is the nearest surface at its pixel.
+    const RasterResult full = RasterizeMesh(cam, gt.mesh.vertices, gt.triangles, 1.0);
+    std::vector<std::pair<double, double>> resolution;  // (px per unit, area)
+    for (const Triangle& t : gt.triangles) {
+      const Eigen::Vector3d& a = gt.mesh.vertices[t[0]];
+      const Eigen::Vector3d& b = gt.mesh.vertices[t[1]];
+      const Eigen::Vector3d& c = gt.mesh.vertices[t[2]];
+      const Eigen::Vector3d cross = (b - a).cross(c - a);
+      const double area = 0.5 * cross.norm();
+      if (!(area > 0)) continue;
+      const Eigen::Vector3d centre = (a + b + c) / 3;
+      const Eigen::Vector3d xc = cam.CamFromWorld(centre);
+      double value = 0;
+      if (xc.z() > 0) {
+        const Eigen::Vector2d px = cam.ProjectCam(xc);
+        const int x = int(std::lround(px.x())), y = int(std::lround(px.y()));
+        if (x >= 0 && y >= 0 && x < full.depth.cols && y < full.depth.rows &&
+            xc.z() <= full.depth(y, x) * 1.01) {
+          const double cosine =
+              std::abs(cross.normalized().dot((centre - center).normalized()));
+          value = cam.K(0, 0) * cosine / xc.z();
+        }
+      }
+      resolution.push_back({value, area});
+    }
+    std::sort(resolution.begin(), resolution.end());
+    double total = 0, acc = 0;
+    for (const auto& r : resolution) total += r.second;
+    for (const auto& r : resolution) {
+      acc += r.second;
+      if (acc >= 0.1 * total) {
+        v.resolution = r.first;
+        break;
+      }
+    }
     v.whole_page = !touches && !cosines.empty();
     out.push_back(v);
   }
@@ -251,10 +287,11 @@ SfmFigures MeasureSfm(const fs::path& sfm_dir, const GroundTruth& gt) {
   for (const TrueViewFigures& v : truth) {
     if (v.image == sfm.reference) {
       f.reference_frontality = v.frontality;
+      f.reference_resolution = v.resolution;
       f.reference_whole_page = v.whole_page;
     }
-    if (v.whole_page && v.frontality > f.best_true_frontality) {
-      f.best_true_frontality = v.frontality;
+    if (v.whole_page && v.resolution > f.best_true_resolution) {
+      f.best_true_resolution = v.resolution;
       f.best_true_view = v.image;
     }
   }
@@ -277,13 +314,13 @@ std::string FormatFigures(const SfmFigures& f) {
   std::snprintf(buf, sizeof buf,
                 "registered %d/%d, camera centres RMS %.3f%%, points %d (on page %d), "
                 "median distance page points %.3f%% (all %.3f%%, shape after ICP %.3f%%), "
-                "reference %s (true frontality %.3f, whole page %s; most frontal whole "
-                "view %s %.3f)",
+                "reference %s (true frontality %.3f, resolution %.0f px/m, whole page %s; "
+                "best-resolving whole view %s %.0f)",
                 f.registered, f.views, 100 * f.camera_rms, f.points, f.page_points,
                 100 * f.median_page_distance, 100 * f.median_all_distance,
                 100 * f.shape_median_distance, f.reference.c_str(), f.reference_frontality,
-                f.reference_whole_page ? "yes" : "no", f.best_true_view.c_str(),
-                f.best_true_frontality);
+                f.reference_resolution, f.reference_whole_page ? "yes" : "no",
+                f.best_true_view.c_str(), f.best_true_resolution);
   return buf;
 }
 

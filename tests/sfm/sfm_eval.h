@@ -29,6 +29,10 @@ struct TrueViewFigures {
   // Median over the page's pixels in the view of |cos| of the angle between
   // the viewing ray and the true surface normal (1 = head-on).
   double frontality = 0;
+  // Pixels per unit of page length across the foreshortening (f·cos/depth),
+  // 10 % quantile over the page's area, hidden or out-of-picture parts 0:
+  // what sfm's reference score estimates from the points.
+  double resolution = 0;
   bool whole_page = false;  // the page touches no image border
 };
 std::vector<TrueViewFigures> TrueViews(const GroundTruth& gt);
@@ -46,9 +50,10 @@ struct SfmFigures {
   double shape_median_distance = 0;
   std::string reference;
   double reference_frontality = 0;  // true figures of the chosen reference
+  double reference_resolution = 0;
   bool reference_whole_page = false;
-  std::string best_true_view;       // most frontal true view that sees the whole page
-  double best_true_frontality = 0;
+  std::string best_true_view;       // best-resolving true view that sees the whole page
+  double best_true_resolution = 0;
   double reference_median_depth = 0;  // of the points inside the reference image
 };
 
