@@ -10,6 +10,7 @@
 #include <optional>
 #include <sstream>
 
+#include <Eigen/Eigenvalues>
 #include <nanoflann.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -89,29 +90,60 @@ struct PixelCloud {
 using PixelTree = nanoflann::KDTreeSingleIndexAdaptor<
     nanoflann::L2_Simple_Adaptor<double, PixelCloud>, PixelCloud, 2, uint32_t>;
 
-// Depth of a pixel from the k nearest projected points (RBF weights).
+// Depth of a pixel from its nearest projected points, RBF weights
+// φ(r) = 1/(1+r²). kAverage: the weighted mean depth of the k nearest (the
+// paper). kPlanar: a weighted least-squares fit of 1/depth as an affine
+// function of the pixel over the `planar_k` nearest, which is exact for a
+// plane and so carries each panel on over blank paper (margins, gaps between
+// columns) instead of levelling it to the nearest points' depth.
 class DepthField {
  public:
-  DepthField(std::vector<Eigen::Vector2d> pixels, std::vector<double> depths, int k, double scale)
+  DepthField(std::vector<Eigen::Vector2d> pixels, std::vector<double> depths, int k, double scale,
+             DepthModel model, int planar_k)
       : pixels_(std::move(pixels)), depths_(std::move(depths)), k_(k), scale_(scale),
+        model_(model), planar_k_(planar_k),
         cloud_{&pixels_}, tree_(2, cloud_, nanoflann::KDTreeSingleIndexAdaptorParams(10)) {
     tree_.buildIndex();
   }
   double At(const Eigen::Vector2d& px) const {
-    const size_t k = std::min<size_t>(size_t(k_), pixels_.size());
+    const int want = model_ == DepthModel::kPlanar ? std::max(k_, planar_k_) : k_;
+    const size_t k = std::min<size_t>(size_t(want), pixels_.size());
     std::vector<uint32_t> idx(k);
     std::vector<double> d2(k);
     nanoflann::KNNResultSet<double, uint32_t> knn(k);
     knn.init(idx.data(), d2.data());
     tree_.findNeighbors(knn, px.data(), nanoflann::SearchParams());
+    const size_t found = knn.size();
+    auto weight = [&](size_t i) { return 1 / (1 + d2[i] / (scale_ * scale_)); };
     double sw = 0, sz = 0;
-    for (size_t i = 0; i < knn.size(); ++i) {
-      const double r2 = d2[i] / (scale_ * scale_);
-      const double w = 1 / (1 + r2);
-      sw += w;
-      sz += w * depths_[idx[i]];
+    for (size_t i = 0; i < std::min<size_t>(found, size_t(k_)); ++i) {
+      sw += weight(i);
+      sz += weight(i) * depths_[idx[i]];
     }
-    return sz / sw;
+    const double average = sz / sw;
+    if (model_ != DepthModel::kPlanar || found < 6) return average;
+    // 1/z = c + a·du + b·dv around px (weighted normal equations).
+    Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
+    double lo = 1e300, hi = 0;
+    for (size_t i = 0; i < found; ++i) {
+      const Eigen::Vector2d d = (pixels_[idx[i]] - px) / scale_;
+      const Eigen::Vector3d row(1, d.x(), d.y());
+      const double inv = 1 / depths_[idx[i]];
+      A += weight(i) * row * row.transpose();
+      rhs += weight(i) * inv * row;
+      lo = std::min(lo, inv);
+      hi = std::max(hi, inv);
+    }
+    // Points (nearly) on a line leave the slope across it free: average.
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> spread(A.bottomRightCorner<2, 2>() / A(0, 0));
+    if (spread.eigenvalues()(0) < 1e-2 * spread.eigenvalues()(1)) return average;
+    const double inv = A.ldlt().solve(rhs)(0);
+    // Far from every point a slope would run away: stay within the
+    // neighbours' range widened by half of it on each side.
+    const double margin = 0.5 * (hi - lo);
+    if (!(inv > 0)) return average;
+    return 1 / std::clamp(inv, std::max(lo - margin, 0.5 * lo), hi + margin);
   }
 
  private:
@@ -119,6 +151,8 @@ class DepthField {
   std::vector<double> depths_;
   int k_;
   double scale_;
+  DepthModel model_;
+  int planar_k_;
   PixelCloud cloud_;
   PixelTree tree_;
 };
@@ -584,7 +618,8 @@ Result Run(const Inputs& in, const Options& o) {
     kept_depth = depths;
   }
   res.points_for_depth = int(kept_px.size());
-  const DepthField depth(kept_px, kept_depth, std::max(1, o.depth_neighbours), res.rbf_scale_px);
+  const DepthField depth(kept_px, kept_depth, std::max(1, o.depth_neighbours), res.rbf_scale_px,
+                         o.depth_model, o.planar_neighbours);
   const Eigen::Matrix3d K_inv = cam.K.inverse();
   const Eigen::Matrix3d R_t = cam.R.transpose();
   auto lift = [&](const Eigen::Vector2d& px) -> Eigen::Vector3d {
@@ -700,6 +735,8 @@ Json OptionsToJson(const Options& o) {
       {"grid", std::to_string(o.grid_short) + "x" + std::to_string(o.grid_long)},
       {"depth_neighbours", o.depth_neighbours},
       {"rbf_scale_px", o.rbf_scale_px},
+      {"depth_model", o.depth_model == DepthModel::kPlanar ? "planar" : "average"},
+      {"planar_neighbours", o.planar_neighbours},
       {"depth_outlier", o.depth_outlier},
       {"mask_margin_px", o.mask_margin_px},
       {"min_points", o.min_points},
@@ -709,6 +746,8 @@ Json OptionsToJson(const Options& o) {
        {{"lambda", {r.weights.iso, r.weights.dist, r.weights.fair3d, r.weights.fair2d, 0.0, 0.0}},
         {"beta", {r.beta_point, r.beta_normal}},
         {"outlier_distance", r.outlier_distance},
+        {"unsupported_fairness", r.unsupported_fairness},
+        {"support_radius", r.support_radius},
         {"iso_normalization",
          r.iso_normalization == isometry::IsoNormalization::kStrain ? "strain" : "raw"},
         {"method", r.method == isometry::Method::kGaussNewton ? "gn" : "lbfgs"},
@@ -730,7 +769,10 @@ Json ResultToJson(const Inputs& in, const Result& r, const Options& o, double re
                    {"used_for_depth", r.points_for_depth},
                    {"inliers", r.inliers},
                    {"outliers", r.points_in_region - r.inliers}};
-  doc["depth"] = {{"neighbours", o.depth_neighbours}, {"rbf_scale_px", r.rbf_scale_px}};
+  doc["depth"] = {{"neighbours", o.depth_neighbours},
+                  {"rbf_scale_px", r.rbf_scale_px},
+                  {"model", o.depth_model == DepthModel::kPlanar ? "planar" : "average"},
+                  {"planar_neighbours", o.planar_neighbours}};
   doc["unfold"] = {{"method", "arap"}, {"iterations", r.unfold_iterations}};
   Json refine = isometry::ToJson(r.refine);
   if (!r.refine.iterations.empty()) {

@@ -4,9 +4,10 @@
 //  1. a quad grid M^r on the page in the reference image: a Coons patch of
 //     the four boundary sides (resampled by arc length on the page), else a
 //     grid over the mask's bounding box;
-//  2. the depth of each grid vertex: RBF-weighted depth of its k nearest SfM
-//     points projected into the image (points inside the page region),
-//     lifted to 3D through the reference camera;
+//  2. the depth of each grid vertex from the SfM points projected into the
+//     image (points inside the page region), RBF-weighted: a planar fit of
+//     inverse depth to the nearest (default) or the paper's mean depth of
+//     the k nearest; lifted to 3D through the reference camera;
 //  3. M unfolded to the plane (as-rigid-as-possible) for M';
 //  4. both refined by the joint optimisation with the feature terms off
 //     (isometry, point fitting, fairness, progressive outlier filtering);
@@ -31,6 +32,8 @@ namespace docunfold::init_mesh {
 
 namespace fs = std::filesystem;
 
+enum class DepthModel { kAverage, kPlanar };
+
 struct Options {
   // Grid of M^r in quads: `grid_short` across the page's shorter side,
   // `grid_long` along its longer side (sides measured on the page in 3D).
@@ -42,6 +45,12 @@ struct Options {
   // on the image resolution (1 gives the paper's plain pixels).
   int depth_neighbours = 3;
   double rbf_scale_px = 0;
+  // kAverage is the paper's weighted mean of those k depths. kPlanar fits
+  // 1/depth as an affine function of the pixel to the `planar_neighbours`
+  // nearest (same weights): exact on a plane, so blank margins and gaps
+  // continue their panel's plane instead of taking the nearest text's depth.
+  DepthModel depth_model = DepthModel::kPlanar;
+  int planar_neighbours = 16;
   // Points whose depth differs by more than this fraction from the median
   // depth of their 8 nearest image neighbours are not used for the depth
   // (they still take part in the refinement, where φ decides).
@@ -63,6 +72,10 @@ struct Options {
   // by the image border (set08: the visible region is no quadrilateral on
   // the page, so its grid lines are curves in M' that fairness fights) and
   // 0.01 gives 0.17 % there while changing nothing measurable elsewhere.
+  // λ3 is not stiffened away from the points here (unlike optimize): on
+  // the 12 data sets init + optimize did best without it, and on a folded
+  // page whose fold runs through blank margins it rounds the fold there
+  // (init test BlankMarginsContinueTheirPanels: 0.33 % instead of 0.11 %).
   isometry::SolveOptions refine = [] {
     isometry::SolveOptions o;
     o.weights.fair2d = 0.01;

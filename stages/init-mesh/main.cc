@@ -1,6 +1,7 @@
 // init-mesh --sfm 10_sfm --boundary 20_boundary --out 40_init [options]
 // Writes mesh3d.ply (M), mesh2d.ply (M') and init.json (see init_mesh.h).
 #include <chrono>
+#include <map>
 #include <regex>
 
 #include "common/cli.h"
@@ -33,6 +34,19 @@ int main(int argc, char** argv) {
                  "pixel distance unit of the depth weights 1/(1+r^2); 0 = median spacing of "
                  "the projected points, 1 = plain pixels as in the paper")
       ->capture_default_str()->check(CLI::Range(0.0, 1e6));
+  app.add_option("--depth-model", o.depth_model,
+                 "planar: fit 1/depth as an affine function of the pixel to the nearest "
+                 "--planar-k points (continues each panel's plane over blank paper); average: "
+                 "the weighted mean depth of the --k nearest (the paper)")
+      ->transform(CLI::CheckedTransformer(
+          std::map<std::string, init_mesh::DepthModel>{
+              {"planar", init_mesh::DepthModel::kPlanar},
+              {"average", init_mesh::DepthModel::kAverage}},
+          CLI::ignore_case))
+      ->default_str("planar");
+  app.add_option("--planar-k", o.planar_neighbours,
+                 "nearest SfM points in each planar depth fit")
+      ->capture_default_str()->check(CLI::Range(6, 256));
   app.add_option("--depth-outlier", o.depth_outlier,
                  "points off the median depth of their image neighbours by more than this "
                  "fraction are not used for the depth")
@@ -51,6 +65,14 @@ int main(int argc, char** argv) {
                  "phi: points farther from M than this fraction of the model size are "
                  "ignored (re-decided every iteration)")
       ->capture_default_str()->check(CLI::Range(0.0, 10.0));
+  app.add_option("--unsupported-fairness", o.refine.unsupported_fairness,
+                 "lambda3 is multiplied by up to this where M has no point within "
+                 "--support-radius (blank paper keeps its panel's plane); 1 = off")
+      ->capture_default_str()->check(CLI::Range(1.0, 1e9));
+  app.add_option("--support-radius", o.refine.support_radius,
+                 "distance to the nearest point, along M, beyond which fairness stiffens "
+                 "(fraction of the model size; full at twice this)")
+      ->capture_default_str()->check(CLI::Range(0.0, 1.0));
   app.add_option("--lambda-iso", o.refine.weights.iso, "lambda1, isometry")->capture_default_str();
   app.add_option("--lambda-dist", o.refine.weights.dist, "lambda2, point fitting")
       ->capture_default_str();

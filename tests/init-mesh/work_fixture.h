@@ -5,10 +5,12 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <array>
 #include <string>
 #include <vector>
 
+#include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 
 #include "common/atomic_file.h"
@@ -102,9 +104,12 @@ inline void WriteWorkFromTruth(const GroundTruth& gt, const std::string& referen
 // with flat x below `keep_left_fraction` of the width only, to make pages
 // with missing parts), 10_sfm and 20_boundary written to `work`. Returns the
 // true pair.
-inline MeshPair WriteSyntheticWork(const fs::path& work, int points = 1500,
-                                   double keep_left_fraction = 1.0) {
-  MeshPair sheet = CurledSheet(22, 30, 0.21, 0.297, 0.2);
+// `sheet` (around z = 1, long side down the image) brought nearer, turned so
+// its long side runs across the image, `points` SfM points on it (those
+// whose flat position `keep` accepts), 10_sfm and 20_boundary written to
+// `work`. Returns the pair as placed.
+template <class Keep>
+MeshPair WriteSheetWork(const fs::path& work, MeshPair sheet, int points, const Keep& keep) {
   for (auto& v : sheet.mesh3d) v.z() = 0.45 + 0.45 * (v.z() - 1.0) + 0.0;  // nearer camera
   PinholeCamera cam;
   cam.image = "ref.jpg";
@@ -128,7 +133,7 @@ inline MeshPair WriteSyntheticWork(const fs::path& work, int points = 1500,
         best = (sheet.mesh3d[i] - p).norm();
         vi = int(i);
       }
-    if (sheet.mesh2d[vi].x() <= keep_left_fraction * 0.21) cloud.vertices.push_back(p);
+    if (keep(sheet.mesh2d[vi])) cloud.vertices.push_back(p);
   }
   cloud.colors.assign(cloud.vertices.size(), {100, 100, 100});
   EnsureDirectory(work / "10_sfm");
@@ -152,6 +157,34 @@ inline MeshPair WriteSyntheticWork(const fs::path& work, int points = 1500,
   cv::Mat1b mask = raster.face >= 0;
   WriteBoundary(work / "20_boundary", "reference.png", cam.width, cam.height, sides, mask);
   return sheet;
+}
+
+inline MeshPair WriteSyntheticWork(const fs::path& work, int points = 1500,
+                                   double keep_left_fraction = 1.0) {
+  return WriteSheetWork(work, CurledSheet(22, 30, 0.21, 0.297, 0.2), points,
+                        [&](const Eigen::Vector2d& flat) {
+                          return flat.x() <= keep_left_fraction * 0.21;
+                        });
+}
+
+// A page folded by `fold_deg` down its middle and tilted by `tilt_deg` about
+// the fold's normal direction, with points only inside a text block that
+// leaves `margin` (fraction of each side) blank all round, as printed pages do.
+inline MeshPair WriteFoldedPageWithMarginsWork(const fs::path& work, double fold_deg,
+                                               double tilt_deg, double margin) {
+  const int nx = 22, ny = 30;
+  const double w = 0.21, h = 0.297;
+  MeshPair sheet = ProfileSheet(nx, ny, w, h, [&](int c) {
+    return c == nx / 2 - 1 ? fold_deg * M_PI / 180 : 0.0;
+  });
+  const Eigen::Matrix3d tilt =
+      Eigen::AngleAxisd(tilt_deg * M_PI / 180, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  const Eigen::Vector3d centre(0, 0, 1);
+  for (auto& v : sheet.mesh3d) v = centre + tilt * (v - centre);
+  return WriteSheetWork(work, sheet, 2500, [&](const Eigen::Vector2d& flat) {
+    return flat.x() >= margin * w && flat.x() <= (1 - margin) * w && flat.y() >= margin * h &&
+           flat.y() <= (1 - margin) * h;
+  });
 }
 
 // The command line pipeline.mk uses, on a work folder.
