@@ -43,6 +43,7 @@
 
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -117,6 +118,14 @@ struct SolveOptions {
   // iteration (progressive filtering). <= 0 keeps every point.
   double outlier_distance = 0.06;
   IsoNormalization iso_normalization = IsoNormalization::kStrain;
+  // λ3 is multiplied by up to this where M has no inlier point within
+  // support_radius (fraction of the model size, along M), reaching it at
+  // twice that distance: blank paper then continues its panel's plane
+  // instead of drifting (the paper's λ3 is tiny so creases stay sharp,
+  // which leaves regions without points almost unconstrained). Decided at
+  // the start of each solve (then held, so F stays one function). 1 = off.
+  double unsupported_fairness = 1;
+  double support_radius = 0.03;
 
   Method method = Method::kGaussNewton;
   // Direct CHOLMOD factorisation up to direct_max_vertices (the 21x31 first
@@ -166,6 +175,10 @@ struct TermValues {
 struct IterationReport {
   int iteration = 0;
   double F = 0;         // Σ λ_k E_k after footpoints/outliers/lines were updated
+  // F after this iteration's step with the same footpoints, outliers,
+  // markers and lines (what the step minimises): never above F. The next
+  // iteration's F differs from it by re-deciding those (NaN: no step taken).
+  double F_after_step = std::numeric_limits<double>::quiet_NaN();
   TermValues terms;
   int inliers = 0;      // points within φ of M
   int outliers = 0;

@@ -4,7 +4,9 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <functional>
 #include <memory>
+#include <queue>
 #include <stdexcept>
 #include <string>
 
@@ -54,8 +56,8 @@ TermValues EvaluateTerms(const State& s, const StepData& data, int threads) {
     for (int p = 0; p < points; ++p) AddSquares(rows, DistRows(s, data, p, rows), &dist);
 #pragma omp for schedule(static) reduction(+ : fair3d, fair2d) nowait
     for (int t = 0; t < triplets; ++t) {
-      AddSquares(rows, FairRows(s, t, false, rows), &fair3d);
-      AddSquares(rows, FairRows(s, t, true, rows), &fair2d);
+      AddSquares(rows, FairRows(s, data, t, false, rows), &fair3d);
+      AddSquares(rows, FairRows(s, data, t, true, rows), &fair2d);
     }
 #pragma omp for schedule(static) reduction(+ : line, ray) nowait
     for (int m = 0; m < markers; ++m) {
@@ -247,6 +249,50 @@ void UpdateFootpoints(const State& s, StepData& data, double phi, int threads) {
   data.num_inliers = inliers;
 }
 
+// E_fair(M)'s per-vertex multiplier: 1 within `radius` (model-size units,
+// along the grid's edges on M) of a triangle holding an inlier footpoint,
+// rising linearly to `boost` at twice that distance. Where no point is near
+// (blank margins, gaps between columns) nothing else holds M's shape, and
+// the paper's tiny λ3 lets it drift; near points it keeps creases sharp.
+void UpdateFairScale(const State& s, StepData& data, double boost, double radius) {
+  if (boost == 1 || radius <= 0) {
+    data.fair3d_scale.clear();
+    return;
+  }
+  const QuadGrid& g = s.grid;
+  const int n = g.NumVertices();
+  std::vector<double> distance(n, std::numeric_limits<double>::infinity());
+  using Item = std::pair<double, int>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
+  for (const internal::Footpoint& f : data.footpoints) {
+    if (!f.inlier || f.triangle < 0) continue;
+    for (int v : internal::TriangleOf(g, f.triangle))
+      if (distance[v] > 0) {
+        distance[v] = 0;
+        queue.push({0, v});
+      }
+  }
+  while (!queue.empty()) {
+    const auto [d, v] = queue.top();
+    queue.pop();
+    if (d > distance[v] || d > 2 * radius) continue;
+    const int r = v / g.nx, c = v % g.nx;
+    const int next[4][2] = {{r - 1, c}, {r + 1, c}, {r, c - 1}, {r, c + 1}};
+    for (const auto& rc : next) {
+      if (rc[0] < 0 || rc[1] < 0 || rc[0] >= g.ny || rc[1] >= g.nx) continue;
+      const int u = g.Index(rc[0], rc[1]);
+      const double du = d + (s.v3[u] - s.v3[v]).norm();
+      if (du < distance[u]) {
+        distance[u] = du;
+        queue.push({du, u});
+      }
+    }
+  }
+  data.fair3d_scale.resize(n);
+  for (int v = 0; v < n; ++v)
+    data.fair3d_scale[v] = 1 + (boost - 1) * std::clamp(distance[v] / radius - 1, 0.0, 1.0);
+}
+
 Eigen::Vector2d FlatPoint(const State& s, const SurfacePoint& w) {
   const Triangle t = internal::TriangleOf(s.grid, w.triangle);
   return w.bary[0] * s.v2[t[0]] + w.bary[1] * s.v2[t[1]] + w.bary[2] * s.v2[t[2]];
@@ -413,11 +459,11 @@ class GaussNewton {
           for (int k = colour; k < per_line; k += 3) {
             const int t = (phase == 0 ? 0 : along_rows) + l * per_line + k;
             if (w.fair3d > 0) {
-              const int m = internal::FairRows(s, t, false, rows);
+              const int m = internal::FairRows(s, data, t, false, rows);
               for (int i = 0; i < m; ++i) f += add(w.fair3d, rows[i]);
             }
             if (w.fair2d > 0) {
-              const int m = internal::FairRows(s, t, true, rows);
+              const int m = internal::FairRows(s, data, t, true, rows);
               for (int i = 0; i < m; ++i) f += add(w.fair2d, rows[i]);
             }
           }
@@ -632,6 +678,7 @@ Json IterationJson(const IterationReport& it) {
   j["linear_iterations"] = it.linear_iterations;
   j["damping"] = it.damping;
   j["step_accepted"] = it.step_accepted;
+  if (std::isfinite(it.F_after_step)) j["F_after_step"] = it.F_after_step;
   return j;
 }
 
@@ -697,6 +744,9 @@ Result Solve(const Problem& problem, const SolveOptions& o) {
     ir.iteration = it;
     auto t0 = Clock::now();
     UpdateFootpoints(w.state, w.data, o.outlier_distance, threads);
+    // Where the points are is decided once per solve: re-deciding it as
+    // footpoints move would change F's weights under the iterations.
+    if (it == 0) UpdateFairScale(w.state, w.data, o.unsupported_fairness, o.support_radius);
     // The callback first: it may regroup markers into new lines, which are
     // then fitted and projected onto like any others.
     if (o.on_outer_iteration) {
@@ -747,6 +797,7 @@ Result Solve(const Problem& problem, const SolveOptions& o) {
       ir.step_accepted = LbfgsStep(w.state, w.data, w.weights, o, &ir.linear_iterations);
     }
     ir.step_seconds = Since(t1);
+    ir.F_after_step = SurrogateF(w.state, w.data, w.weights, threads);
     ir.seconds = Since(start);
     report.iterations.push_back(ir);
     f_previous = ir.F;

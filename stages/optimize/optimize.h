@@ -22,6 +22,10 @@ struct OptimizeOptions {
   double relative_tolerance = 0.01;   // inner loop stops when |ΔF/F| < this (ε)
   int max_outer_iterations = 100;     // ... or after this many outer iterations (Q)
   double outlier_distance = 0.06;     // φ, fraction of the model size
+  // λ3 × up to this far from every point (isometry::SolveOptions); 1 is
+  // the paper. 100 measured best of 1, 30, 100, 1000 (README, "Blank paper").
+  double unsupported_fairness = 100;
+  double support_radius = 0.03;       // fraction of the model size
   isometry::Method method = isometry::Method::kGaussNewton;
   isometry::LinearSolver linear_solver = isometry::LinearSolver::kAuto;
   bool features = true;        // false: no feature lines at all (--no-features)
