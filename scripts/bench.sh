@@ -24,6 +24,9 @@
 #   BENCH_JOBS=N         data sets run side by side (default 1: timings are
 #                        then undisturbed; the end-to-end tests use 2)
 #   BENCH_ONLY="row ..." make only these built-in rows (default: all)
+#   BENCH_SOLVER_SET=name the set on which optimize runs once with Gauss-Newton
+#                        and once with L-BFGS on the same inputs (default: set05
+#                        when benched, else the first set; "none" skips it)
 #   BENCH_ROWS="name=path/in/work.png[:mesh dir in work] ..."
 #                        further rows: any image the pipeline leaves in the work
 #                        directory, evaluated like the others
@@ -241,7 +244,31 @@ for i in "${!data_dirs[@]}"; do
 done
 wait
 
+# Gauss-Newton against L-BFGS: optimize twice on one set's inputs, nothing
+# else running; bench_report.py reads both log.json files (time to reach the
+# same F in the last round).
+solver_set=${BENCH_SOLVER_SET:-}
+if [[ -z $solver_set ]]; then
+  solver_set=${names[0]}
+  for n in "${names[@]}"; do [[ $n == set05 ]] && solver_set=set05; done
+fi
+solver_args=()
+if [[ $solver_set != none ]] && have optimize; then
+  sw=$bench_work/$solver_set
+  if [[ -f $sw/40_init/mesh3d.ply && -f $sw/30_features/features.json ]]; then
+    for solver in gn lbfgs; do
+      echo "bench: optimize --solver $solver on $solver_set" >&2
+      "$timer" "$sw/bench/timings.jsonl" "solver:$solver" "$bin/optimize" --sfm "$sw/10_sfm" \
+        --boundary "$sw/20_boundary" --features "$sw/30_features/features.json" \
+        --init "$sw/40_init" --out "$sw/bench/solver_$solver" --solver "$solver" --no-scene \
+        >> "$sw/bench/solver_$solver.log" 2>&1 || echo "bench: optimize --solver $solver failed" >&2
+    done
+    solver_args=(--solver-set "$solver_set")
+  fi
+fi
+
 args=()
 for i in "${!data_dirs[@]}"; do args+=("${names[$i]}=${data_dirs[$i]}"); done
 /usr/bin/python3 "$root/scripts/bench_report.py" --root "$root" --work "$bench_work" \
-  --out "$bench_out" --frontend "$frontend" --eval-flags="${eval_flags[*]}" "${args[@]}"
+  --out "$bench_out" --frontend "$frontend" --eval-flags="${eval_flags[*]}" \
+  "${solver_args[@]}" "${args[@]}"

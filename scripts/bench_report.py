@@ -169,6 +169,32 @@ def collect_set(name, data, work):
             "stages": stages, "rows": rows}
 
 
+def collect_solvers(work, name):
+    """Gauss-Newton vs L-BFGS on one set: per solver the wall time, the final
+    F of each round, and the time at which the last round first reached the
+    worse of the two final Fs (the F both reach)."""
+    logs = {}
+    for solver in ("gn", "lbfgs"):
+        path = os.path.join(work, name, "bench", "solver_" + solver, "log.json")
+        if not os.path.exists(path):
+            return None
+        with open(path) as f:
+            logs[solver] = json.load(f)
+    finals = {s: l["rounds"][-1]["iterations"][-1]["F"] for s, l in logs.items()}
+    target = max(finals.values())
+    out = {"set": name, "target_F": target, "solvers": []}
+    for solver, log in logs.items():
+        last = log["rounds"][-1]["iterations"]
+        reached = next((it["seconds"] for it in last if it["F"] <= target * (1 + 1e-9)), None)
+        out["solvers"].append({
+            "solver": solver, "method": log["rounds"][-1]["solver"].get("method"),
+            "seconds": log["seconds"], "final_F": finals[solver],
+            "seconds_to_target": reached,
+            "iterations": sum(len(r["iterations"]) for r in log["rounds"]),
+            "round_F": [r["iterations"][-1]["F"] for r in log["rounds"]]})
+    return out
+
+
 def summarize(sets):
     methods = []
     for s in sets:
@@ -285,6 +311,20 @@ def markdown(result):
             " in " + s["pipeline"]["failed_stage"] if s["pipeline"]["failed_stage"] else "",
             os.path.join(result["work"], s["name"], "bench", "pipeline.log")))
 
+    sv = result.get("solvers")
+    if sv:
+        lines += ["", "## Gauss-Newton against L-BFGS (optimize on %s)" % sv["set"], "",
+                  "Both solvers on the same inputs with the default schedule, nothing else "
+                  "running. *to F\\** = wall time at which the last round first reached "
+                  "F\\* = %.4g, the worse of the two final values." % sv["target_F"], "",
+                  "| solver | method (last round) | total s | outer iterations | final F | "
+                  "to F\\* s | F after each round |", "|---|---|---:|---:|---:|---:|---|"]
+        for s in sv["solvers"]:
+            lines.append("| %s | %s | %.1f | %d | %.4g | %s | %s |" % (
+                s["solver"], s["method"], s["seconds"], s["iterations"], s["final_F"],
+                fmt(s["seconds_to_target"], "%.1f"),
+                ", ".join("%.3g" % f for f in s["round_F"])))
+
     lines += ["", "## Making and evaluating each row", "",
               "| set | method | make s / MB | evaluate s / MB |", "|---|---|---:|---:|"]
     for s in sets:
@@ -307,6 +347,8 @@ def main():
     p.add_argument("--out", required=True)
     p.add_argument("--frontend", default="pipeline", choices=["pipeline", "truth"])
     p.add_argument("--eval-flags", default="")
+    p.add_argument("--solver-set", default=None,
+                   help="set whose bench/solver_{gn,lbfgs}/log.json compare the solvers")
     p.add_argument("sets", nargs="+", help="NAME=DATA_DIR")
     a = p.parse_args()
     sets = []
@@ -326,6 +368,10 @@ def main():
         "sets": sets,
         "summary": summarize(sets),
     }
+    if a.solver_set:
+        solvers = collect_solvers(a.work, a.solver_set)
+        if solvers:
+            result["solvers"] = solvers
     os.makedirs(a.out, exist_ok=True)
     # NaN never reaches JSON: evaluate writes null for figures it lacks.
     with open(os.path.join(a.out, "results.json.tmp"), "w") as f:

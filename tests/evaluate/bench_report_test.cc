@@ -5,6 +5,8 @@
 
 #include <fstream>
 #include <sstream>
+#include <utility>
+#include <vector>
 
 #include <opencv2/imgcodecs.hpp>
 
@@ -57,11 +59,28 @@ TEST(BenchReport, WritesValidJsonAndAReadableTable) {
       << (work / "70_eval" / "metrics-homography.json").string() << "\t\t\n"
       << "docunfold\tfailed\t\t\t\tevaluate failed: boom\n";
 
+  // The two solvers' logs (optimize log.json, only what the report reads):
+  // L-BFGS ends higher, so F* is its final F; Gauss-Newton reached it at 2 s.
+  auto solver_log = [](double seconds, std::vector<std::pair<double, double>> last) {
+    Json its = Json::array();
+    for (const auto& [t, f] : last) its.push_back({{"seconds", t}, {"F", f}});
+    return Json{{"seconds", seconds},
+                {"rounds", {{{"iterations", {{{"seconds", 0.5}, {"F", 9.0}}}},
+                             {"solver", {{"method", "x"}}}},
+                            {{"iterations", its}, {"solver", {{"method", "y"}}}}}}};
+  };
+  fs::create_directories(work / "bench" / "solver_gn");
+  fs::create_directories(work / "bench" / "solver_lbfgs");
+  std::ofstream(work / "bench" / "solver_gn" / "log.json")
+      << solver_log(3, {{1, 5.0}, {2, 3.9}, {3, 3.5}}).dump();
+  std::ofstream(work / "bench" / "solver_lbfgs" / "log.json")
+      << solver_log(20, {{5, 6.0}, {20, 4.0}}).dump();
+
   const fs::path out = dir / "out";
   CommandResult r = RunCommand(
       "/usr/bin/python3 " + Quote((SourceDir() / "scripts" / "bench_report.py").string()) +
       " --root " + Quote(SourceDir().string()) + " --work " + Quote((dir / "work").string()) +
-      " --out " + Quote(out.string()) + " --frontend truth --eval-flags=--ocr-at-truth-size setA=" +
+      " --out " + Quote(out.string()) + " --frontend truth --eval-flags=--ocr-at-truth-size --solver-set setA setA=" +
       Quote(data.string()));
   ASSERT_EQ(r.exit_code, 0) << r.output;
 
@@ -92,6 +111,12 @@ TEST(BenchReport, WritesValidJsonAndAReadableTable) {
   EXPECT_NE(md.find("Front end: **ground truth**"), std::string::npos) << md;
   EXPECT_NE(md.find("on the result resized to flat.png's size"), std::string::npos) << md;
   EXPECT_EQ(j["producer"]["options"]["eval_flags"], "--ocr-at-truth-size");
+  // Solvers: F* = 4 (the worse final F); GN reached it at 2 s, L-BFGS at 20 s.
+  EXPECT_EQ(j["solvers"]["target_F"], 4.0);
+  EXPECT_EQ(j["solvers"]["solvers"][0]["seconds_to_target"], 2.0);
+  EXPECT_EQ(j["solvers"]["solvers"][1]["seconds_to_target"], 20.0);
+  EXPECT_EQ(j["solvers"]["solvers"][0]["iterations"], 4);
+  EXPECT_NE(md.find("| gn | y | 3.0 | 4 | 3.5 | 2.0 | 9, 3.5 |"), std::string::npos) << md;
 }
 
 }  // namespace
