@@ -225,7 +225,25 @@ SfmFigures MeasureSfm(const fs::path& sfm_dir, const GroundTruth& gt) {
     }
   f.registered = int(src.size());
   if (src.size() < 3) return f;
-  const Eigen::Matrix4d T = Umeyama(src, dst);
+  // Centres alone leave the rotation about their centroid weakly held when
+  // there are few views, and the page, half a metre in front of them, moves
+  // with it: add each camera's point at the page's distance along its
+  // optical axis (the true distance, and that over the centres' scale on
+  // sfm's side), so the cameras' orientations hold it too.
+  Eigen::Matrix4d T = Umeyama(src, dst);
+  {
+    Eigen::Vector3d page_centre = Eigen::Vector3d::Zero();
+    for (const auto& v : gt.mesh.vertices) page_centre += v / double(gt.mesh.vertices.size());
+    const double scale = T.block<3, 1>(0, 0).norm();
+    std::vector<Eigen::Vector3d> src2 = src, dst2 = dst;
+    for (const PinholeCamera& c : sfm.views)
+      if (const PinholeCamera* t = gt.cameras.Find(c.image)) {
+        const double d = (page_centre - t->Center()).norm();
+        dst2.push_back(t->Center() + d * t->R.row(2).transpose());
+        src2.push_back(c.Center() + d / scale * c.R.row(2).transpose());
+      }
+    T = Umeyama(src2, dst2);
+  }
   double sum = 0;
   for (size_t i = 0; i < src.size(); ++i) sum += (Apply(T, src[i]) - dst[i]).squaredNorm();
   f.camera_rms = std::sqrt(sum / src.size()) / diag;
