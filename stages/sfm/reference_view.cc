@@ -24,8 +24,7 @@ using KdTree = nanoflann::KDTreeSingleIndexAdaptor<
     nanoflann::L2_Simple_Adaptor<double, PointCloudAdaptor>, PointCloudAdaptor,
     3, size_t>;
 
-// Weighted median of (value, weight) pairs; 0 when empty.
-// The q-quantile of (value, weight) pairs.
+// The weighted q-quantile of (value, weight) pairs; 0 when empty.
 double WeightedQuantile(std::vector<std::pair<double, double>> v, double q) {
   if (v.empty()) return 0;
   std::sort(v.begin(), v.end());
@@ -298,7 +297,7 @@ std::vector<ViewScore> ScoreReferenceViews(const ColmapModel& model,
     if ((cameras_mean - xyz[i]).dot(oriented[i]) < 0) oriented[i] = -oriented[i];
 
   std::vector<ViewScore> scores;
-  double max_pixels = 1e-300, max_resolution = 1e-300;
+  double max_resolution = 1e-300;
   for (const auto& [id, image] : model.images) {
     const ColmapCamera& camera = model.cameras.at(image.camera_id);
     const Eigen::Matrix3d R = image.R();
@@ -343,7 +342,6 @@ std::vector<ViewScore> ScoreReferenceViews(const ColmapModel& model,
     s.resolution = WeightedQuantile(std::move(resolution), options.resolution_quantile);
     s.hidden = total_area > 0 ? hidden_area / total_area : 0;
     s.coverage = page_indices.empty() ? 0 : double(inside) / double(page_indices.size());
-    max_pixels = std::max(max_pixels, s.page_pixels);
     max_resolution = std::max(max_resolution, s.resolution);
     scores.push_back(s);
   }
