@@ -72,10 +72,10 @@ struct Options {
   // by the image border (set08: the visible region is no quadrilateral on
   // the page, so its grid lines are curves in M' that fairness fights) and
   // 0.01 gives 0.17 % there while changing nothing measurable elsewhere.
-  // λ3 is not stiffened away from the points here (unlike optimize): on
-  // the 12 data sets init + optimize did best without it, and on a folded
-  // page whose fold runs through blank margins it rounds the fold there
-  // (init test BlankMarginsContinueTheirPanels: 0.33 % instead of 0.11 %).
+  // λ3 is not stiffened away from the points (unsupported_fairness, off
+  // here as in optimize): on a folded page whose fold runs through blank
+  // margins it rounds the fold there (init test
+  // BlankMarginsContinueTheirPanels: 0.33 % instead of 0.11 %).
   isometry::SolveOptions refine = [] {
     isometry::SolveOptions o;
     o.weights.fair2d = 0.01;
