@@ -102,4 +102,16 @@ double SecondsSince(std::chrono::steady_clock::time_point start) {
       .count();
 }
 
+void AddFairnessBoostOptions(CLI::App& app, double* unsupported_fairness,
+                             double* support_radius) {
+  app.add_option("--unsupported-fairness", *unsupported_fairness,
+                 "lambda3 is multiplied by up to this where M has no point within "
+                 "--support-radius (blank paper keeps its panel's plane); 1 = off")
+      ->capture_default_str()->check(CLI::Range(1.0, 1e9));
+  app.add_option("--support-radius", *support_radius,
+                 "distance to the nearest point, along M, beyond which fairness stiffens "
+                 "(fraction of the model size; full at twice this)")
+      ->capture_default_str()->check(CLI::Range(0.0, 1.0));
+}
+
 }  // namespace docunfold

@@ -31,6 +31,11 @@ int RunStage(const std::string& program, CLI::App& app, int argc, char** argv,
 // thing in main; returns normally when nothing needs doing or exec fails).
 void LimitOpenMpThreads(char** argv);
 
+// --unsupported-fairness and --support-radius, the same in every stage that
+// runs the isometric solver (isometry::SolveOptions documents them).
+void AddFairnessBoostOptions(CLI::App& app, double* unsupported_fairness,
+                             double* support_radius);
+
 // One plain line on stderr: "<program>: <message>".
 void Log(const std::string& message);
 

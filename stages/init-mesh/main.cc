@@ -65,14 +65,7 @@ int main(int argc, char** argv) {
                  "phi: points farther from M than this fraction of the model size are "
                  "ignored (re-decided every iteration)")
       ->capture_default_str()->check(CLI::Range(0.0, 10.0));
-  app.add_option("--unsupported-fairness", o.refine.unsupported_fairness,
-                 "lambda3 is multiplied by up to this where M has no point within "
-                 "--support-radius (blank paper keeps its panel's plane); 1 = off")
-      ->capture_default_str()->check(CLI::Range(1.0, 1e9));
-  app.add_option("--support-radius", o.refine.support_radius,
-                 "distance to the nearest point, along M, beyond which fairness stiffens "
-                 "(fraction of the model size; full at twice this)")
-      ->capture_default_str()->check(CLI::Range(0.0, 1.0));
+  AddFairnessBoostOptions(app, &o.refine.unsupported_fairness, &o.refine.support_radius);
   app.add_option("--lambda-iso", o.refine.weights.iso, "lambda1, isometry")->capture_default_str();
   app.add_option("--lambda-dist", o.refine.weights.dist, "lambda2, point fitting")
       ->capture_default_str();

@@ -46,14 +46,7 @@ int main(int argc, char** argv) {
   app.add_option("--outlier-distance", o.outlier_distance,
                  "points farther from M than this fraction of the model size are ignored")
       ->capture_default_str();
-  app.add_option("--unsupported-fairness", o.unsupported_fairness,
-                 "λ3 is multiplied by up to this where M has no point within "
-                 "--support-radius (blank paper keeps its panel's plane); 1 = off")
-      ->capture_default_str()->check(CLI::Range(1.0, 1e9));
-  app.add_option("--support-radius", o.support_radius,
-                 "distance to the nearest point, along M, beyond which fairness stiffens "
-                 "(fraction of the model size; full at twice this)")
-      ->capture_default_str()->check(CLI::Range(0.0, 1.0));
+  AddFairnessBoostOptions(app, &o.unsupported_fairness, &o.support_radius);
   app.add_option("--solver", solver, "gn (Gauss-Newton/LM, sparse Cholesky) or lbfgs")
       ->capture_default_str();
   app.add_option("--linear-solver", linear,
