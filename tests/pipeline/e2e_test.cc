@@ -121,12 +121,12 @@ class EndToEnd : public ::testing::TestWithParam<std::string> {
     ref_.t = (ref->R * sim_.t + ref->t) / sim_.s;
   }
 
-  // Pixels of the reference photo (as its true camera projects) moved to
+  // Lines in pixels of the reference photo (as its true camera projects) moved to
   // reference.png, which sfm undistorted with its own intrinsics and radial
   // distortion: true lines placed this way measure the detector alone, not
   // sfm's camera error as well (a 0.4 % focal error is 2 px at 500 px).
-  std::vector<Eigen::Vector2d> PhotoToReference(const std::vector<Eigen::Vector2d>& photo) const {
-    if (photo.empty()) return photo;
+  std::vector<std::vector<Eigen::Vector2d>> PhotoToReference(
+      const std::vector<std::vector<Eigen::Vector2d>>& lines) const {
     const Json cameras = ReadJsonFile(work_ / "10_sfm/cameras.json");
     const std::string model = cameras["colmap"].value("camera_model", "PINHOLE");
     const Json& params = cameras["colmap"]["params"];
@@ -140,11 +140,14 @@ class EndToEnd : public ::testing::TestWithParam<std::string> {
     cv::Mat K(3, 3, CV_64F);
     for (int r = 0; r < 3; ++r)
       for (int c = 0; c < 3; ++c) K.at<double>(r, c) = ours->K(r, c);
-    std::vector<cv::Point2d> in, out;
-    for (const auto& p : photo) in.emplace_back(p.x(), p.y());
-    cv::undistortPoints(in, out, K, dist, cv::noArray(), K);
-    std::vector<Eigen::Vector2d> moved;
-    for (const auto& p : out) moved.emplace_back(p.x, p.y);
+    std::vector<std::vector<Eigen::Vector2d>> moved;
+    for (const auto& line : lines) {
+      std::vector<cv::Point2d> in, out;
+      for (const auto& p : line) in.emplace_back(p.x(), p.y());
+      if (!in.empty()) cv::undistortPoints(in, out, K, dist, cv::noArray(), K);
+      moved.emplace_back();
+      for (const auto& p : out) moved.back().emplace_back(p.x, p.y);
+    }
     return moved;
   }
 
@@ -217,8 +220,13 @@ TEST_P(EndToEnd, FeatureSegmentsLieOnTrueLines) {
   double true_length = 0;
   const PinholeCamera* photo = gt_.cameras.Find(sfm_.reference);
   ASSERT_NE(photo, nullptr) << set_;
-  for (const TrueLine& l : TrueLinesInView(view_gt, *photo, 2.0)) {
-    (l.kind == "text" ? text : edge).push_back(PhotoToReference(l.points));
+  const std::vector<TrueLine> in_photo = TrueLinesInView(view_gt, *photo, 2.0);
+  std::vector<std::vector<Eigen::Vector2d>> photo_points;
+  for (const TrueLine& l : in_photo) photo_points.push_back(l.points);
+  const auto in_reference = PhotoToReference(photo_points);
+  for (size_t i = 0; i < in_photo.size(); ++i) {
+    const TrueLine& l = in_photo[i];
+    (l.kind == "text" ? text : edge).push_back(in_reference[i]);
     if (l.kind != "border")
       for (size_t k = 1; k < l.points.size(); ++k) true_length += (l.points[k] - l.points[k - 1]).norm();
   }
