@@ -190,6 +190,33 @@ TEST(CornerHelpers, FoldKinksAreNotCornersWhenTheFoldIsSeen) {
     EXPECT_LE(cv::norm(contour[idx[i]] - expected[i]), 3.0) << i << " " << contour[idx[i]];
 }
 
+TEST(CornerHelpers, ASideAlongAShadedFlapIsNoFold) {
+  // Page corners (100,100) (600,100) (600,500) (100,500); the left side
+  // bulges out over a flap (kinks of 27 degrees at (40,220) and (40,380),
+  // 8 % of the area) whose shading differs, so the shading test calls the
+  // chord between the two left corners a fold (set05's reference view).
+  std::vector<cv::Point> contour;
+  auto edge = [&](cv::Point a, cv::Point b) {
+    const int n = std::max(std::abs(b.x - a.x), std::abs(b.y - a.y));
+    for (int k = 0; k < n; ++k) contour.emplace_back(a + (b - a) * (double(k) / n));
+  };
+  edge({100, 100}, {600, 100});
+  edge({600, 100}, {600, 500});
+  edge({600, 500}, {100, 500});
+  edge({100, 500}, {40, 380});
+  edge({40, 380}, {40, 220});
+  edge({40, 220}, {100, 100});
+  const auto near = [](const cv::Point& p, const cv::Point& q) { return cv::norm(p - q) <= 3; };
+  const detail::FoldTest shaded_chord = [&](const cv::Point& a, const cv::Point& b) {
+    return (near(a, {100, 100}) && near(b, {100, 500})) ||
+           (near(b, {100, 100}) && near(a, {100, 500}));
+  };
+  const std::vector<cv::Point> expected = {{100, 100}, {600, 100}, {600, 500}, {100, 500}};
+  const auto idx = detail::FindCornerIndices(contour, shaded_chord);
+  for (int i = 0; i < 4; ++i)
+    EXPECT_LE(cv::norm(contour[idx[i]] - expected[i]), 3.0) << i << " " << contour[idx[i]];
+}
+
 TEST(CornerHelpers, ShadingStepTellsAFoldFromAFlatPageAndASide) {
   // The folded page of FoldedPageOutline: panel above y = 140 darker.
   cv::Mat1b mask = cv::Mat1b::zeros(560, 700);
