@@ -39,6 +39,10 @@ FEATURES_FLAGS ?=
 # FEATURES=file.json: use another detector's feature segments instead of
 # running detect-features (validated against schemas/, then copied).
 FEATURES ?=
+DENSIFY_FLAGS ?=
+# DENSIFY=0: init-mesh and optimize fit sfm's sparse points only (the paper's
+# input) instead of 25_points/points.ply.
+DENSIFY ?= 1
 INIT_FLAGS ?=
 OPTIMIZE_FLAGS ?=
 RENDER_FLAGS ?=
@@ -61,12 +65,15 @@ endef
 $(eval $(call flags_rule,sfm,$(SFM_FLAGS) $(if $(REF),--ref $(REF))))
 $(eval $(call flags_rule,boundary,$(BOUNDARY_FLAGS)))
 $(eval $(call flags_rule,features,$(if $(FEATURES),FEATURES=$(abspath $(FEATURES)),$(FEATURES_FLAGS))))
-$(eval $(call flags_rule,init,$(INIT_FLAGS)))
-$(eval $(call flags_rule,optimize,$(OPTIMIZE_FLAGS)))
+# The point cloud init-mesh and optimize fit: densify's when it is built in.
+POINTS_FILE := $(if $(and $(wildcard $(ROOT)/stages/densify),$(filter-out 0,$(DENSIFY))),$(WORK)/25_points/points.ply,$(WORK)/10_sfm/points.ply)
+$(eval $(call flags_rule,points,$(DENSIFY_FLAGS)))
+$(eval $(call flags_rule,init,$(INIT_FLAGS) points=$(POINTS_FILE)))
+$(eval $(call flags_rule,optimize,$(OPTIMIZE_FLAGS) points=$(POINTS_FILE)))
 $(eval $(call flags_rule,render,$(RENDER_FLAGS)))
 $(eval $(call flags_rule,evaluate,$(EVAL_FLAGS)))
 
-.PHONY: all sfm boundary features init optimize render evaluate report help clean deps build test bench check-data FORCE
+.PHONY: all sfm boundary points features init optimize render evaluate report help clean deps build test bench check-data FORCE
 FORCE:
 
 # ---- build ----------------------------------------------------------------------
@@ -105,7 +112,7 @@ bench: build
 # The chain of stages, in order. `all` runs every stage whose program exists
 # in stages/ (so the pipeline runs as far as it is implemented), plus
 # evaluate when the data set has ground truth.
-CHAIN := sfm:sfm boundary:segment-boundary features:detect-features \
+CHAIN := sfm:sfm boundary:segment-boundary points:densify features:detect-features \
   init:init-mesh optimize:optimize render:render
 IMPLEMENTED := $(foreach s,$(CHAIN),$(if $(wildcard $(ROOT)/stages/$(word 2,$(subst :, ,$(s)))),$(word 1,$(subst :, ,$(s)))))
 HAS_GT := $(wildcard $(DATA_DIR)/ground_truth/flat.png)
@@ -124,6 +131,11 @@ BOUNDARY_OUT := $(addprefix $(WORK)/20_boundary/,boundary.json mask.png overlay.
 boundary: check-data $(BOUNDARY_OUT)
 $(BOUNDARY_OUT) &: $(BIN)/segment-boundary $(WORK)/.flags/boundary $(WORK)/10_sfm/reference.png
 	$(call timed,segment-boundary) $(BIN)/segment-boundary --image $(WORK)/10_sfm/reference.png --out $(WORK)/20_boundary $(BOUNDARY_FLAGS)
+
+POINTS_OUT := $(addprefix $(WORK)/25_points/,points.ply points.json overlay.png)
+points: check-data boundary $(POINTS_OUT)
+$(POINTS_OUT) &: $(BIN)/densify $(WORK)/.flags/points $(WORK)/10_sfm/cameras.json $(WORK)/10_sfm/points.ply $(WORK)/10_sfm/reference.png $(WORK)/20_boundary/boundary.json $(WORK)/20_boundary/mask.png $(IMAGES)
+	$(call timed,densify) $(BIN)/densify --data $(DATA_DIR) --sfm $(WORK)/10_sfm --boundary $(WORK)/20_boundary --out $(WORK)/25_points $(DENSIFY_FLAGS)
 
 ifeq ($(FEATURES),)
 FEATURES_OUT := $(addprefix $(WORK)/30_features/,features.json overlay.png)
@@ -144,14 +156,14 @@ SFM_IN := $(addprefix $(WORK)/10_sfm/,cameras.json points.ply reference.png)
 BOUNDARY_IN := $(WORK)/20_boundary/boundary.json $(WORK)/20_boundary/mask.png
 
 INIT_OUT := $(addprefix $(WORK)/40_init/,mesh3d.ply mesh2d.ply init.json)
-init: check-data boundary $(INIT_OUT)
-$(INIT_OUT) &: $(BIN)/init-mesh $(WORK)/.flags/init $(SFM_IN) $(BOUNDARY_IN)
-	$(call timed,init-mesh) $(BIN)/init-mesh --sfm $(WORK)/10_sfm --boundary $(WORK)/20_boundary --out $(WORK)/40_init $(INIT_FLAGS)
+init: check-data boundary $(if $(findstring 25_points,$(POINTS_FILE)),points) $(INIT_OUT)
+$(INIT_OUT) &: $(BIN)/init-mesh $(WORK)/.flags/init $(SFM_IN) $(POINTS_FILE) $(BOUNDARY_IN)
+	$(call timed,init-mesh) $(BIN)/init-mesh --sfm $(WORK)/10_sfm --boundary $(WORK)/20_boundary --points $(POINTS_FILE) --out $(WORK)/40_init $(INIT_FLAGS)
 
 OPTIMIZE_OUT := $(addprefix $(WORK)/50_optimize/,mesh3d.ply mesh2d.ply lines.json log.json scene.glb)
 optimize: check-data features init $(OPTIMIZE_OUT)
-$(OPTIMIZE_OUT) &: $(BIN)/optimize $(WORK)/.flags/optimize $(INIT_OUT) $(SFM_IN) $(BOUNDARY_IN) $(WORK)/30_features/features.json
-	$(call timed,optimize) $(BIN)/optimize --sfm $(WORK)/10_sfm --boundary $(WORK)/20_boundary --features $(WORK)/30_features/features.json --init $(WORK)/40_init --out $(WORK)/50_optimize $(OPTIMIZE_FLAGS)
+$(OPTIMIZE_OUT) &: $(BIN)/optimize $(WORK)/.flags/optimize $(INIT_OUT) $(SFM_IN) $(POINTS_FILE) $(BOUNDARY_IN) $(WORK)/30_features/features.json
+	$(call timed,optimize) $(BIN)/optimize --sfm $(WORK)/10_sfm --boundary $(WORK)/20_boundary --features $(WORK)/30_features/features.json --init $(WORK)/40_init --points $(POINTS_FILE) --out $(WORK)/50_optimize $(OPTIMIZE_FLAGS)
 
 # render textures the newest meshes there are: 50_optimize/ once optimize
 # exists, else 40_init/.
@@ -170,7 +182,7 @@ $(EVAL_OUT): $(BIN)/evaluate $(WORK)/.flags/evaluate $(WORK)/60_render/rectified
 # The report is redrawn whenever a stage's output is newer.
 REPORT_OUT := $(WORK)/report.html
 report: check-data $(REPORT_OUT)
-STAGE_OUTPUTS := sfm:SFM_OUT boundary:BOUNDARY_OUT features:FEATURES_OUT init:INIT_OUT \
+STAGE_OUTPUTS := sfm:SFM_OUT boundary:BOUNDARY_OUT points:POINTS_OUT features:FEATURES_OUT init:INIT_OUT \
   optimize:OPTIMIZE_OUT render:RENDER_OUT
 REPORT_IN := $(foreach s,$(STAGE_OUTPUTS),$(if $(filter $(word 1,$(subst :, ,$(s))),$(IMPLEMENTED)),$($(word 2,$(subst :, ,$(s)))))) \
   $(if $(and $(HAS_GT),$(wildcard $(ROOT)/stages/evaluate)),$(EVAL_OUT))
@@ -199,6 +211,7 @@ help:
 	@echo "  all (default)  run every implemented stage on DATA"
 	@echo "  sfm            COLMAP structure from motion -> work/<name>/10_sfm/"
 	@echo "  boundary       document region and its four sides -> 20_boundary/"
+	@echo "  points         more 3D points of the page (texture, outline) -> 25_points/"
 	@echo "  features       straight text and edge segments -> 30_features/"
 	@echo "  init           initial 3D mesh M and flat mesh M' -> 40_init/"
 	@echo "  optimize       joint isometric optimisation with feature lines -> 50_optimize/"
@@ -222,6 +235,8 @@ help:
 	@echo "  BOUNDARY_FLAGS=...  extra flags for build/bin/segment-boundary"
 	@echo "  FEATURES_FLAGS=...  extra flags for build/bin/detect-features"
 	@echo "  FEATURES=f.json     use another detector's segments (docunfold.features) instead"
+	@echo "  DENSIFY_FLAGS=...   extra flags for build/bin/densify"
+	@echo "  DENSIFY=0           fit sfm's sparse points only (skip densify)"
 	@echo "  INIT_FLAGS=...      extra flags for build/bin/init-mesh"
 	@echo "  OPTIMIZE_FLAGS=...  extra flags for build/bin/optimize"
 	@echo "  RENDER_FLAGS=...    extra flags for build/bin/render"

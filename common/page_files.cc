@@ -1,5 +1,9 @@
 #include "common/page_files.h"
 
+#include <cmath>
+
+#include <opencv2/imgproc.hpp>
+
 #include "common/json_io.h"
 
 namespace docunfold {
@@ -78,6 +82,39 @@ FeatureFile ReadFeatures(const fs::path& file) {
     f.segments.push_back(std::move(s));
   }
   return f;
+}
+
+cv::Mat1b GrowRegion(const cv::Mat1b& region, double margin_px) {
+  cv::Mat1b grown = region > 0;
+  if (margin_px > 0) {
+    const int r = int(std::ceil(margin_px));
+    cv::dilate(grown, grown,
+               cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * r + 1, 2 * r + 1)));
+  }
+  return grown;
+}
+
+cv::Mat1b ContourRegion(const Boundary& boundary, double margin_px) {
+  cv::Mat1b region(boundary.height, boundary.width, uchar(0));
+  std::vector<cv::Point> polygon;
+  for (const Eigen::Vector2d& p : boundary.contour)
+    polygon.emplace_back(int(std::lround(p.x())), int(std::lround(p.y())));
+  if (polygon.size() >= 3) cv::fillPoly(region, std::vector<std::vector<cv::Point>>{polygon}, 255);
+  return GrowRegion(region, margin_px);
+}
+
+std::vector<int> PointsInRegion(const std::vector<Eigen::Vector3d>& points,
+                                const PinholeCamera& camera, const cv::Mat1b& region) {
+  std::vector<int> inside;
+  for (size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector3d xc = camera.CamFromWorld(points[i]);
+    if (!(xc.z() > 0)) continue;
+    const Eigen::Vector2d px = camera.ProjectCam(xc);
+    const long u = std::lround(px.x()), v = std::lround(px.y());
+    if (u < 0 || v < 0 || u >= region.cols || v >= region.rows || !region(int(v), int(u))) continue;
+    inside.push_back(int(i));
+  }
+  return inside;
 }
 
 }  // namespace docunfold

@@ -2,6 +2,7 @@
 // by every stage that uses them: 20_boundary/boundary.json
 // (docunfold.boundary) and 30_features/features.json (docunfold.features).
 // Both report problems as "file:/json/pointer: problem" (InputError).
+// Also: which 3D points belong to the document region of the reference view.
 #pragma once
 
 #include <array>
@@ -10,6 +11,9 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include "common/camera.h"
 
 namespace docunfold {
 
@@ -50,5 +54,19 @@ struct FeatureFile {
 // Any detector's file: only format, version and segments[].kind/points are
 // required (schemas/docunfold.features.schema.json).
 FeatureFile ReadFeatures(const fs::path& file);
+
+// The document region in the reference image: `region` (e.g. mask.png, any
+// non-zero pixel inside) grown by `margin_px`, so points on the page's very
+// edge still count.
+cv::Mat1b GrowRegion(const cv::Mat1b& region, double margin_px);
+
+// The filled closed contour of `boundary`, grown by `margin_px`.
+cv::Mat1b ContourRegion(const Boundary& boundary, double margin_px);
+
+// Indices of the points in front of `camera` whose projection falls on a
+// non-zero pixel of `region` (same size as the camera's image). Points of
+// the table or background next to the page would otherwise count as page.
+std::vector<int> PointsInRegion(const std::vector<Eigen::Vector3d>& points,
+                                const PinholeCamera& camera, const cv::Mat1b& region);
 
 }  // namespace docunfold

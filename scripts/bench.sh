@@ -99,16 +99,18 @@ done
 # inputs some runnable stage makes (so a stage that is being written, or one
 # whose predecessor is, is simply absent). evaluate is the bench's own
 # business (one run per row).
-declare -A program_of=([sfm]=sfm [boundary]=segment-boundary [features]=detect-features
-                       [init]=init-mesh [optimize]=optimize [render]=render)
-declare -A needs=([sfm]="" [boundary]="sfm" [features]="sfm boundary" [init]="sfm boundary"
+declare -A program_of=([sfm]=sfm [boundary]=segment-boundary [points]=densify
+                       [features]=detect-features [init]=init-mesh [optimize]=optimize
+                       [render]=render)
+declare -A needs=([sfm]="" [boundary]="sfm" [points]="sfm boundary" [features]="sfm boundary"
+                  [init]="sfm boundary"
                   [optimize]="features init" [render]="sfm boundary init")
 # pipeline.mk renders the optimised meshes as soon as stages/optimize exists.
 [[ -d $root/stages/optimize ]] && needs[render]+=" optimize"
 declare -A runnable=()
 if [[ $frontend == truth ]]; then runnable[sfm]=1 runnable[boundary]=1; fi
 pipeline_targets=() absent=()
-for s in sfm boundary features init optimize render; do
+for s in sfm boundary points features init optimize render; do
   [[ -n ${runnable[$s]:-} ]] && continue
   ok=1
   [[ -x $bin/${program_of[$s]} ]] || ok=""
@@ -150,6 +152,10 @@ make_row_docunfold-init() {
     --meshes "$work/40_init" --out "$work/60_render_init" || return
   image=$work/60_render_init/rectified.png
 }
+# The point cloud pipeline.mk gave init-mesh and optimize (densify's when it ran).
+points_args() {
+  if [[ -f $work/25_points/points.ply ]]; then echo --points "$work/25_points/points.ply"; fi
+}
 optimize_variant() {  # optimize_variant <row> <suffix> <optimize flag>
   local row=$1 suffix=$2 flag=$3
   { have optimize && have render; } || { reason="no optimize or render binary"; return 1; }
@@ -158,7 +164,7 @@ optimize_variant() {  # optimize_variant <row> <suffix> <optimize flag>
   mesh_dir=$work/50_optimize_$suffix
   timed "$row" "$bin/optimize" --sfm "$work/10_sfm" --boundary "$work/20_boundary" \
     --features "$work/30_features/features.json" --init "$work/40_init" \
-    --out "$mesh_dir" "$flag" || return
+    $(points_args) --out "$mesh_dir" "$flag" || return
   timed "$row" "$bin/render" --sfm "$work/10_sfm" --boundary "$work/20_boundary" \
     --meshes "$mesh_dir" --out "$work/60_render_$suffix" || return
   image=$work/60_render_$suffix/rectified.png
@@ -260,7 +266,7 @@ if [[ $solver_set != none ]] && have optimize; then
       echo "bench: optimize --solver $solver on $solver_set" >&2
       "$timer" "$sw/bench/timings.jsonl" "solver:$solver" "$bin/optimize" --sfm "$sw/10_sfm" \
         --boundary "$sw/20_boundary" --features "$sw/30_features/features.json" \
-        --init "$sw/40_init" --out "$sw/bench/solver_$solver" --solver "$solver" --no-scene \
+        --init "$sw/40_init" $(work=$sw points_args) --out "$sw/bench/solver_$solver" --solver "$solver" --no-scene \
         >> "$sw/bench/solver_$solver.log" 2>&1 || echo "bench: optimize --solver $solver failed" >&2
     done
     solver_args=(--solver-set "$solver_set")

@@ -19,7 +19,7 @@ import struct
 import subprocess
 
 # Pipeline stages in chain order (names as pipeline.mk's TIMER records them).
-STAGE_ORDER = ["truth-frontend", "sfm", "segment-boundary", "detect-features", "init-mesh",
+STAGE_ORDER = ["truth-frontend", "sfm", "segment-boundary", "densify", "detect-features", "init-mesh",
                "optimize", "render", "evaluate"]
 # Figures of a row, in table order: (key in metrics, column title, format).
 FIGURES = [("ms_ssim", "MS-SSIM ↑", "%.4f"), ("ld", "LD ↓", "%.2f"), ("li_d", "Li-D ↓", "%.2f"),

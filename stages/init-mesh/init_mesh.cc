@@ -21,6 +21,7 @@
 #include "common/isometry/mesh_index.h"
 #include "common/isometry/metrics.h"
 #include "common/isometry/unfold.h"
+#include "common/page_files.h"
 #include "common/ply.h"
 
 namespace docunfold::init_mesh {
@@ -518,7 +519,8 @@ double UprightAngle(const MeshPair& m, const std::vector<Eigen::Vector2d>& pts) 
 
 // ---------------------------------------------------------------------------
 
-Inputs ReadInputs(const fs::path& sfm_dir, const fs::path& boundary_dir) {
+Inputs ReadInputs(const fs::path& sfm_dir, const fs::path& boundary_dir,
+                  const fs::path& points_file) {
   Inputs in;
   const fs::path cameras_path = sfm_dir / "cameras.json";
   const CameraSet cameras = ReadCameras(cameras_path);
@@ -527,7 +529,7 @@ Inputs ReadInputs(const fs::path& sfm_dir, const fs::path& boundary_dir) {
                      ": no reference view (expected format docunfold.cameras with \"reference\")");
   in.reference = *cameras.Find(cameras.reference);
 
-  const fs::path points_path = sfm_dir / "points.ply";
+  const fs::path points_path = points_file.empty() ? sfm_dir / "points.ply" : points_file;
   PlyData ply = ReadPly(points_path);
   if (ply.vertices.empty()) throw InputError(points_path.string() + ": no points");
   in.points = std::move(ply.vertices);
@@ -567,23 +569,14 @@ Result Run(const Inputs& in, const Options& o) {
 
   // --- SfM points inside the document region.
   auto t = Clock::now();
-  cv::Mat1b region = in.mask.clone();
-  if (o.mask_margin_px > 0) {
-    const int r = int(std::ceil(o.mask_margin_px));
-    cv::dilate(region, region,
-               cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * r + 1, 2 * r + 1)));
-  }
+  const cv::Mat1b region = GrowRegion(in.mask, o.mask_margin_px);
   std::vector<Eigen::Vector3d> region_points;
   std::vector<Eigen::Vector2d> pixels;
   std::vector<double> depths;
-  for (const Eigen::Vector3d& x : in.points) {
-    const Eigen::Vector3d xc = cam.CamFromWorld(x);
-    if (!(xc.z() > 0)) continue;
-    const Eigen::Vector2d px = cam.ProjectCam(xc);
-    const int u = int(std::lround(px.x())), v = int(std::lround(px.y()));
-    if (u < 0 || v < 0 || u >= cam.width || v >= cam.height || !region(v, u)) continue;
-    region_points.push_back(x);
-    pixels.push_back(px);
+  for (const int i : PointsInRegion(in.points, cam, region)) {
+    const Eigen::Vector3d xc = cam.CamFromWorld(in.points[i]);
+    region_points.push_back(in.points[i]);
+    pixels.push_back(cam.ProjectCam(xc));
     depths.push_back(xc.z());
   }
   res.points_total = int(in.points.size());

@@ -109,7 +109,9 @@ struct Inputs {
 // 20_boundary/{boundary.json, mask.png}; throws InputError naming the file.
 // An unusable boundary.json content is not an error (Run falls back to the
 // mask), a missing or corrupt file is.
-Inputs ReadInputs(const fs::path& sfm_dir, const fs::path& boundary_dir);
+// `points_path` empty: sfm_dir/points.ply.
+Inputs ReadInputs(const fs::path& sfm_dir, const fs::path& boundary_dir,
+                  const fs::path& points_path = {});
 
 struct Timings {
   double grid = 0, depth = 0, unfold = 0, refine = 0, upright = 0, total = 0;

@@ -15,7 +15,7 @@ int main(int argc, char** argv) {
       "image (Coons patch of the boundary sides), lifted to 3D by the depths of the SfM "
       "points, unfolded to the plane and refined by the joint isometric optimisation "
       "without feature lines; M' is turned upright by the page border."};
-  fs::path sfm_dir, boundary_dir, out_dir;
+  fs::path sfm_dir, boundary_dir, out_dir, points_path;
   init_mesh::Options o;
   std::string grid = "20x30", method = "gn", iso = "strain";
   bool no_upright = false, verbose = false;
@@ -23,6 +23,8 @@ int main(int argc, char** argv) {
       ->required();
   app.add_option("--boundary", boundary_dir, "segment-boundary output: boundary.json, mask.png")
       ->required();
+  app.add_option("--points", points_path,
+                 "3D points to fit (default: <sfm>/points.ply; densify writes 25_points/points.ply)");
   app.add_option("--out", out_dir, "output directory (mesh3d.ply, mesh2d.ply, init.json)")
       ->required();
   app.add_option("--grid", grid,
@@ -109,7 +111,7 @@ int main(int argc, char** argv) {
     o.refine.iso_normalization = iso == "strain" ? isometry::IsoNormalization::kStrain
                                                  : isometry::IsoNormalization::kRaw;
 
-    const init_mesh::Inputs inputs = init_mesh::ReadInputs(sfm_dir, boundary_dir);
+    const init_mesh::Inputs inputs = init_mesh::ReadInputs(sfm_dir, boundary_dir, points_path);
     const double read_seconds = SecondsSince(start);
     const init_mesh::Result result = init_mesh::Run(inputs, o);
     for (const std::string& w : result.warnings) Log("warning: " + w);

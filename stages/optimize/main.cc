@@ -23,6 +23,8 @@ int main(int argc, char** argv) {
   app.add_option("--features", paths.features, "feature segments (docunfold.features)")
       ->required();
   app.add_option("--init", paths.init, "40_init/ (mesh3d.ply, mesh2d.ply)")->required();
+  app.add_option("--points", paths.points,
+                 "3D points to fit (default: <sfm>/points.ply; densify writes 25_points/points.ply)");
   app.add_option("--out", out, "output folder, e.g. 50_optimize")->required();
   app.add_option("--rounds", o.rounds, "rounds of optimisation (subdivisions between them)")
       ->capture_default_str();
@@ -45,6 +47,10 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--outlier-distance", o.outlier_distance,
                  "points farther from M than this fraction of the model size are ignored")
+      ->capture_default_str();
+  app.add_option("--region-margin-px", o.region_margin_px,
+                 "fit only points projecting inside the boundary contour grown by this many "
+                 "reference pixels")
       ->capture_default_str();
   AddFairnessBoostOptions(app, &o.unsupported_fairness, &o.support_radius);
   app.add_option("--solver", solver, "gn (Gauss-Newton/LM, sparse Cholesky) or lbfgs")
@@ -101,6 +107,7 @@ int main(int argc, char** argv) {
                                {"tolerance", o.relative_tolerance},
                                {"max_iterations", o.max_outer_iterations},
                                {"outlier_distance", o.outlier_distance},
+                               {"region_margin_px", o.region_margin_px},
                                {"unsupported_fairness", o.unsupported_fairness},
                                {"support_radius", o.support_radius},
                                {"features", o.features},

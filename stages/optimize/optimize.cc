@@ -57,6 +57,15 @@ OptimizeResult Run(const OptimizeInputs& in, const OptimizeOptions& o) {
           in.features.file.string() + ")");
   }
 
+  result.region_points =
+      PointsInRegion(in.points, in.reference, ContourRegion(in.boundary, o.region_margin_px));
+  if (result.region_points.empty())
+    throw InputError(in.boundary.file.string() + ": none of the " +
+                     std::to_string(in.points.size()) +
+                     " SfM points falls inside the document region");
+  std::vector<Eigen::Vector3d> region_points;
+  for (const int i : result.region_points) region_points.push_back(in.points[i]);
+
   MeshPair meshes = in.init;
   isometry::Weights weights = o.weights;
   if (segments.empty()) weights.line = weights.ray = 0;
@@ -73,7 +82,7 @@ OptimizeResult Run(const OptimizeInputs& in, const OptimizeOptions& o) {
 
     isometry::Problem problem;
     problem.meshes = meshes;
-    problem.points = in.points;
+    problem.points = region_points;
     isometry::SolveOptions so;
     so.weights = weights;
     so.outlier_distance = o.outlier_distance;

@@ -22,6 +22,11 @@ struct OptimizeOptions {
   double relative_tolerance = 0.01;   // inner loop stops when |ΔF/F| < this (ε)
   int max_outer_iterations = 100;     // ... or after this many outer iterations (Q)
   double outlier_distance = 0.06;     // φ, fraction of the model size
+  // Only points projecting into the document region of the reference view
+  // (boundary contour grown by this many pixels) are fitted, as in
+  // init-mesh; points of the table beside the page are within φ of M's edge
+  // and would pull it outward.
+  double region_margin_px = 4;
   // λ3 × up to this far from every point (isometry::SolveOptions); 1 is
   // the paper and the default: 100 helped on average with the old reference
   // views but rounded an unsupported fold on set01 (README, "Choices we
@@ -69,7 +74,8 @@ struct RoundResult {
 struct OptimizeResult {
   MeshPair meshes;                 // final M and M'
   std::vector<RoundResult> rounds;
-  std::vector<bool> inliers;       // per SfM point, after the last round
+  std::vector<int> region_points;  // indices of the SfM points in the document region
+  std::vector<bool> inliers;       // per region point, after the last round
   int segments = 0;                // feature segments given (text + edge)
   int segments_off_page = 0;       // of those, dropped: their samples miss M
   int boundary_lines = 0;          // real boundary sides used

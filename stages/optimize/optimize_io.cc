@@ -34,9 +34,9 @@ OptimizeInputs ReadInputs(const InputPaths& paths) {
     throw InputError((paths.sfm / "cameras.json").string() +
                      ": no reference view (not written by sfm?)");
   in.reference = *ref;
-  const PlyData points = ReadPly(paths.sfm / "points.ply");
+  const PlyData points = ReadPly(paths.PointsFile());
   if (points.vertices.empty())
-    throw InputError((paths.sfm / "points.ply").string() + ": no points");
+    throw InputError(paths.PointsFile().string() + ": no points");
   in.points = points.vertices;
   const fs::path boundary_file =
       fs::is_directory(paths.boundary) ? paths.boundary / "boundary.json" : paths.boundary;
@@ -82,6 +82,7 @@ Json LogJson(const OptimizeResult& result, const Json& options_json) {
   doc["segments"] = result.segments;
   doc["segments_off_page"] = result.segments_off_page;
   doc["boundary_lines"] = result.boundary_lines;
+  doc["points_in_region"] = result.region_points.size();
   doc["seconds"] = result.seconds;
   doc["rounds"] = Json::array();
   for (const RoundResult& r : result.rounds) {
@@ -157,9 +158,11 @@ void WriteOutputs(const fs::path& out, const InputPaths& paths, const OptimizeIn
   }
   GltfPoints cloud;
   cloud.name = "SfM points (inliers)";
-  const PlyData points = ReadPly(paths.sfm / "points.ply");
-  for (size_t i = 0; i < points.vertices.size(); ++i) {
-    if (i < result.inliers.size() && !result.inliers[i]) continue;
+  const PlyData points = ReadPly(paths.PointsFile());
+  for (size_t k = 0; k < result.region_points.size(); ++k) {
+    if (k < result.inliers.size() && !result.inliers[k]) continue;
+    const size_t i = size_t(result.region_points[k]);
+    if (i >= points.vertices.size()) continue;
     cloud.positions.push_back(points.vertices[i]);
     if (!points.colors.empty())
       cloud.colors.emplace_back(points.colors[i][0] / 255.f, points.colors[i][1] / 255.f,

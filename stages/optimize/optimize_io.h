@@ -19,6 +19,8 @@ struct InputPaths {
   fs::path boundary;  // 20_boundary/ or its boundary.json
   fs::path features;  // features.json
   fs::path init;      // 40_init/
+  fs::path points;    // 3D points to fit; empty: sfm/points.ply
+  fs::path PointsFile() const { return points.empty() ? sfm / "points.ply" : points; }
 };
 
 // Reads and checks every input (throws InputError naming file and problem).

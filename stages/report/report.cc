@@ -218,8 +218,11 @@ void MeshSection(const ReportOptions& o, const Json& cameras, Page* page, fs::pa
     const PinholeCamera* ref = set.Find(set.reference);
     std::vector<Eigen::Vector3d> points;
     std::error_code ec;
-    if (fs::is_regular_file(o.work / "10_sfm/points.ply", ec))
-      points = ReadPly(o.work / "10_sfm/points.ply").vertices;
+    for (const char* cloud : {"25_points/points.ply", "10_sfm/points.ply"})
+      if (fs::is_regular_file(o.work / cloud, ec)) {
+        points = ReadPly(o.work / cloud).vertices;
+        break;
+      }
     const cv::Mat texture = TryImage(o.work / "10_sfm/reference.png");
     std::string html;
     for (auto [yaw, pitch] : {std::pair<double, double>{-35, -20}, {40, 25}}) {
@@ -229,9 +232,21 @@ void MeshSection(const ReportOptions& o, const Json& cameras, Page* page, fs::pa
       cv::Mat picture = RenderMeshView(mesh, *ref, texture, points, v);
       html += Figure(InlineImage(picture, v.width, "M"),
                      "M from " + Fmt(yaw, "%+.0f") + "°, " + Fmt(pitch, "%+.0f") +
-                         "° off the reference view, with the SfM points (red)");
+                         "° off the reference view, with the points (red)");
     }
     page->Add(html);
+    const cv::Mat points_overlay = TryImage(o.work / "25_points/overlay.png");
+    if (!points_overlay.empty()) {
+      const Json counts = TryJson(o.work / "25_points/points.json");
+      std::string caption = "The points fitted (25_points/overlay.png): sfm's (blue), texture "
+                            "(green) and outline (magenta) points of densify.";
+      if (counts.is_object() && counts.contains("points"))
+        caption += " " + std::to_string(counts["points"].value("sfm_in_region", 0)) +
+                   " sfm points on the page, " +
+                   std::to_string(counts["points"].value("texture", 0)) + " texture, " +
+                   std::to_string(counts["points"].value("outline", 0)) + " outline.";
+      page->Add(Figure(InlineImage(points_overlay, o.figure_width / 2 + 100, "points"), caption));
+    }
     page->Add("<p>M and M' from <code>" + Escape(mesh_dir->filename().string()) + "/</code>: " +
               std::to_string(mesh.grid.nx) + " × " + std::to_string(mesh.grid.ny) +
               " vertices; " + std::to_string(points.size()) +
@@ -417,7 +432,8 @@ void StagesSection(const ReportOptions& o, Page* page) {
   page->Section("stages", "Stages: time, memory and flags");
   const auto timings = StageTimings(o.work);
   const std::vector<std::pair<std::string, std::string>> stages = {
-      {"sfm", "sfm"},           {"segment-boundary", "boundary"}, {"detect-features", "features"},
+      {"sfm", "sfm"},           {"segment-boundary", "boundary"}, {"densify", "points"},
+      {"detect-features", "features"},
       {"init-mesh", "init"},    {"optimize", "optimize"},         {"render", "render"},
       {"evaluate", "evaluate"}};
   std::string t = "<table><tr><th class=l>stage</th><th>wall time (s)</th><th>peak memory (MB)"

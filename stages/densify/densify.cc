@@ -1,0 +1,749 @@
+#include "stages/densify/densify.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include <Eigen/SVD>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/video/tracking.hpp>
+
+#include "common/atomic_file.h"
+#include "common/cli.h"
+#include "common/errors.h"
+
+namespace docunfold::densify {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// Bilinear sample of a float image; 0 outside.
+float Sample(const cv::Mat1f& m, double x, double y) {
+  if (!(x >= 0 && y >= 0 && x <= m.cols - 1 && y <= m.rows - 1)) return 0;
+  const int x0 = std::min(int(x), m.cols - 2), y0 = std::min(int(y), m.rows - 2);
+  const float fx = float(x - x0), fy = float(y - y0);
+  return (1 - fy) * ((1 - fx) * m(y0, x0) + fx * m(y0, x0 + 1)) +
+         fy * ((1 - fx) * m(y0 + 1, x0) + fx * m(y0 + 1, x0 + 1));
+}
+
+// A photo as the stage works on it: undistorted, resized, with its camera
+// and the gradient of a slightly blurred copy (grey levels per pixel).
+struct View {
+  int index = -1;  // in the camera set
+  PinholeCamera camera;
+  cv::Mat1b grey;
+  cv::Mat1f gx, gy;
+
+  Eigen::Vector2d Gradient(const Eigen::Vector2d& p) const {
+    return {Sample(gx, p.x(), p.y()), Sample(gy, p.x(), p.y())};
+  }
+  bool Inside(const Eigen::Vector2d& p, double border = 1) const {
+    return p.x() >= border && p.y() >= border && p.x() <= grey.cols - 1 - border &&
+           p.y() <= grey.rows - 1 - border;
+  }
+};
+
+View MakeView(int index, const PinholeCamera& camera, const cv::Mat& grey_photo,
+              const std::array<double, 4>& distortion, double scale) {
+  View v;
+  v.index = index;
+  v.camera = ScaleCamera(camera, scale);
+  cv::Mat resized;
+  if (scale != 1) {
+    cv::resize(grey_photo, resized, cv::Size(v.camera.width, v.camera.height), 0, 0,
+               cv::INTER_AREA);
+  } else {
+    resized = grey_photo;
+  }
+  const bool distorted = std::any_of(distortion.begin(), distortion.end(),
+                                     [](double d) { return d != 0; });
+  if (distorted) {
+    cv::Mat K(3, 3, CV_64F);
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) K.at<double>(r, c) = v.camera.K(r, c);
+    const std::vector<double> coefficients(distortion.begin(), distortion.end());
+    cv::undistort(resized, v.grey, K, coefficients);
+  } else {
+    v.grey = resized.clone();
+  }
+  cv::Mat blurred;
+  cv::GaussianBlur(v.grey, blurred, cv::Size(0, 0), 1.2);
+  cv::Sobel(blurred, v.gx, CV_32F, 1, 0, 3, 0.125);
+  cv::Sobel(blurred, v.gy, CV_32F, 0, 1, 3, 0.125);
+  return v;
+}
+
+Eigen::Vector2d ScalePixel(const Eigen::Vector2d& p, double scale) {
+  return (p.array() + 0.5) * scale - 0.5;
+}
+
+// Point of the reference camera's ray through `pixel` at camera depth `depth`.
+Eigen::Vector3d RayPoint(const PinholeCamera& camera, const Eigen::Vector2d& pixel,
+                         double depth) {
+  const Eigen::Vector3d xc = depth * (camera.K.inverse() * Eigen::Vector3d(pixel.x(), pixel.y(), 1));
+  return camera.R.transpose() * (xc - camera.t);
+}
+
+struct Observation {
+  const PinholeCamera* camera;
+  Eigen::Vector2d pixel;
+};
+
+// Triangulates and checks: in front of every camera, every reprojection
+// within `max_error`, rays at least `min_angle` apart. Returns false when not.
+bool TriangulateChecked(const std::vector<Observation>& obs, double max_error,
+                        double min_angle_rad, Eigen::Vector3d* point, double* mean_error) {
+  std::vector<const PinholeCamera*> cameras;
+  std::vector<Eigen::Vector2d> pixels;
+  for (const Observation& o : obs) {
+    cameras.push_back(o.camera);
+    pixels.push_back(o.pixel);
+  }
+  const Eigen::Vector3d X = Triangulate(cameras, pixels);
+  if (!X.allFinite()) return false;
+  double sum = 0;
+  for (const Observation& o : obs) {
+    const Eigen::Vector3d xc = o.camera->CamFromWorld(X);
+    if (!(xc.z() > 0)) return false;
+    const double e = (o.camera->ProjectCam(xc) - o.pixel).norm();
+    if (e > max_error) return false;
+    sum += e;
+  }
+  double widest = 0;
+  const Eigen::Vector3d d0 = (X - obs[0].camera->Center()).normalized();
+  for (size_t i = 1; i < obs.size(); ++i)
+    widest = std::max(widest, std::acos(std::clamp(
+                                  d0.dot((X - obs[i].camera->Center()).normalized()), -1.0, 1.0)));
+  if (widest < min_angle_rad) return false;
+  *point = X;
+  *mean_error = sum / double(obs.size());
+  return true;
+}
+
+// Homography taking reference pixels of the page to `view`'s pixels, fitted
+// to the page's SfM points; empty when too few are seen by both.
+cv::Mat PageHomography(const View& ref, const View& view,
+                       const std::vector<Eigen::Vector3d>& page_points, int* used) {
+  std::vector<cv::Point2f> a, b;
+  for (const Eigen::Vector3d& X : page_points) {
+    const Eigen::Vector3d cr = ref.camera.CamFromWorld(X), cv_ = view.camera.CamFromWorld(X);
+    if (!(cr.z() > 0) || !(cv_.z() > 0)) continue;
+    const Eigen::Vector2d pr = ref.camera.ProjectCam(cr), pv = view.camera.ProjectCam(cv_);
+    if (!ref.Inside(pr, 0) || !view.Inside(pv, 0)) continue;
+    a.emplace_back(float(pr.x()), float(pr.y()));
+    b.emplace_back(float(pv.x()), float(pv.y()));
+  }
+  *used = int(a.size());
+  if (a.size() < 12) return cv::Mat();
+  return cv::findHomography(a, b, cv::RANSAC, 5.0);
+}
+
+// --- texture points -------------------------------------------------------
+
+void AddTexturePoints(const View& ref, const std::vector<View>& others,
+                      const cv::Mat1b& region, const std::vector<Eigen::Vector3d>& page_points,
+                      const cv::Mat& reference_bgr, const TextureOptions& o,
+                      DensifyResult* result) {
+  cv::Mat1f texture;
+  cv::cornerMinEigenVal(ref.grey, texture, 7, 3);
+  std::vector<float> values;
+  for (int y = 0; y < region.rows; ++y)
+    for (int x = 0; x < region.cols; ++x)
+      if (region(y, x)) values.push_back(texture(y, x));
+  if (values.empty()) return;
+  const size_t q95 = values.size() * 95 / 100;
+  std::nth_element(values.begin(), values.begin() + q95, values.end());
+  const double threshold = o.min_texture * values[q95];
+
+  struct Track {
+    Eigen::Vector2d pixel;
+    std::vector<Observation> obs;
+  };
+  std::vector<Track> tracks;
+  cv::Mat1i track_of(region.size(), -1);
+  const double step = std::max(1.0, o.step_px);
+  for (double y = 0; y < region.rows; y += step)
+    for (double x = 0; x < region.cols; x += step) {
+      const int u = int(x), v = int(y);
+      if (!region(v, u) || texture(v, u) < threshold) continue;
+      track_of(v, u) = int(tracks.size());
+      tracks.push_back({Eigen::Vector2d(u, v), {}});
+    }
+  result->texture_samples = int(tracks.size());
+
+  auto dis = cv::DISOpticalFlow::create(cv::DISOpticalFlow::PRESET_MEDIUM);
+  for (const View& view : others) {
+    ViewStats& stats = result->views[view.index];
+    const cv::Mat H = PageHomography(ref, view, page_points, &stats.page_points);
+    if (H.empty()) continue;
+    const Eigen::Matrix3d He = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(
+        H.ptr<double>());
+    // The view brought onto the reference by the page's homography: what is
+    // left for the flow is the page's relief, a few pixels.
+    cv::Mat1b warped;
+    cv::warpPerspective(view.grey, warped, H, ref.grey.size(),
+                        cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_CONSTANT, 0);
+    cv::Mat1b covered;
+    cv::warpPerspective(cv::Mat1b(view.grey.size(), uchar(255)), covered, H, ref.grey.size(),
+                        cv::INTER_NEAREST | cv::WARP_INVERSE_MAP, cv::BORDER_CONSTANT, 0);
+    cv::Mat forward, backward;
+    dis->calc(ref.grey, warped, forward);
+    dis->calc(warped, ref.grey, backward);
+    for (Track& t : tracks) {
+      const int u = int(t.pixel.x()), v = int(t.pixel.y());
+      const cv::Point2f f = forward.at<cv::Point2f>(v, u);
+      const double qx = u + f.x, qy = v + f.y;
+      if (!(qx >= 1 && qy >= 1 && qx <= ref.grey.cols - 2 && qy <= ref.grey.rows - 2)) continue;
+      const int iu = int(std::lround(qx)), iv = int(std::lround(qy));
+      if (!covered(iv, iu)) continue;
+      const cv::Point2f b = backward.at<cv::Point2f>(iv, iu);
+      if (std::hypot(f.x + b.x, f.y + b.y) > o.max_flow_disagreement_px) continue;
+      const Eigen::Vector3d p = He * Eigen::Vector3d(qx, qy, 1);
+      t.obs.push_back({&view.camera, p.head<2>() / p.z()});
+      ++stats.flow_matches;
+    }
+  }
+
+  const double min_angle = o.min_triangulation_angle_deg * M_PI / 180;
+  auto* track_length = &result->points.properties[0].values;  // set up by Run
+  auto* reprojection = &result->points.properties[1].values;
+  auto* source = &result->points.properties[2].values;
+  for (const Track& t : tracks) {
+    if (int(t.obs.size()) + 1 < o.min_views) continue;
+    std::vector<Observation> obs{{&ref.camera, t.pixel}};
+    obs.insert(obs.end(), t.obs.begin(), t.obs.end());
+    Eigen::Vector3d X;
+    double error = 0;
+    if (!TriangulateChecked(obs, o.max_reprojection_px, min_angle, &X, &error)) continue;
+    const cv::Point full = result->working_scale == 1
+                               ? cv::Point(int(t.pixel.x()), int(t.pixel.y()))
+                               : cv::Point(std::clamp(int(std::lround((t.pixel.x() + 0.5) / result->working_scale - 0.5)), 0, reference_bgr.cols - 1),
+                                           std::clamp(int(std::lround((t.pixel.y() + 0.5) / result->working_scale - 0.5)), 0, reference_bgr.rows - 1));
+    const cv::Vec3b bgr = reference_bgr.at<cv::Vec3b>(full);
+    result->points.vertices.push_back(X);
+    result->points.colors.push_back({bgr[2], bgr[1], bgr[0]});
+    track_length->push_back(double(obs.size()));
+    reprojection->push_back(error);
+    source->push_back(kTexture);
+    ++result->texture_points;
+  }
+}
+
+// --- outline points -------------------------------------------------------
+
+// Strongest step of sign `sign` (grey rising along +n) within +-reach of c
+// along the unit normal n; returns its offset (sub-pixel) and strength.
+bool FindStep(const View& view, const Eigen::Vector2d& c, const Eigen::Vector2d& n,
+              double reach, int sign, double* offset, double* strength) {
+  const int count = int(2 * reach / 0.5) + 1;
+  std::vector<double> g(count, 0);
+  int best = -1;
+  for (int i = 0; i < count; ++i) {
+    const Eigen::Vector2d p = c + (-reach + 0.5 * i) * n;
+    if (!view.Inside(p)) continue;
+    g[i] = sign * view.Gradient(p).dot(n);
+    if (best < 0 || g[i] > g[best]) best = i;
+  }
+  if (best <= 0 || best >= count - 1 || g[best] <= 0) return false;
+  const double curvature = g[best - 1] - 2 * g[best] + g[best + 1];
+  const double frac = curvature < 0 ? 0.5 * (g[best - 1] - g[best + 1]) / curvature : 0;
+  *offset = -reach + 0.5 * (best + frac);
+  *strength = g[best];
+  return true;
+}
+
+struct EdgeSample {
+  Eigen::Vector2d pixel;   // on the edge, reference working copy
+  Eigen::Vector2d normal;  // unit, pointing out of the page
+  int sign = 1;            // grey rises (+1) or falls (-1) going out
+  double near_depth = 0, far_depth = 0;
+  std::vector<std::vector<Eigen::Vector2d>> candidates;  // per view index
+};
+
+std::vector<EdgeSample> EdgeSamples(const View& ref, const Boundary& boundary,
+                                    const cv::Mat1b& page, double scale,
+                                    const OutlineOptions& o) {
+  std::vector<EdgeSample> samples;
+  std::array<Eigen::Vector2d, 4> corners;
+  for (int i = 0; i < 4; ++i) corners[i] = ScalePixel(boundary.corners[i], scale);
+  for (int s = 0; s < 4; ++s) {
+    if (!boundary.sides[s].real) continue;
+    const auto& side = boundary.sides[s].points;
+    double walked = 0;  // arc length of the side before segment k
+    for (size_t k = 0; k + 1 < side.size(); ++k) {
+      const Eigen::Vector2d a = ScalePixel(side[k], scale), b = ScalePixel(side[k + 1], scale);
+      const double length = (b - a).norm();
+      if (length < 1e-9) continue;
+      const Eigen::Vector2d t = (b - a) / length;
+      // Samples every step_px of arc length along the whole side.
+      for (double u = std::fmod(o.step_px - std::fmod(walked, o.step_px), o.step_px); u < length;
+           u += o.step_px) {
+        const Eigen::Vector2d p = a + u * t;
+        bool near_corner = false;
+        for (const auto& c : corners) near_corner |= (p - c).norm() < o.corner_gap_px;
+        if (near_corner) continue;
+        Eigen::Vector2d n(-t.y(), t.x());
+        const Eigen::Vector2d probe = p + 4 * n;
+        if (ref.Inside(probe, 0) && page(int(probe.y()), int(probe.x()))) n = -n;
+        double off_up = 0, up = 0, off_down = 0, down = 0;
+        const bool rises = FindStep(ref, p, n, 5, 1, &off_up, &up);
+        const bool falls = FindStep(ref, p, n, 5, -1, &off_down, &down);
+        if (!rises && !falls) continue;
+        const bool use_rise = rises && (!falls || up >= down);
+        if ((use_rise ? up : down) < o.min_contrast) continue;
+        EdgeSample e;
+        e.pixel = p + (use_rise ? off_up : off_down) * n;
+        e.normal = n;
+        e.sign = use_rise ? 1 : -1;
+        samples.push_back(e);
+      }
+      walked += length;
+    }
+  }
+  return samples;
+}
+
+void AddOutlinePoints(const View& ref, const std::vector<View>& others, int num_views,
+                      const Boundary& boundary, const cv::Mat1b& page,
+                      const std::vector<Eigen::Vector2d>& known_pixels,
+                      const std::vector<double>& known_depths, const OutlineOptions& o,
+                      DensifyResult* result) {
+  if (known_pixels.empty()) return;
+  std::vector<EdgeSample> samples = EdgeSamples(ref, boundary, page, result->working_scale, o);
+  result->outline_samples = int(samples.size());
+  // Depth range of each sample from its nearest known points.
+  {
+    std::vector<std::pair<double, double>> by_distance(known_pixels.size());
+    const size_t k = std::min<size_t>(std::max(1, o.depth_neighbours), known_pixels.size());
+    for (EdgeSample& e : samples) {
+      for (size_t i = 0; i < known_pixels.size(); ++i)
+        by_distance[i] = {(known_pixels[i] - e.pixel).squaredNorm(), known_depths[i]};
+      std::partial_sort(by_distance.begin(), by_distance.begin() + k, by_distance.end());
+      double lo = std::numeric_limits<double>::infinity(), hi = 0;
+      for (size_t i = 0; i < k; ++i) {
+        lo = std::min(lo, by_distance[i].second);
+        hi = std::max(hi, by_distance[i].second);
+      }
+      e.near_depth = lo * (1 - o.depth_margin);
+      e.far_depth = hi * (1 + o.depth_margin);
+      e.candidates.assign(num_views, {});
+    }
+  }
+
+  const double min_cos = std::sin(o.min_epipolar_angle_deg * M_PI / 180);
+  for (const View& view : others) {
+    ViewStats& stats = result->views[view.index];
+    for (EdgeSample& e : samples) {
+      const Eigen::Vector3d A = view.camera.CamFromWorld(RayPoint(ref.camera, e.pixel, e.near_depth));
+      const Eigen::Vector3d B = view.camera.CamFromWorld(RayPoint(ref.camera, e.pixel, e.far_depth));
+      if (!(A.z() > 0) || !(B.z() > 0)) continue;
+      const Eigen::Vector2d a = view.camera.ProjectCam(A), b = view.camera.ProjectCam(B);
+      const double length = (b - a).norm();
+      if (length < 1) continue;
+      const Eigen::Vector2d dir = (b - a) / length;
+      // The sample's normal and tangent as this view sees them (mid depth).
+      const double mid = 0.5 * (e.near_depth + e.far_depth);
+      const Eigen::Vector2d at = view.camera.Project(RayPoint(ref.camera, e.pixel, mid));
+      const Eigen::Vector2d nj =
+          (view.camera.Project(RayPoint(ref.camera, e.pixel + e.normal, mid)) - at).normalized();
+      const Eigen::Vector2d tj =
+          (view.camera.Project(RayPoint(ref.camera, e.pixel + Eigen::Vector2d(-e.normal.y(), e.normal.x()), mid)) - at)
+              .normalized();
+      const double cos_cross = nj.dot(dir);
+      if (!nj.allFinite() || !tj.allFinite() || std::abs(cos_cross) < min_cos) continue;
+      const int sign_along = e.sign * (cos_cross > 0 ? 1 : -1);
+      const int count = int(length / 0.5) + 1;
+      std::vector<double> g(count, 0);
+      for (int i = 0; i < count; ++i) {
+        const Eigen::Vector2d p = a + 0.5 * i * dir;
+        if (view.Inside(p)) g[i] = sign_along * view.Gradient(p).dot(dir);
+      }
+      const double floor = o.min_contrast * std::abs(cos_cross);
+      for (int i = 1; i + 1 < count; ++i) {
+        if (g[i] < floor || g[i] < g[i - 1] || g[i] <= g[i + 1]) continue;
+        const double curvature = g[i - 1] - 2 * g[i] + g[i + 1];
+        const double frac = curvature < 0 ? 0.5 * (g[i - 1] - g[i + 1]) / curvature : 0;
+        const Eigen::Vector2d c = a + 0.5 * (i + frac) * dir;
+        const Eigen::Vector2d grad = view.Gradient(c);
+        if (e.sign * grad.normalized().dot(nj) < 0.85) continue;  // not this edge's direction
+        bool straight = true;
+        for (double along : {-o.straight_px, -o.straight_px / 2, o.straight_px / 2, o.straight_px}) {
+          double offset = 0, strength = 0;
+          if (!FindStep(view, c + along * tj, nj, 1.5, e.sign, &offset, &strength) ||
+              strength < 0.5 * g[i] * std::abs(cos_cross)) {
+            straight = false;
+            break;
+          }
+        }
+        if (!straight) continue;
+        e.candidates[view.index].push_back(c);
+        ++stats.outline_candidates;
+      }
+    }
+  }
+
+  auto* track_length = &result->points.properties[0].values;
+  auto* reprojection = &result->points.properties[1].values;
+  auto* source = &result->points.properties[2].values;
+  const std::vector<const View*> view_of = [&] {
+    std::vector<const View*> v(num_views, nullptr);
+    for (const View& view : others) v[view.index] = &view;
+    return v;
+  }();
+  for (const EdgeSample& e : samples) {
+    // Every candidate is a depth hypothesis; its support is the number of
+    // other views with a candidate where that depth projects.
+    struct Hypothesis {
+      Eigen::Vector3d point;
+      std::vector<Observation> obs;
+      std::vector<int> views;
+    };
+    std::vector<Hypothesis> hypotheses;
+    for (int vi = 0; vi < num_views; ++vi) {
+      for (const Eigen::Vector2d& c : e.candidates[vi]) {
+        Hypothesis h;
+        h.point = Triangulate({&ref.camera, &view_of[vi]->camera}, {e.pixel, c});
+        if (!h.point.allFinite()) continue;
+        h.obs = {{&ref.camera, e.pixel}, {&view_of[vi]->camera, c}};
+        h.views = {vi};
+        for (int vk = 0; vk < num_views; ++vk) {
+          if (vk == vi || e.candidates[vk].empty()) continue;
+          const Eigen::Vector3d xc = view_of[vk]->camera.CamFromWorld(h.point);
+          if (!(xc.z() > 0)) continue;
+          const Eigen::Vector2d expected = view_of[vk]->camera.ProjectCam(xc);
+          const Eigen::Vector2d* nearest = nullptr;
+          double nearest_distance = o.agree_px;
+          for (const Eigen::Vector2d& ck : e.candidates[vk]) {
+            const double d = (ck - expected).norm();
+            if (d < nearest_distance) {
+              nearest_distance = d;
+              nearest = &ck;
+            }
+          }
+          if (nearest) {
+            h.obs.push_back({&view_of[vk]->camera, *nearest});
+            h.views.push_back(vk);
+          }
+        }
+        hypotheses.push_back(std::move(h));
+      }
+    }
+    int best = -1;
+    for (size_t h = 0; h < hypotheses.size(); ++h)
+      if (best < 0 || hypotheses[h].obs.size() > hypotheses[best].obs.size()) best = int(h);
+    if (best < 0 || int(hypotheses[best].obs.size()) < o.min_views) {
+      ++result->outline_unmatched;
+      continue;
+    }
+    // Unambiguous: no hypothesis at a clearly different depth (its points
+    // 3 px apart in some view) is as well supported.
+    bool ambiguous = false;
+    for (size_t h = 0; h < hypotheses.size() && !ambiguous; ++h) {
+      if (hypotheses[h].obs.size() < hypotheses[best].obs.size()) continue;
+      double apart = 0;
+      for (const View& view : others) {
+        const Eigen::Vector3d p = view.camera.CamFromWorld(hypotheses[h].point);
+        const Eigen::Vector3d q = view.camera.CamFromWorld(hypotheses[best].point);
+        if (p.z() > 0 && q.z() > 0)
+          apart = std::max(apart, (view.camera.ProjectCam(p) - view.camera.ProjectCam(q)).norm());
+      }
+      ambiguous = apart > 3;
+    }
+    if (ambiguous) {
+      ++result->outline_ambiguous;
+      continue;
+    }
+    Eigen::Vector3d X;
+    double error = 0;
+    if (!TriangulateChecked(hypotheses[best].obs, o.max_reprojection_px, 0, &X, &error)) {
+      ++result->outline_unmatched;
+      continue;
+    }
+    result->points.vertices.push_back(X);
+    result->points.colors.push_back({255, 0, 255});
+    track_length->push_back(double(hypotheses[best].obs.size()));
+    reprojection->push_back(error);
+    source->push_back(kOutline);
+    for (int vi : hypotheses[best].views) ++result->views[vi].outline_votes;
+    ++result->outline_points;
+  }
+}
+
+std::array<double, 4> ReadDistortion(const JsonReader& r, const std::string& view) {
+  std::array<double, 4> d{};
+  const std::string pointer = view + "/distortion";
+  if (!r.Has(pointer)) return d;
+  if (r.String(pointer + "/model") != "opencv")
+    r.Fail(pointer + "/model", "only the \"opencv\" model (k1 k2 p1 p2) is understood");
+  const Json& c = r.At(pointer + "/coefficients");
+  if (!c.is_array() || c.size() != 4) r.Fail(pointer + "/coefficients", "expected 4 numbers");
+  for (int i = 0; i < 4; ++i) d[i] = r.Number(pointer + "/coefficients/" + std::to_string(i));
+  return d;
+}
+
+}  // namespace
+
+PinholeCamera ScaleCamera(const PinholeCamera& camera, double scale) {
+  PinholeCamera c = camera;
+  if (scale == 1) return c;
+  c.width = std::max(1, int(std::lround(camera.width * scale)));
+  c.height = std::max(1, int(std::lround(camera.height * scale)));
+  c.K(0, 0) *= scale;
+  c.K(0, 1) *= scale;
+  c.K(1, 1) *= scale;
+  c.K(0, 2) = (camera.K(0, 2) + 0.5) * scale - 0.5;
+  c.K(1, 2) = (camera.K(1, 2) + 0.5) * scale - 0.5;
+  return c;
+}
+
+Eigen::Vector3d Triangulate(const std::vector<const PinholeCamera*>& cameras,
+                            const std::vector<Eigen::Vector2d>& pixels) {
+  const int n = int(cameras.size());
+  Eigen::MatrixXd A(2 * n, 4);
+  for (int i = 0; i < n; ++i) {
+    Eigen::Matrix<double, 3, 4> P;
+    P.leftCols<3>() = cameras[i]->K * cameras[i]->R;
+    P.col(3) = cameras[i]->K * cameras[i]->t;
+    A.row(2 * i) = pixels[i].x() * P.row(2) - P.row(0);
+    A.row(2 * i + 1) = pixels[i].y() * P.row(2) - P.row(1);
+  }
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeFullV);
+  const Eigen::Vector4d X = svd.matrixV().col(3);
+  if (std::abs(X(3)) < 1e-12) return Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+  return X.head<3>() / X(3);
+}
+
+Json DensifyOptions::ToJson() const {
+  return {{"max_image_size", max_image_size},
+          {"region_margin_px", region_margin_px},
+          {"texture",
+           {{"enabled", texture.enabled},
+            {"step_px", texture.step_px},
+            {"min_texture", texture.min_texture},
+            {"max_flow_disagreement_px", texture.max_flow_disagreement_px},
+            {"max_reprojection_px", texture.max_reprojection_px},
+            {"min_views", texture.min_views},
+            {"min_triangulation_angle_deg", texture.min_triangulation_angle_deg}}},
+          {"outline",
+           {{"enabled", outline.enabled},
+            {"step_px", outline.step_px},
+            {"corner_gap_px", outline.corner_gap_px},
+            {"min_contrast", outline.min_contrast},
+            {"depth_neighbours", outline.depth_neighbours},
+            {"depth_margin", outline.depth_margin},
+            {"min_epipolar_angle_deg", outline.min_epipolar_angle_deg},
+            {"straight_px", outline.straight_px},
+            {"agree_px", outline.agree_px},
+            {"max_reprojection_px", outline.max_reprojection_px},
+            {"min_views", outline.min_views}}}};
+}
+
+DensifyInputs ReadInputs(const DensifyOptions& o) {
+  DensifyInputs in;
+  const fs::path cameras_path = o.sfm_dir / "cameras.json";
+  in.cameras = ReadCameras(cameras_path);
+  const PinholeCamera* ref = in.cameras.Find(in.cameras.reference);
+  if (!ref) throw InputError(cameras_path.string() + ": no reference view (not written by sfm?)");
+  {
+    const Json doc = ReadJsonFile(cameras_path);
+    const JsonReader r(doc, cameras_path);
+    for (size_t i = 0; i < in.cameras.views.size(); ++i)
+      in.distortion.push_back(ReadDistortion(r, "/views/" + std::to_string(i)));
+  }
+  in.reference = ReadImage(o.sfm_dir / "reference.png", cv::IMREAD_COLOR);
+  if (in.reference.cols != ref->width || in.reference.rows != ref->height)
+    throw InputError((o.sfm_dir / "reference.png").string() + ": " +
+                     std::to_string(in.reference.cols) + "x" + std::to_string(in.reference.rows) +
+                     " differs from the reference camera's " + std::to_string(ref->width) + "x" +
+                     std::to_string(ref->height));
+  const fs::path images = o.data_dir / "images";
+  for (const PinholeCamera& view : in.cameras.views) {
+    if (view.image == in.cameras.reference) {
+      in.photos.emplace_back();
+      continue;
+    }
+    const fs::path path = images / view.image;
+    cv::Mat photo = ReadImage(path, cv::IMREAD_GRAYSCALE);
+    if (photo.cols != view.width || photo.rows != view.height)
+      throw InputError(path.string() + ": " + std::to_string(photo.cols) + "x" +
+                       std::to_string(photo.rows) + " differs from its camera's " +
+                       std::to_string(view.width) + "x" + std::to_string(view.height) +
+                       " in " + cameras_path.string());
+    in.photos.push_back(photo);
+  }
+  const fs::path boundary_file =
+      fs::is_directory(o.boundary) ? o.boundary / "boundary.json" : o.boundary;
+  in.boundary = ReadBoundary(boundary_file);
+  const fs::path mask_path = boundary_file.parent_path() / "mask.png";
+  const cv::Mat mask = ReadImage(mask_path, cv::IMREAD_GRAYSCALE);
+  if (mask.cols != ref->width || mask.rows != ref->height)
+    throw InputError(mask_path.string() + ": " + std::to_string(mask.cols) + "x" +
+                     std::to_string(mask.rows) + " differs from the reference image's " +
+                     std::to_string(ref->width) + "x" + std::to_string(ref->height));
+  in.region = mask > 0;
+  if (cv::countNonZero(in.region) == 0)
+    throw InputError(mask_path.string() + ": empty document region (all pixels zero)");
+  in.points = ReadPly(o.sfm_dir / "points.ply");
+  if (in.points.vertices.empty())
+    throw InputError((o.sfm_dir / "points.ply").string() + ": no points");
+  return in;
+}
+
+DensifyResult Run(const DensifyInputs& in, const DensifyOptions& o) {
+  const auto start = Clock::now();
+  if (o.max_image_size < 64) throw UsageError("--max-image-size must be at least 64");
+  if (o.texture.step_px < 1 || o.outline.step_px < 1)
+    throw UsageError("--texture-step and --outline-step must be at least 1 pixel");
+  DensifyResult r;
+  const PinholeCamera& ref_camera = *in.cameras.Find(in.cameras.reference);
+  const int num_views = int(in.cameras.views.size());
+  r.views.resize(num_views);
+  for (int i = 0; i < num_views; ++i) r.views[i].image = in.cameras.views[i].image;
+
+  // Output cloud: sfm's points first, with their properties, then ours.
+  r.points.vertices = in.points.vertices;
+  r.points.colors = in.points.colors;
+  if (r.points.colors.size() != r.points.vertices.size())
+    r.points.colors.assign(r.points.vertices.size(), {200, 200, 200});
+  r.points.comments = {
+      "docunfold densify: sfm's points (source 0), then points triangulated from the texture "
+      "of the page (1) and from its outline (2), cameras of 10_sfm held fixed",
+      "frame: that of 10_sfm/cameras.json (camera of the reference view " +
+          in.cameras.reference + ")"};
+  r.sfm_points = int(in.points.vertices.size());
+  auto sfm_property = [&](const char* name, double fallback) {
+    const PlyProperty* p = in.points.FindProperty(name);
+    return p ? p->values : std::vector<double>(in.points.vertices.size(), fallback);
+  };
+  r.points.properties = {{"track_length", PlyScalar::kUint32, sfm_property("track_length", 2)},
+                         {"reprojection_error", PlyScalar::kFloat32,
+                          sfm_property("reprojection_error", 0)},
+                         {"source", PlyScalar::kUint8,
+                          std::vector<double>(in.points.vertices.size(), kSfm)}};
+
+  const cv::Mat1b full_region = GrowRegion(in.region, o.region_margin_px);
+  const std::vector<int> in_region = PointsInRegion(in.points.vertices, ref_camera, full_region);
+  r.sfm_points_in_region = int(in_region.size());
+  std::vector<Eigen::Vector3d> page_points;
+  for (const int i : in_region) page_points.push_back(in.points.vertices[i]);
+
+  // Working copies.
+  auto t = Clock::now();
+  const int long_side = std::max(ref_camera.width, ref_camera.height);
+  r.working_scale = std::min(1.0, double(o.max_image_size) / long_side);
+  cv::Mat ref_grey;
+  cv::cvtColor(in.reference, ref_grey, cv::COLOR_BGR2GRAY);
+  const int ref_index = int(in.cameras.Find(in.cameras.reference) - in.cameras.views.data());
+  const View ref = MakeView(ref_index, ref_camera, ref_grey, {}, r.working_scale);
+  std::vector<View> others;
+  for (int i = 0; i < num_views; ++i) {
+    if (i == ref_index) continue;
+    others.push_back(MakeView(i, in.cameras.views[i], in.photos[i], in.distortion[i],
+                              r.working_scale));
+  }
+  cv::Mat1b region, page;
+  cv::resize(full_region, region, ref.grey.size(), 0, 0, cv::INTER_NEAREST);
+  cv::resize(in.region, page, ref.grey.size(), 0, 0, cv::INTER_NEAREST);
+  r.seconds_reading = SecondsSince(t);
+  if (others.empty()) r.warnings.push_back("only one view: nothing to match, no points added");
+
+  t = Clock::now();
+  if (o.texture.enabled && !others.empty())
+    AddTexturePoints(ref, others, region, page_points, in.reference, o.texture, &r);
+  r.seconds_texture = SecondsSince(t);
+  Log(std::to_string(r.texture_points) + " texture points from " +
+      std::to_string(r.texture_samples) + " textured samples, " +
+      std::to_string(r.seconds_texture).substr(0, 4) + " s");
+
+  t = Clock::now();
+  if (o.outline.enabled && !others.empty()) {
+    // Known depths for the outline's search: the page's sfm points and the
+    // texture points just made.
+    std::vector<Eigen::Vector2d> pixels;
+    std::vector<double> depths;
+    auto add = [&](const Eigen::Vector3d& X) {
+      const Eigen::Vector3d xc = ref.camera.CamFromWorld(X);
+      if (!(xc.z() > 0)) return;
+      pixels.push_back(ref.camera.ProjectCam(xc));
+      depths.push_back(xc.z());
+    };
+    for (const Eigen::Vector3d& X : page_points) add(X);
+    for (size_t i = in.points.vertices.size(); i < r.points.vertices.size(); ++i)
+      add(r.points.vertices[i]);
+    if (in.boundary.RealSides() == 0)
+      r.warnings.push_back("no real boundary side: no outline points");
+    AddOutlinePoints(ref, others, num_views, in.boundary, page, pixels, depths, o.outline, &r);
+  }
+  r.seconds_outline = SecondsSince(t);
+  Log(std::to_string(r.outline_points) + " outline points from " +
+      std::to_string(r.outline_samples) + " edge samples (" +
+      std::to_string(r.outline_unmatched) + " unmatched, " +
+      std::to_string(r.outline_ambiguous) + " ambiguous), " +
+      std::to_string(r.seconds_outline).substr(0, 4) + " s");
+  r.seconds_total = SecondsSince(start);
+  return r;
+}
+
+void WriteOutputs(const DensifyInputs& in, const DensifyResult& r, const DensifyOptions& o) {
+  EnsureDirectory(o.out_dir);
+  WritePly(o.out_dir / "points.ply", r.points);
+
+  // Overlay: the reference image dimmed, points by source.
+  cv::Mat overlay = in.reference * 0.55;
+  const PinholeCamera& ref = *in.cameras.Find(in.cameras.reference);
+  const double radius_scale = std::max(1.0, std::max(ref.width, ref.height) / 1600.0);
+  const cv::Scalar colours[3] = {cv::Scalar(255, 200, 0), cv::Scalar(80, 220, 80),
+                                 cv::Scalar(255, 0, 255)};
+  const std::vector<double>& source = r.points.properties[2].values;
+  for (int pass = 0; pass < 3; ++pass)
+    for (size_t i = 0; i < r.points.vertices.size(); ++i) {
+      if (int(source[i]) != pass) continue;
+      const Eigen::Vector3d xc = ref.CamFromWorld(r.points.vertices[i]);
+      if (!(xc.z() > 0)) continue;
+      const Eigen::Vector2d p = ref.ProjectCam(xc);
+      if (p.x() < 0 || p.y() < 0 || p.x() >= ref.width || p.y() >= ref.height) continue;
+      cv::circle(overlay, cv::Point(int(std::lround(p.x())), int(std::lround(p.y()))),
+                 int(std::lround(radius_scale * (pass == 2 ? 3 : 2))), colours[pass], -1,
+                 cv::LINE_AA);
+    }
+  const double font = 0.8 * radius_scale;
+  const int thick = int(std::lround(2 * radius_scale));
+  const std::string legend[3] = {"sfm " + std::to_string(r.sfm_points_in_region),
+                                 "texture " + std::to_string(r.texture_points),
+                                 "outline " + std::to_string(r.outline_points)};
+  for (int i = 0; i < 3; ++i)
+    cv::putText(overlay, legend[i], cv::Point(int(20 * radius_scale), int((40 + 34 * i) * radius_scale)),
+                cv::FONT_HERSHEY_SIMPLEX, font, colours[i], thick, cv::LINE_AA);
+  WriteImageAtomic(o.out_dir / "overlay.png", overlay, {cv::IMWRITE_PNG_COMPRESSION, 1});
+
+  Json doc = MakeHeader("docunfold.points", 1, "densify", o.ToJson());
+  doc["reference"] = in.cameras.reference;
+  doc["working_scale"] = r.working_scale;
+  doc["points"] = {{"sfm", r.sfm_points},
+                   {"sfm_in_region", r.sfm_points_in_region},
+                   {"texture", r.texture_points},
+                   {"outline", r.outline_points},
+                   {"total", r.points.vertices.size()}};
+  doc["texture"] = {{"samples", r.texture_samples}};
+  doc["outline"] = {{"samples", r.outline_samples},
+                    {"unmatched", r.outline_unmatched},
+                    {"ambiguous", r.outline_ambiguous}};
+  doc["views"] = Json::array();
+  for (const ViewStats& v : r.views)
+    doc["views"].push_back({{"image", v.image},
+                            {"page_points", v.page_points},
+                            {"flow_matches", v.flow_matches},
+                            {"outline_candidates", v.outline_candidates},
+                            {"outline_votes", v.outline_votes}});
+  doc["warnings"] = r.warnings;
+  doc["seconds"] = {{"reading", r.seconds_reading},
+                    {"texture", r.seconds_texture},
+                    {"outline", r.seconds_outline},
+                    {"total", r.seconds_total}};
+  WriteJsonAtomic(o.out_dir / "points.json", doc);
+}
+
+}  // namespace docunfold::densify

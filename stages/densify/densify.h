@@ -1,0 +1,147 @@
+// densify: more 3D points on the page than COLMAP's sparse cloud, with the
+// cameras sfm found held fixed. Two sources, both measured against the
+// ground truth (README, "Choices we measured"):
+//  - texture: every `step_px`-th pixel of the reference view's document
+//    region with enough texture (text, print) is followed into each other
+//    photo by optical flow (DIS, after a homography that takes the page's
+//    SfM points across), kept when the flow agrees forwards and backwards,
+//    and triangulated from at least `min_views` photos;
+//  - outline: samples of the real boundary sides of 20_boundary are matched
+//    along their epipolar segments in every other photo (the page's edge is
+//    a sharp, straight step there too); a depth that at least two other
+//    photos agree on, and no other depth does as well, is triangulated.
+// Blank paper gives SIFT nothing, so COLMAP's cloud leaves margins and flaps
+// empty; their outline points and the text's points fill most of that.
+//
+// Writes into options' out_dir (each file atomically):
+//   points.ply   binary PLY: sfm's points followed by the new ones; x y z,
+//                red green blue, track_length, reprojection_error (pixels of
+//                the working copies), source (0 sfm, 1 texture, 2 outline)
+//   points.json  docunfold.points: counts, per-view statistics, options, times
+//   overlay.png  the reference image with the points by source
+#pragma once
+
+#include <array>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include "common/camera.h"
+#include "common/json_io.h"
+#include "common/page_files.h"
+#include "common/ply.h"
+
+namespace docunfold::densify {
+
+namespace fs = std::filesystem;
+
+enum PointSource : uint8_t { kSfm = 0, kTexture = 1, kOutline = 2 };
+
+struct TextureOptions {
+  bool enabled = true;
+  double step_px = 4;  // grid spacing in working-copy pixels
+  // Structure-tensor minimum eigenvalue (7x7 window) below this fraction of
+  // its 95th percentile over the region: blank paper, where flow only
+  // interpolates, is skipped.
+  double min_texture = 0.05;
+  double max_flow_disagreement_px = 0.5;  // forward + backward flow, |sum|
+  double max_reprojection_px = 1.0;       // every view, working-copy pixels
+  // Photos a point needs, the reference included. Two-view points were 2-3x
+  // less accurate on our sets (median 0.10 vs 0.06 % of the page diagonal).
+  int min_views = 3;
+  double min_triangulation_angle_deg = 2;
+};
+
+struct OutlineOptions {
+  bool enabled = true;
+  double step_px = 4;         // spacing of the samples along each real side
+  double corner_gap_px = 12;  // no samples this close to a corner
+  double min_contrast = 3;    // grey levels per pixel across the edge (after blur)
+  // The depth searched along each sample's ray: the depth range of its
+  // `depth_neighbours` nearest points (sfm + texture) in the reference
+  // image, widened by `depth_margin` on both sides.
+  int depth_neighbours = 16;
+  double depth_margin = 0.15;
+  // Edges crossing the epipolar segment at less than this angle are skipped
+  // (the match slides along the edge).
+  double min_epipolar_angle_deg = 20;
+  // A candidate must continue as a step of the same sign for this far along
+  // the edge's direction on both sides: texture of a table or carpet gives
+  // short gradient blobs, a page's edge a straight step.
+  double straight_px = 6;
+  double agree_px = 1.5;             // other views agree within this distance
+  double max_reprojection_px = 1.0;  // after triangulating from all of them
+  int min_views = 3;                 // the reference included
+};
+
+struct DensifyOptions {
+  fs::path data_dir;  // data set folder (with images/)
+  fs::path sfm_dir;   // 10_sfm/
+  fs::path boundary;  // 20_boundary/ or its boundary.json
+  fs::path out_dir;   // e.g. 25_points/
+  // Long side of the working copies of the photos; 1600 keeps the
+  // 1600x1200 sets as they are and brings 4000x3000 photos down to the
+  // same detail per page.
+  int max_image_size = 1600;
+  double region_margin_px = 4;  // document region grown by this (reference pixels)
+  TextureOptions texture;
+  OutlineOptions outline;
+
+  Json ToJson() const;
+};
+
+struct DensifyInputs {
+  CameraSet cameras;  // every registered view, reference frame (sfm)
+  std::vector<std::array<double, 4>> distortion;  // per view: OpenCV k1 k2 p1 p2
+  cv::Mat reference;              // 10_sfm/reference.png (undistorted), BGR
+  std::vector<cv::Mat> photos;    // per view, greyscale as taken (empty for the reference)
+  Boundary boundary;
+  cv::Mat1b region;               // document region, reference pixels (mask.png)
+  PlyData points;                 // 10_sfm/points.ply
+};
+
+struct ViewStats {
+  std::string image;
+  int page_points = 0;        // sfm points of the page seen in both (homography)
+  int flow_matches = 0;       // texture samples followed into this view
+  int outline_candidates = 0; // edge crossings found on the epipolar segments
+  int outline_votes = 0;      // of those, in a triangulated outline point
+};
+
+struct DensifyResult {
+  PlyData points;  // sfm's points, then texture, then outline points
+  int sfm_points = 0, sfm_points_in_region = 0, texture_points = 0, outline_points = 0;
+  int texture_samples = 0;     // textured grid pixels in the region
+  int outline_samples = 0;     // edge samples on the real sides
+  int outline_unmatched = 0;   // fewer than min_views agree
+  int outline_ambiguous = 0;   // another depth is as well supported
+  double working_scale = 1;    // working copies / photos
+  std::vector<ViewStats> views;
+  double seconds_reading = 0, seconds_texture = 0, seconds_outline = 0, seconds_total = 0;
+  std::vector<std::string> warnings;
+};
+
+// Reads and checks everything Run needs (InputError names the file).
+DensifyInputs ReadInputs(const DensifyOptions& options);
+
+DensifyResult Run(const DensifyInputs& inputs, const DensifyOptions& options);
+
+// Writes points.ply, points.json and overlay.png (OutputError on failure).
+void WriteOutputs(const DensifyInputs& inputs, const DensifyResult& result,
+                  const DensifyOptions& options);
+
+// --- building blocks (exposed for tests) ----------------------------------
+
+// `camera` for a copy of its image resized by `scale` (cv::resize's pixel
+// centres: x' = (x + 0.5) scale - 0.5).
+PinholeCamera ScaleCamera(const PinholeCamera& camera, double scale);
+
+// Point seen at `pixels[i]` by `cameras[i]` (linear, DLT); NaN when the rays
+// are degenerate.
+Eigen::Vector3d Triangulate(const std::vector<const PinholeCamera*>& cameras,
+                            const std::vector<Eigen::Vector2d>& pixels);
+
+}  // namespace docunfold::densify

@@ -1,0 +1,61 @@
+// densify --data DATA --sfm 10_sfm/ --boundary 20_boundary/ --out 25_points/
+// Writes points.ply, points.json and overlay.png (see densify.h).
+#include "common/cli.h"
+#include "stages/densify/densify.h"
+
+using namespace docunfold;
+
+int main(int argc, char** argv) {
+  CLI::App app{"Adds 3D points of the page to sfm's sparse cloud, cameras held fixed: "
+               "text and print followed from the reference view into the other photos by "
+               "optical flow, and the page's outline matched along epipolar lines. Writes "
+               "points.ply (sfm's points first), points.json and overlay.png."};
+  densify::DensifyOptions o;
+  bool no_texture = false, no_outline = false;
+  app.add_option("--data", o.data_dir, "data set folder (its images/ are read)")->required();
+  app.add_option("--sfm", o.sfm_dir, "sfm output: cameras.json, points.ply, reference.png")
+      ->required();
+  app.add_option("--boundary", o.boundary, "segment-boundary output: boundary.json, mask.png")
+      ->required();
+  app.add_option("--out", o.out_dir, "output directory (e.g. 25_points)")->required();
+  app.add_option("--max-image-size", o.max_image_size,
+                 "long side of the working copies of the photos (pixels)")
+      ->capture_default_str()->check(CLI::Range(64, 100000));
+  app.add_option("--region-margin-px", o.region_margin_px,
+                 "document region (mask.png) grown by this many pixels")
+      ->capture_default_str()->check(CLI::Range(0.0, 1000.0));
+  app.add_flag("--no-texture", no_texture, "no texture points");
+  app.add_option("--texture-step", o.texture.step_px,
+                 "texture: grid spacing in working-copy pixels")
+      ->capture_default_str()->check(CLI::Range(1.0, 1000.0));
+  app.add_option("--min-texture", o.texture.min_texture,
+                 "texture: skip pixels whose structure-tensor minimum eigenvalue is below "
+                 "this fraction of the region's 95th percentile")
+      ->capture_default_str()->check(CLI::Range(0.0, 1.0));
+  app.add_option("--texture-min-views", o.texture.min_views,
+                 "texture: photos a point needs, the reference included")
+      ->capture_default_str()->check(CLI::Range(2, 1000));
+  app.add_flag("--no-outline", no_outline, "no outline points");
+  app.add_option("--outline-step", o.outline.step_px,
+                 "outline: spacing of the samples along the real sides (working-copy pixels)")
+      ->capture_default_str()->check(CLI::Range(1.0, 1000.0));
+  app.add_option("--outline-min-views", o.outline.min_views,
+                 "outline: photos that must agree on a point, the reference included")
+      ->capture_default_str()->check(CLI::Range(2, 1000));
+  app.add_option("--outline-agree-px", o.outline.agree_px,
+                 "outline: other photos agree when their edge is within this distance")
+      ->capture_default_str()->check(CLI::Range(0.1, 100.0));
+
+  return RunStage("densify", app, argc, argv, [&] {
+    o.texture.enabled = !no_texture;
+    o.outline.enabled = !no_outline;
+    const densify::DensifyInputs in = densify::ReadInputs(o);
+    const densify::DensifyResult r = densify::Run(in, o);
+    densify::WriteOutputs(in, r, o);
+    for (const std::string& w : r.warnings) Log("warning: " + w);
+    Log("wrote " + (o.out_dir / "points.ply").string() + ": " + std::to_string(r.sfm_points) +
+        " sfm + " + std::to_string(r.texture_points) + " texture + " +
+        std::to_string(r.outline_points) + " outline points, " +
+        std::to_string(r.seconds_total).substr(0, 4) + " s");
+  });
+}
