@@ -261,6 +261,7 @@ struct EdgeSample {
   int sign = 1;            // grey rises (+1) or falls (-1) going out
   double near_depth = 0, far_depth = 0;
   std::vector<std::vector<Eigen::Vector2d>> candidates;  // per view index
+  std::vector<Eigen::Vector2d> normal_in_view;            // unit, per view index
 };
 
 std::vector<EdgeSample> EdgeSamples(const View& ref, const Boundary& boundary,
@@ -330,6 +331,7 @@ void AddOutlinePoints(const View& ref, const std::vector<View>& others, int num_
       e.near_depth = lo * (1 - o.depth_margin);
       e.far_depth = hi * (1 + o.depth_margin);
       e.candidates.assign(num_views, {});
+      e.normal_in_view.assign(num_views, Eigen::Vector2d::Zero());
     }
   }
 
@@ -355,6 +357,7 @@ void AddOutlinePoints(const View& ref, const std::vector<View>& others, int num_
       const double cos_cross = nj.dot(dir);
       if (!nj.allFinite() || !tj.allFinite() || std::abs(cos_cross) < min_cos) continue;
       const int sign_along = e.sign * (cos_cross > 0 ? 1 : -1);
+      e.normal_in_view[view.index] = nj;
       const int count = int(length / 0.5) + 1;
       std::vector<double> g(count, 0);
       for (int i = 0; i < count; ++i) {
@@ -456,12 +459,82 @@ void AddOutlinePoints(const View& ref, const std::vector<View>& others, int num_
       ++result->outline_ambiguous;
       continue;
     }
-    Eigen::Vector3d X;
-    double error = 0;
-    if (!TriangulateChecked(hypotheses[best].obs, o.max_reprojection_px, 0, &X, &error)) {
+    // The depth along the sample's ray at which its projection crosses the
+    // edge found in each view: residuals across the edge only (along it a
+    // match is no evidence), so a view whose edge nearly follows its
+    // epipolar line weighs little.
+    const Hypothesis& h = hypotheses[best];
+    double depth = ref.camera.CamFromWorld(h.point).z();
+    auto residuals = [&](double d, std::vector<double>* r) {
+      r->clear();
+      const Eigen::Vector3d X = RayPoint(ref.camera, e.pixel, d);
+      for (size_t k = 1; k < h.obs.size(); ++k) {
+        const Eigen::Vector3d xc = h.obs[k].camera->CamFromWorld(X);
+        if (!(xc.z() > 0)) return false;
+        r->push_back(e.normal_in_view[h.views[k - 1]].dot(h.obs[k].camera->ProjectCam(xc) -
+                                                           h.obs[k].pixel));
+      }
+      return true;
+    };
+    std::vector<double> r0, r1;
+    bool solved = depth > 0;
+    for (int iteration = 0; solved && iteration < 8; ++iteration) {
+      const double step = 1e-6 * depth;
+      if (!residuals(depth, &r0) || !residuals(depth + step, &r1)) {
+        solved = false;
+        break;
+      }
+      double jtj = 0, jtr = 0;
+      for (size_t k = 0; k < r0.size(); ++k) {
+        const double j = (r1[k] - r0[k]) / step;
+        jtj += j * j;
+        jtr += j * r0[k];
+      }
+      if (!(jtj > 0)) {
+        solved = false;
+        break;
+      }
+      const double delta = -jtr / jtj;
+      depth += delta;
+      if (!(depth > 0) || std::abs(delta) < 1e-9 * depth) break;
+    }
+    double worst = 0, error = 0;
+    if (solved && depth > 0 && residuals(depth, &r0)) {
+      for (const double r : r0) {
+        worst = std::max(worst, std::abs(r));
+        error += std::abs(r) / double(r0.size());
+      }
+    } else {
+      solved = false;
+    }
+    if (!solved || worst > o.max_reprojection_px) {
       ++result->outline_unmatched;
       continue;
     }
+    // Continuity with the page seen just inside the edge.
+    {
+      Eigen::Matrix3d ata = Eigen::Matrix3d::Zero();
+      Eigen::Vector3d atb = Eigen::Vector3d::Zero();
+      int near = 0;
+      const double r2 = o.continuity_radius_px * o.continuity_radius_px;
+      for (size_t i = 0; i < known_pixels.size(); ++i) {
+        const Eigen::Vector2d d = known_pixels[i] - e.pixel;
+        if (d.squaredNorm() > r2) continue;
+        const Eigen::Vector3d a(d.x(), d.y(), 1);
+        ata += a * a.transpose();
+        atb += a / known_depths[i];
+        ++near;
+      }
+      if (near >= 6 && std::abs(ata.determinant()) > 1e-6 * std::pow(ata.trace(), 3)) {
+        const double inverse_depth = ata.ldlt().solve(atb)(2);
+        if (inverse_depth > 0 &&
+            std::abs(1 / inverse_depth - depth) > o.max_depth_jump * depth) {
+          ++result->outline_off_surface;
+          continue;
+        }
+      }
+    }
+    const Eigen::Vector3d X = RayPoint(ref.camera, e.pixel, depth);
     result->points.vertices.push_back(X);
     result->points.colors.push_back({255, 0, 255});
     track_length->push_back(double(hypotheses[best].obs.size()));
@@ -538,6 +611,8 @@ Json DensifyOptions::ToJson() const {
             {"straight_px", outline.straight_px},
             {"agree_px", outline.agree_px},
             {"max_reprojection_px", outline.max_reprojection_px},
+            {"continuity_radius_px", outline.continuity_radius_px},
+            {"max_depth_jump", outline.max_depth_jump},
             {"min_views", outline.min_views}}}};
 }
 
@@ -681,7 +756,8 @@ DensifyResult Run(const DensifyInputs& in, const DensifyOptions& o) {
   Log(std::to_string(r.outline_points) + " outline points from " +
       std::to_string(r.outline_samples) + " edge samples (" +
       std::to_string(r.outline_unmatched) + " unmatched, " +
-      std::to_string(r.outline_ambiguous) + " ambiguous), " +
+      std::to_string(r.outline_ambiguous) + " ambiguous, " +
+      std::to_string(r.outline_off_surface) + " off the surface), " +
       std::to_string(r.seconds_outline).substr(0, 4) + " s");
   r.seconds_total = SecondsSince(start);
   return r;
@@ -730,7 +806,8 @@ void WriteOutputs(const DensifyInputs& in, const DensifyResult& r, const Densify
   doc["texture"] = {{"samples", r.texture_samples}};
   doc["outline"] = {{"samples", r.outline_samples},
                     {"unmatched", r.outline_unmatched},
-                    {"ambiguous", r.outline_ambiguous}};
+                    {"ambiguous", r.outline_ambiguous},
+                    {"off_surface", r.outline_off_surface}};
   doc["views"] = Json::array();
   for (const ViewStats& v : r.views)
     doc["views"].push_back({{"image", v.image},

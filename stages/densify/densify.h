@@ -75,6 +75,13 @@ struct OutlineOptions {
   double agree_px = 1.5;             // other views agree within this distance
   double max_reprojection_px = 1.0;  // after triangulating from all of them
   int min_views = 3;                 // the reference included
+  // A point must continue the surface of the known points within
+  // `continuity_radius_px` of it (an affine fit of 1/depth, when at least 6
+  // are there) to `max_depth_jump` of its depth. The silhouette of a curl
+  // is matched across views like an edge, but its triangulation lies off
+  // the page (set02's curled corner: p90 4 % of the diagonal without this).
+  double continuity_radius_px = 24;
+  double max_depth_jump = 0.02;
 };
 
 struct DensifyOptions {
@@ -118,6 +125,7 @@ struct DensifyResult {
   int outline_samples = 0;     // edge samples on the real sides
   int outline_unmatched = 0;   // fewer than min_views agree
   int outline_ambiguous = 0;   // another depth is as well supported
+  int outline_off_surface = 0; // off the surface of the points just inside
   double working_scale = 1;    // working copies / photos
   std::vector<ViewStats> views;
   double seconds_reading = 0, seconds_texture = 0, seconds_outline = 0, seconds_total = 0;

@@ -45,12 +45,13 @@ class Pipeline : public ::testing::Test {
 };
 
 TEST_F(Pipeline, WritesEveryStageOutputAndTheyValidate) {
-  for (const char* stage : {"bin/sfm", "bin/segment-boundary", "bin/detect-features",
+  for (const char* stage : {"bin/sfm", "bin/segment-boundary", "bin/densify", "bin/detect-features",
                             "bin/init-mesh", "bin/optimize", "bin/render"})
     EXPECT_EQ(first_.output.find(stage), std::string::npos) << first_.output;
   for (const char* f : {"10_sfm/cameras.json", "10_sfm/points.ply", "10_sfm/reference.png",
                         "20_boundary/boundary.json", "20_boundary/mask.png",
-                        "20_boundary/overlay.png", "30_features/features.json",
+                        "20_boundary/overlay.png", "25_points/points.ply",
+                        "25_points/points.json", "25_points/overlay.png", "30_features/features.json",
                         "30_features/overlay.png", "40_init/mesh3d.ply",
                         "50_optimize/log.json", "50_optimize/scene.glb", "60_render/rectified.png",
                         "70_eval/metrics.json", "report.html"})
@@ -82,12 +83,24 @@ TEST_F(Pipeline, SecondRunDoesNothingAndFlagsRerunOnlyDownstream) {
   EXPECT_EQ(changed.output.find("bin/sfm"), std::string::npos) << changed.output;
   EXPECT_NE(changed.output.find("bin/segment-boundary"), std::string::npos) << changed.output;
   EXPECT_NE(changed.output.find("bin/detect-features"), std::string::npos) << changed.output;
+  EXPECT_NE(changed.output.find("bin/densify"), std::string::npos) << changed.output;
   EXPECT_EQ(MTime("10_sfm/cameras.json"), sfm_time);
   EXPECT_NE(MTime("20_boundary/boundary.json"), boundary_time);
   // Back to the default flags: reruns once more, then is stable.
   ASSERT_EQ(Make("all EVAL_FLAGS=--no-ocr").exit_code, 0);
   CommandResult stable = Make("all EVAL_FLAGS=--no-ocr");
   EXPECT_EQ(stable.output.find("bin/segment-boundary"), std::string::npos) << stable.output;
+
+  // DENSIFY=0: init-mesh and optimize fit sfm's points; back again, densify's.
+  CommandResult sparse = Make("all EVAL_FLAGS=--no-ocr DENSIFY=0");
+  ASSERT_EQ(sparse.exit_code, 0) << sparse.output;
+  EXPECT_EQ(sparse.output.find("bin/densify"), std::string::npos) << sparse.output;
+  EXPECT_NE(sparse.output.find("--points " + (Work() / "10_sfm/points.ply").string()),
+            std::string::npos) << sparse.output;
+  CommandResult dense = Make("all EVAL_FLAGS=--no-ocr");
+  ASSERT_EQ(dense.exit_code, 0) << dense.output;
+  EXPECT_NE(dense.output.find("--points " + (Work() / "25_points/points.ply").string()),
+            std::string::npos) << dense.output;
 }
 
 TEST_F(Pipeline, FeaturesFromAnotherDetectorAreValidatedAndUsed) {

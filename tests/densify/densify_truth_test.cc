@@ -1,0 +1,78 @@
+// densify on every data set with ground truth, from the true cameras and the
+// true outline (so only densify's matching is measured): its texture and
+// outline points against the true surface.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+
+#include "common/isometry/mesh_index.h"
+#include "tests/init-mesh/work_fixture.h"
+#include "tests/isometry/test_meshes.h"
+#include "tests/support/test_support.h"
+#include "tests/support/truth_frame.h"
+
+namespace docunfold::testing {
+namespace {
+
+double Quantile(std::vector<double> v, double q) {
+  if (v.empty()) return NAN;
+  std::sort(v.begin(), v.end());
+  return v[size_t(q * double(v.size() - 1))];
+}
+
+// One process for all sets: ctest runs each test case in its own.
+TEST(DensifyOnTruth, PointsLieOnTheTrueSurface) {
+  const auto sets = DataSetsWithGroundTruth();
+  if (sets.empty()) GTEST_SKIP() << "no data sets with ground truth";
+  for (const fs::path& set : sets) {
+    SCOPED_TRACE(set.string());
+    auto gt = LoadGroundTruth(set);
+    ASSERT_TRUE(gt) << set;
+    const std::string reference = ChooseReferenceView(*gt);
+    TempDir dir;
+    WriteWorkFromTruth(*gt, reference, dir.path(), SfmFromTruthOptions());
+    const CommandResult run = RunCommand(
+        Quote(StageBinary("densify").string()) + " --data " + Quote(set.string()) + " --sfm " +
+        Quote((dir / "10_sfm").string()) + " --boundary " + Quote((dir / "20_boundary").string()) +
+        " --out " + Quote((dir / "25_points").string()) + " 2>&1");
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+    const PlyData cloud = ReadPly(dir / "25_points/points.ply");
+    const PlyProperty* source = cloud.FindProperty("source");
+    ASSERT_NE(source, nullptr);
+    const MeshPair truth = TrueMeshPair(*gt, reference);
+    const double diagonal = gt->Diagonal() * ReferenceFrame(*gt, reference).scale;
+    isometry::TriangleMeshIndex surface(truth.mesh3d, truth.grid.Triangles());
+    std::vector<double> texture, outline;
+    for (size_t i = 0; i < cloud.vertices.size(); ++i) {
+      const double d = surface.Closest(cloud.vertices[i])->distance / diagonal;
+      if (source->values[i] == 1) texture.push_back(d);
+      if (source->values[i] == 2) outline.push_back(d);
+    }
+    const Json report = ReadJsonFile(dir / "25_points/points.json");
+    const Json boundary = ReadJsonFile(dir / "20_boundary/boundary.json");
+    bool whole_page = true;
+    for (const auto& side : boundary["sides"]) whole_page = whole_page && side["real"].get<bool>();
+    std::printf("[densify] %-6s ref %-11s texture %5zu median %.3f%% p90 %.3f%% | outline %4zu "
+                "of %4d samples median %.3f%% p90 %.3f%% of the diagonal, %.2f s\n",
+                set.filename().c_str(), reference.c_str(), texture.size(),
+                100 * Quantile(texture, 0.5), 100 * Quantile(texture, 0.9), outline.size(),
+                report["outline"]["samples"].get<int>(), 100 * Quantile(outline, 0.5),
+                100 * Quantile(outline, 0.9), report["seconds"]["total"].get<double>());
+    // Measured (true cameras and outline): texture median <= 0.022 %, p90
+    // <= 0.114 %; outline on whole pages median <= 0.054 %, p90 <= 0.26 %
+    // except r04 (0.68 %: its bottom edge's soft shadow is matched in some
+    // views). The outline of a cut-off page (set08) gives few points.
+    EXPECT_GE(texture.size(), 1000u);
+    EXPECT_LT(Quantile(texture, 0.5), 0.0005);
+    EXPECT_LT(Quantile(texture, 0.9), 0.002);
+    if (whole_page) {
+      EXPECT_GE(outline.size(), 200u);
+      EXPECT_LT(Quantile(outline, 0.5), 0.001);
+      EXPECT_LT(Quantile(outline, 0.9), 0.01);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace docunfold::testing

@@ -1,0 +1,236 @@
+// densify's building blocks, and Run on a rendered scene: a tilted page
+// with rows of "words" on a darker table, seen by four cameras.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <random>
+
+#include <Eigen/Geometry>
+#include <opencv2/imgproc.hpp>
+
+#include "stages/densify/densify.h"
+
+namespace docunfold::testing {
+namespace {
+
+using densify::DensifyInputs;
+using densify::DensifyOptions;
+using densify::DensifyResult;
+
+PinholeCamera LookAt(const std::string& image, const Eigen::Vector3d& centre,
+                     const Eigen::Vector3d& target) {
+  PinholeCamera c;
+  c.image = image;
+  c.width = 800;
+  c.height = 600;
+  c.K << 1000, 0, 399.5, 0, 1000, 299.5, 0, 0, 1;
+  const Eigen::Vector3d z = (target - centre).normalized();
+  const Eigen::Vector3d x = Eigen::Vector3d::UnitY().cross(z).normalized();
+  const Eigen::Vector3d y = z.cross(x);
+  c.R.row(0) = x.transpose();
+  c.R.row(1) = y.transpose();
+  c.R.row(2) = z.transpose();
+  c.t = -c.R * centre;
+  return c;
+}
+
+TEST(Densify, ScaledCameraSeesTheResizedPixel) {
+  const PinholeCamera c = LookAt("a.jpg", {0.1, -0.2, 0}, {0, 0, 1});
+  const PinholeCamera half = densify::ScaleCamera(c, 0.5);
+  EXPECT_EQ(half.width, 400);
+  EXPECT_EQ(half.height, 300);
+  const Eigen::Vector3d X(0.05, 0.1, 1.1);
+  const Eigen::Vector2d full = c.Project(X), small = half.Project(X);
+  // cv::resize's pixel centres: x' = (x + 0.5) s - 0.5.
+  EXPECT_NEAR(small.x(), (full.x() + 0.5) * 0.5 - 0.5, 1e-9);
+  EXPECT_NEAR(small.y(), (full.y() + 0.5) * 0.5 - 0.5, 1e-9);
+}
+
+TEST(Densify, TriangulationIsExactWithoutNoise) {
+  const PinholeCamera a = LookAt("a", {0, 0, 0}, {0, 0, 1});
+  const PinholeCamera b = LookAt("b", {0.3, 0, 0.05}, {0, 0, 1});
+  const PinholeCamera c = LookAt("c", {-0.1, 0.25, 0}, {0, 0, 1});
+  const Eigen::Vector3d X(0.07, -0.04, 0.93);
+  const Eigen::Vector3d Y =
+      densify::Triangulate({&a, &b, &c}, {a.Project(X), b.Project(X), c.Project(X)});
+  EXPECT_LT((X - Y).norm(), 1e-9);
+  // One view cannot place a point: the result is not finite or not X.
+  const Eigen::Vector3d Z = densify::Triangulate({&a, &a}, {a.Project(X), a.Project(X)});
+  EXPECT_FALSE(Z.allFinite() && (Z - X).norm() < 1e-6);
+}
+
+// The page: origin at its top-left corner, `along`/`down` its axes (metres
+// per texel), a texture of rows of dark words on white.
+struct Scene {
+  Eigen::Vector3d origin, along, down;
+  cv::Mat1b texture;
+  CameraSet cameras;
+  std::vector<cv::Mat> photos;  // grey, per view
+  Eigen::Vector3d Point(double u, double v) const { return origin + u * along + v * down; }
+  // The page's corners: texel centres are at integers, so the texture's
+  // outer edges (what the photos show) are half a texel outside them.
+  std::array<Eigen::Vector3d, 4> Corners() const {
+    const double r = texture.cols - 0.5, b = texture.rows - 0.5;
+    return {Point(-0.5, -0.5), Point(r, -0.5), Point(r, b), Point(-0.5, b)};
+  }
+};
+
+Scene MakeScene() {
+  Scene s;
+  // 0.30 x 0.40 m page at about 1 m, tilted 25 degrees about x; 1 mm texels.
+  const Eigen::Matrix3d tilt =
+      Eigen::AngleAxisd(25 * M_PI / 180, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  s.along = tilt * Eigen::Vector3d(0.001, 0, 0);
+  s.down = tilt * Eigen::Vector3d(0, 0.001, 0);
+  s.texture = cv::Mat1b(400, 300, uchar(235));
+  s.origin = Eigen::Vector3d(0, 0, 1.1) - 150 * s.along - 200 * s.down;
+  std::mt19937 rng(7);
+  std::uniform_int_distribution<int> word(6, 22), gap(3, 8), ink(20, 70);
+  for (int y = 40; y + 6 < 360; y += 12)  // lines of words, 30 mm margins
+    for (int x = 30; x < 270;) {
+      const int w = std::min(word(rng), 270 - x);
+      cv::rectangle(s.texture, cv::Rect(x, y, w, 6), cv::Scalar(ink(rng)), cv::FILLED);
+      x += w + gap(rng);
+    }
+  s.cameras.reference = "ref.png";
+  s.cameras.views = {LookAt("ref.png", {0, 0, 0}, {0, 0, 1.1}),
+                     LookAt("b.png", {0.35, 0.05, 0.05}, {0, 0, 1.1}),
+                     LookAt("c.png", {-0.3, 0.1, 0.0}, {0, 0, 1.1}),
+                     LookAt("d.png", {0.05, -0.35, 0.1}, {0, 0, 1.1})};
+  for (const PinholeCamera& c : s.cameras.views) {
+    // Texel (u, v) -> pixel through K [R along | R down | R origin + t].
+    Eigen::Matrix3d M;
+    M.col(0) = c.R * s.along;
+    M.col(1) = c.R * s.down;
+    M.col(2) = c.R * s.origin + c.t;
+    const Eigen::Matrix3d H = c.K * M;
+    cv::Mat Hcv(3, 3, CV_64F);
+    for (int r = 0; r < 3; ++r)
+      for (int k = 0; k < 3; ++k) Hcv.at<double>(r, k) = H(r, k);
+    cv::Mat1b photo(c.height, c.width, uchar(70));  // the table
+    cv::Mat1b page, cover;
+    cv::warpPerspective(s.texture, page, Hcv, photo.size(), cv::INTER_AREA);
+    cv::warpPerspective(cv::Mat1b(s.texture.size(), uchar(255)), cover, Hcv, photo.size(),
+                        cv::INTER_LINEAR);
+    // Blend along the edge as a camera would.
+    cv::Mat1f a, p, t;
+    cover.convertTo(a, CV_32F, 1 / 255.0);
+    page.convertTo(p, CV_32F);
+    photo.convertTo(t, CV_32F);
+    cv::Mat1f mixed = p.mul(a) + t.mul(1 - a);
+    mixed.convertTo(photo, CV_8U);
+    s.photos.push_back(photo);
+  }
+  return s;
+}
+
+DensifyInputs InputsOf(const Scene& s, int sfm_points) {
+  DensifyInputs in;
+  in.cameras = s.cameras;
+  in.distortion.assign(s.cameras.views.size(), {0, 0, 0, 0});
+  cv::cvtColor(s.photos[0], in.reference, cv::COLOR_GRAY2BGR);
+  in.photos = s.photos;
+  in.photos[0] = cv::Mat();
+  const PinholeCamera& ref = s.cameras.views[0];
+  const auto corners = s.Corners();
+  in.boundary.width = ref.width;
+  in.boundary.height = ref.height;
+  for (int i = 0; i < 4; ++i) {
+    in.boundary.corners[i] = ref.Project(corners[i]);
+    in.boundary.contour.push_back(in.boundary.corners[i]);
+  }
+  for (int i = 0; i < 4; ++i) {
+    in.boundary.sides[i].real = true;
+    // top TL->TR, right TR->BR, bottom BL->BR, left TL->BL
+    const int a = i == 2 ? 3 : i == 3 ? 0 : i, b = i == 2 ? 2 : i == 3 ? 3 : i + 1;
+    for (int k = 0; k <= 20; ++k)
+      in.boundary.sides[i].points.push_back(in.boundary.corners[a] +
+                                            (in.boundary.corners[b] - in.boundary.corners[a]) * k / 20.0);
+  }
+  in.region = ContourRegion(in.boundary, 0);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(20, 280), v(20, 380);
+  for (int i = 0; i < sfm_points; ++i) in.points.vertices.push_back(s.Point(u(rng), v(rng)));
+  in.points.colors.assign(in.points.vertices.size(), {128, 128, 128});
+  return in;
+}
+
+double DistanceToPage(const Scene& s, const Eigen::Vector3d& X) {
+  const Eigen::Vector3d n = s.along.cross(s.down).normalized();
+  return std::abs(n.dot(X - s.origin));
+}
+
+double DistanceToOutline(const Scene& s, const Eigen::Vector3d& X) {
+  const auto c = s.Corners();
+  double best = 1e9;
+  for (int i = 0; i < 4; ++i) {
+    const Eigen::Vector3d a = c[i], b = c[(i + 1) % 4];
+    const double t = std::clamp((X - a).dot(b - a) / (b - a).squaredNorm(), 0.0, 1.0);
+    best = std::min(best, (X - (a + t * (b - a))).norm());
+  }
+  return best;
+}
+
+TEST(Densify, PointsLieOnTheRenderedPageAndItsOutline) {
+  const Scene scene = MakeScene();
+  const DensifyInputs in = InputsOf(scene, 150);
+  const DensifyResult r = densify::Run(in, DensifyOptions());
+  const double diagonal = 0.5;  // of the 0.3 x 0.4 page
+  const auto& source = r.points.FindProperty("source")->values;
+  ASSERT_EQ(source.size(), r.points.vertices.size());
+  EXPECT_EQ(r.sfm_points, 150);
+  std::vector<double> on_page, on_outline;
+  for (size_t i = 0; i < r.points.vertices.size(); ++i) {
+    if (source[i] == densify::kTexture) on_page.push_back(DistanceToPage(scene, r.points.vertices[i]));
+    if (source[i] == densify::kOutline)
+      on_outline.push_back(DistanceToOutline(scene, r.points.vertices[i]));
+  }
+  ASSERT_EQ(int(on_page.size()), r.texture_points);
+  ASSERT_EQ(int(on_outline.size()), r.outline_points);
+  auto quantile = [](std::vector<double> v, double q) {
+    std::sort(v.begin(), v.end());
+    return v.empty() ? NAN : v[size_t(q * (v.size() - 1))];
+  };
+  std::printf("[densify] rendered page: %d texture points (median %.3f %%, p95 %.3f %% of the "
+              "diagonal off the page), %d of %d outline samples (median %.3f %%, p95 %.3f %% off "
+              "the outline)\n",
+              r.texture_points, 100 * quantile(on_page, 0.5) / diagonal,
+              100 * quantile(on_page, 0.95) / diagonal, r.outline_points, r.outline_samples,
+              100 * quantile(on_outline, 0.5) / diagonal,
+              100 * quantile(on_outline, 0.95) / diagonal);
+  EXPECT_GT(r.texture_points, 2000);
+  EXPECT_LT(quantile(on_page, 0.5), 0.0005 * diagonal);
+  EXPECT_LT(quantile(on_page, 0.95), 0.002 * diagonal);
+  EXPECT_GT(r.outline_points, r.outline_samples / 2);
+  EXPECT_LT(quantile(on_outline, 0.5), 0.001 * diagonal);
+  EXPECT_LT(quantile(on_outline, 0.95), 0.003 * diagonal);
+  // Nothing of the table: every new point is on the page or its edge.
+  EXPECT_LT(quantile(on_page, 1.0), 0.01 * diagonal);
+  EXPECT_LT(quantile(on_outline, 1.0), 0.01 * diagonal);
+}
+
+TEST(Densify, EachSourceCanBeSwitchedOffAndOneViewAddsNothing) {
+  const Scene scene = MakeScene();
+  DensifyInputs in = InputsOf(scene, 150);
+  DensifyOptions o;
+  o.texture.enabled = false;
+  DensifyResult r = densify::Run(in, o);
+  EXPECT_EQ(r.texture_points, 0);
+  EXPECT_GT(r.outline_points, 0);
+  o.texture.enabled = true;
+  o.outline.enabled = false;
+  r = densify::Run(in, o);
+  EXPECT_GT(r.texture_points, 0);
+  EXPECT_EQ(r.outline_points, 0);
+  // Only the reference view: sfm's points come back unchanged, with a warning.
+  in.cameras.views.resize(1);
+  in.photos.resize(1);
+  in.distortion.resize(1);
+  r = densify::Run(in, DensifyOptions());
+  EXPECT_EQ(r.points.vertices.size(), 150u);
+  EXPECT_EQ(r.texture_points + r.outline_points, 0);
+  EXPECT_FALSE(r.warnings.empty());
+}
+
+}  // namespace
+}  // namespace docunfold::testing
