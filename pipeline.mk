@@ -68,8 +68,11 @@ $(eval $(call flags_rule,features,$(if $(FEATURES),FEATURES=$(abspath $(FEATURES
 # The point cloud init-mesh and optimize fit: densify's when it is built in.
 POINTS_FILE := $(if $(and $(wildcard $(ROOT)/stages/densify),$(filter-out 0,$(DENSIFY))),$(WORK)/25_points/points.ply,$(WORK)/10_sfm/points.ply)
 $(eval $(call flags_rule,points,$(DENSIFY_FLAGS)))
-$(eval $(call flags_rule,init,$(INIT_FLAGS) points=$(POINTS_FILE)))
-$(eval $(call flags_rule,optimize,$(OPTIMIZE_FLAGS) points=$(POINTS_FILE)))
+# (recorded relative to the work directory, so a copied work directory is
+# still up to date)
+POINTS_FROM := $(notdir $(patsubst %/points.ply,%,$(POINTS_FILE)))
+$(eval $(call flags_rule,init,$(INIT_FLAGS) points=$(POINTS_FROM)))
+$(eval $(call flags_rule,optimize,$(OPTIMIZE_FLAGS) points=$(POINTS_FROM)))
 $(eval $(call flags_rule,render,$(RENDER_FLAGS)))
 $(eval $(call flags_rule,evaluate,$(EVAL_FLAGS)))
 

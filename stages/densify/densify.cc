@@ -255,13 +255,19 @@ bool FindStep(const View& view, const Eigen::Vector2d& c, const Eigen::Vector2d&
   return true;
 }
 
+// A crossing of an edge found in another view: where, and the edge's unit
+// normal there (from that image's gradient).
+struct EdgeMatch {
+  Eigen::Vector2d pixel;
+  Eigen::Vector2d normal;
+};
+
 struct EdgeSample {
   Eigen::Vector2d pixel;   // on the edge, reference working copy
   Eigen::Vector2d normal;  // unit, pointing out of the page
   int sign = 1;            // grey rises (+1) or falls (-1) going out
   double near_depth = 0, far_depth = 0;
-  std::vector<std::vector<Eigen::Vector2d>> candidates;  // per view index
-  std::vector<Eigen::Vector2d> normal_in_view;            // unit, per view index
+  std::vector<std::vector<EdgeMatch>> candidates;  // per view index
 };
 
 std::vector<EdgeSample> EdgeSamples(const View& ref, const Boundary& boundary,
@@ -331,7 +337,6 @@ void AddOutlinePoints(const View& ref, const std::vector<View>& others, int num_
       e.near_depth = lo * (1 - o.depth_margin);
       e.far_depth = hi * (1 + o.depth_margin);
       e.candidates.assign(num_views, {});
-      e.normal_in_view.assign(num_views, Eigen::Vector2d::Zero());
     }
   }
 
@@ -346,18 +351,15 @@ void AddOutlinePoints(const View& ref, const std::vector<View>& others, int num_
       const double length = (b - a).norm();
       if (length < 1) continue;
       const Eigen::Vector2d dir = (b - a) / length;
-      // The sample's normal and tangent as this view sees them (mid depth).
+      // The sample's outward normal as this view sees it (at mid depth; only
+      // for the crossing angle and the gradient's direction).
       const double mid = 0.5 * (e.near_depth + e.far_depth);
       const Eigen::Vector2d at = view.camera.Project(RayPoint(ref.camera, e.pixel, mid));
       const Eigen::Vector2d nj =
           (view.camera.Project(RayPoint(ref.camera, e.pixel + e.normal, mid)) - at).normalized();
-      const Eigen::Vector2d tj =
-          (view.camera.Project(RayPoint(ref.camera, e.pixel + Eigen::Vector2d(-e.normal.y(), e.normal.x()), mid)) - at)
-              .normalized();
       const double cos_cross = nj.dot(dir);
-      if (!nj.allFinite() || !tj.allFinite() || std::abs(cos_cross) < min_cos) continue;
+      if (!nj.allFinite() || std::abs(cos_cross) < min_cos) continue;
       const int sign_along = e.sign * (cos_cross > 0 ? 1 : -1);
-      e.normal_in_view[view.index] = nj;
       const int count = int(length / 0.5) + 1;
       std::vector<double> g(count, 0);
       for (int i = 0; i < count; ++i) {
@@ -372,17 +374,22 @@ void AddOutlinePoints(const View& ref, const std::vector<View>& others, int num_
         const Eigen::Vector2d c = a + 0.5 * (i + frac) * dir;
         const Eigen::Vector2d grad = view.Gradient(c);
         if (e.sign * grad.normalized().dot(nj) < 0.85) continue;  // not this edge's direction
+        // The step continues along the edge as this image shows it (a
+        // tangent predicted from the reference is off where the edge
+        // recedes in depth: set07's tilted panel).
+        const Eigen::Vector2d normal = grad.normalized();  // grey rises along it
+        const Eigen::Vector2d tangent(-normal.y(), normal.x());
         bool straight = true;
         for (double along : {-o.straight_px, -o.straight_px / 2, o.straight_px / 2, o.straight_px}) {
           double offset = 0, strength = 0;
-          if (!FindStep(view, c + along * tj, nj, 1.5, e.sign, &offset, &strength) ||
+          if (!FindStep(view, c + along * tangent, normal, 1.5, 1, &offset, &strength) ||
               strength < 0.5 * g[i] * std::abs(cos_cross)) {
             straight = false;
             break;
           }
         }
         if (!straight) continue;
-        e.candidates[view.index].push_back(c);
+        e.candidates[view.index].push_back({c, normal});
         ++stats.outline_candidates;
       }
     }
@@ -401,34 +408,37 @@ void AddOutlinePoints(const View& ref, const std::vector<View>& others, int num_
     // other views with a candidate where that depth projects.
     struct Hypothesis {
       Eigen::Vector3d point;
-      std::vector<Observation> obs;
-      std::vector<int> views;
+      std::vector<Observation> obs;    // the reference first
+      std::vector<int> views;          // of obs[1...]
+      std::vector<Eigen::Vector2d> normals;  // of obs[1...]
     };
     std::vector<Hypothesis> hypotheses;
     for (int vi = 0; vi < num_views; ++vi) {
-      for (const Eigen::Vector2d& c : e.candidates[vi]) {
+      for (const EdgeMatch& c : e.candidates[vi]) {
         Hypothesis h;
-        h.point = Triangulate({&ref.camera, &view_of[vi]->camera}, {e.pixel, c});
+        h.point = Triangulate({&ref.camera, &view_of[vi]->camera}, {e.pixel, c.pixel});
         if (!h.point.allFinite()) continue;
-        h.obs = {{&ref.camera, e.pixel}, {&view_of[vi]->camera, c}};
+        h.obs = {{&ref.camera, e.pixel}, {&view_of[vi]->camera, c.pixel}};
         h.views = {vi};
+        h.normals = {c.normal};
         for (int vk = 0; vk < num_views; ++vk) {
           if (vk == vi || e.candidates[vk].empty()) continue;
           const Eigen::Vector3d xc = view_of[vk]->camera.CamFromWorld(h.point);
           if (!(xc.z() > 0)) continue;
           const Eigen::Vector2d expected = view_of[vk]->camera.ProjectCam(xc);
-          const Eigen::Vector2d* nearest = nullptr;
+          const EdgeMatch* nearest = nullptr;
           double nearest_distance = o.agree_px;
-          for (const Eigen::Vector2d& ck : e.candidates[vk]) {
-            const double d = (ck - expected).norm();
+          for (const EdgeMatch& ck : e.candidates[vk]) {
+            const double d = (ck.pixel - expected).norm();
             if (d < nearest_distance) {
               nearest_distance = d;
               nearest = &ck;
             }
           }
           if (nearest) {
-            h.obs.push_back({&view_of[vk]->camera, *nearest});
+            h.obs.push_back({&view_of[vk]->camera, nearest->pixel});
             h.views.push_back(vk);
+            h.normals.push_back(nearest->normal);
           }
         }
         hypotheses.push_back(std::move(h));
@@ -471,8 +481,7 @@ void AddOutlinePoints(const View& ref, const std::vector<View>& others, int num_
       for (size_t k = 1; k < h.obs.size(); ++k) {
         const Eigen::Vector3d xc = h.obs[k].camera->CamFromWorld(X);
         if (!(xc.z() > 0)) return false;
-        r->push_back(e.normal_in_view[h.views[k - 1]].dot(h.obs[k].camera->ProjectCam(xc) -
-                                                           h.obs[k].pixel));
+        r->push_back(h.normals[k - 1].dot(h.obs[k].camera->ProjectCam(xc) - h.obs[k].pixel));
       }
       return true;
     };
