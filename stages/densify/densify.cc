@@ -218,11 +218,11 @@ void AddTexturePoints(const View& ref, const std::vector<View>& others,
     Eigen::Vector3d X;
     double error = 0;
     if (!TriangulateChecked(obs, o.max_reprojection_px, min_angle, &X, &error)) continue;
-    const cv::Point full = result->working_scale == 1
-                               ? cv::Point(int(t.pixel.x()), int(t.pixel.y()))
-                               : cv::Point(std::clamp(int(std::lround((t.pixel.x() + 0.5) / result->working_scale - 0.5)), 0, reference_bgr.cols - 1),
-                                           std::clamp(int(std::lround((t.pixel.y() + 0.5) / result->working_scale - 0.5)), 0, reference_bgr.rows - 1));
-    const cv::Vec3b bgr = reference_bgr.at<cv::Vec3b>(full);
+    // Colour from the full-size reference image.
+    const Eigen::Vector2d full = ScalePixel(t.pixel, 1 / result->working_scale);
+    const cv::Vec3b bgr = reference_bgr.at<cv::Vec3b>(
+        std::clamp(int(std::lround(full.y())), 0, reference_bgr.rows - 1),
+        std::clamp(int(std::lround(full.x())), 0, reference_bgr.cols - 1));
     result->points.vertices.push_back(X);
     result->points.colors.push_back({bgr[2], bgr[1], bgr[0]});
     track_length->push_back(double(obs.size()));
