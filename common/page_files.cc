@@ -2,8 +2,11 @@
 
 #include <cmath>
 
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "common/atomic_file.h"
+#include "common/errors.h"
 #include "common/json_io.h"
 
 namespace docunfold {
@@ -82,6 +85,18 @@ FeatureFile ReadFeatures(const fs::path& file) {
     f.segments.push_back(std::move(s));
   }
   return f;
+}
+
+cv::Mat1b ReadDocumentMask(const fs::path& path, int width, int height) {
+  const cv::Mat mask = ReadImage(path, cv::IMREAD_GRAYSCALE);
+  if (mask.cols != width || mask.rows != height)
+    throw InputError(path.string() + ": " + std::to_string(mask.cols) + "x" +
+                     std::to_string(mask.rows) + " differs from the reference image's " +
+                     std::to_string(width) + "x" + std::to_string(height));
+  cv::Mat1b region = mask > 0;
+  if (cv::countNonZero(region) == 0)
+    throw InputError(path.string() + ": empty document region (all pixels zero)");
+  return region;
 }
 
 cv::Mat1b GrowRegion(const cv::Mat1b& region, double margin_px) {

@@ -55,6 +55,10 @@ struct FeatureFile {
 // required (schemas/docunfold.features.schema.json).
 FeatureFile ReadFeatures(const fs::path& file);
 
+// 20_boundary/mask.png as the document region (non-zero = page). Throws
+// InputError naming the file when it is not width x height or is empty.
+cv::Mat1b ReadDocumentMask(const fs::path& path, int width, int height);
+
 // The document region in the reference image: `region` (e.g. mask.png, any
 // non-zero pixel inside) grown by `margin_px`, so points on the page's very
 // edge still count.

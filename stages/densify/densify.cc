@@ -661,15 +661,7 @@ DensifyInputs ReadInputs(const DensifyOptions& o) {
   const fs::path boundary_file =
       fs::is_directory(o.boundary) ? o.boundary / "boundary.json" : o.boundary;
   in.boundary = ReadBoundary(boundary_file);
-  const fs::path mask_path = boundary_file.parent_path() / "mask.png";
-  const cv::Mat mask = ReadImage(mask_path, cv::IMREAD_GRAYSCALE);
-  if (mask.cols != ref->width || mask.rows != ref->height)
-    throw InputError(mask_path.string() + ": " + std::to_string(mask.cols) + "x" +
-                     std::to_string(mask.rows) + " differs from the reference image's " +
-                     std::to_string(ref->width) + "x" + std::to_string(ref->height));
-  in.region = mask > 0;
-  if (cv::countNonZero(in.region) == 0)
-    throw InputError(mask_path.string() + ": empty document region (all pixels zero)");
+  in.region = ReadDocumentMask(boundary_file.parent_path() / "mask.png", ref->width, ref->height);
   in.points = ReadPly(o.sfm_dir / "points.ply");
   if (in.points.vertices.empty())
     throw InputError((o.sfm_dir / "points.ply").string() + ": no points");

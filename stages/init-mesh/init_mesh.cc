@@ -547,16 +547,7 @@ Inputs ReadInputs(const fs::path& sfm_dir, const fs::path& boundary_dir,
   CheckFormat(doc, boundary_path, "docunfold.boundary", 1);
   in.boundary = ParseBoundary(doc);
 
-  const fs::path mask_path = boundary_dir / "mask.png";
-  const cv::Mat mask = ReadImage(mask_path, cv::IMREAD_GRAYSCALE);
-  if (mask.cols != in.reference.width || mask.rows != in.reference.height)
-    throw InputError(mask_path.string() + ": " + std::to_string(mask.cols) + "x" +
-                     std::to_string(mask.rows) + " differs from the reference image's " +
-                     std::to_string(in.reference.width) + "x" +
-                     std::to_string(in.reference.height));
-  in.mask = mask > 0;
-  if (cv::countNonZero(in.mask) == 0)
-    throw InputError(mask_path.string() + ": empty document region (all pixels zero)");
+  in.mask = ReadDocumentMask(boundary_dir / "mask.png", in.reference.width, in.reference.height);
   return in;
 }
 
