@@ -7,6 +7,7 @@
 
 #include <Eigen/SVD>
 #include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
@@ -61,9 +62,8 @@ View MakeView(int index, const PinholeCamera& camera, const cv::Mat& grey_photo,
   const bool distorted = std::any_of(distortion.begin(), distortion.end(),
                                      [](double d) { return d != 0; });
   if (distorted) {
-    cv::Mat K(3, 3, CV_64F);
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) K.at<double>(r, c) = v.camera.K(r, c);
+    cv::Mat K;
+    cv::eigen2cv(v.camera.K, K);
     const std::vector<double> coefficients(distortion.begin(), distortion.end());
     cv::undistort(resized, v.grey, K, coefficients);
   } else {
@@ -91,6 +91,24 @@ struct Observation {
   const PinholeCamera* camera;
   Eigen::Vector2d pixel;
 };
+
+// Sub-pixel position of the local maximum g[i] (a parabola through it and
+// its neighbours), as an offset in samples from i.
+double ParabolaPeak(const std::vector<double>& g, int i) {
+  const double curvature = g[i - 1] - 2 * g[i] + g[i + 1];
+  return curvature < 0 ? 0.5 * (g[i - 1] - g[i + 1]) / curvature : 0;
+}
+
+// Appends a point made by densify with its PLY properties (Run sets up
+// track_length, reprojection_error and source, in that order).
+void AppendPoint(const Eigen::Vector3d& X, const std::array<uint8_t, 3>& rgb, int views,
+                 double reprojection_error, PointSource source, PlyData* points) {
+  points->vertices.push_back(X);
+  points->colors.push_back(rgb);
+  points->properties[0].values.push_back(views);
+  points->properties[1].values.push_back(reprojection_error);
+  points->properties[2].values.push_back(source);
+}
 
 // Triangulates and checks: in front of every camera, every reprojection
 // within `max_error`, rays at least `min_angle` apart. Returns false when not.
@@ -163,13 +181,11 @@ void AddTexturePoints(const View& ref, const std::vector<View>& others,
     std::vector<Observation> obs;
   };
   std::vector<Track> tracks;
-  cv::Mat1i track_of(region.size(), -1);
   const double step = std::max(1.0, o.step_px);
   for (double y = 0; y < region.rows; y += step)
     for (double x = 0; x < region.cols; x += step) {
       const int u = int(x), v = int(y);
       if (!region(v, u) || texture(v, u) < threshold) continue;
-      track_of(v, u) = int(tracks.size());
       tracks.push_back({Eigen::Vector2d(u, v), {}});
     }
   result->texture_samples = int(tracks.size());
@@ -208,9 +224,6 @@ void AddTexturePoints(const View& ref, const std::vector<View>& others,
   }
 
   const double min_angle = o.min_triangulation_angle_deg * M_PI / 180;
-  auto* track_length = &result->points.properties[0].values;  // set up by Run
-  auto* reprojection = &result->points.properties[1].values;
-  auto* source = &result->points.properties[2].values;
   for (const Track& t : tracks) {
     if (int(t.obs.size()) + 1 < o.min_views) continue;
     std::vector<Observation> obs{{&ref.camera, t.pixel}};
@@ -223,11 +236,7 @@ void AddTexturePoints(const View& ref, const std::vector<View>& others,
     const cv::Vec3b bgr = reference_bgr.at<cv::Vec3b>(
         std::clamp(int(std::lround(full.y())), 0, reference_bgr.rows - 1),
         std::clamp(int(std::lround(full.x())), 0, reference_bgr.cols - 1));
-    result->points.vertices.push_back(X);
-    result->points.colors.push_back({bgr[2], bgr[1], bgr[0]});
-    track_length->push_back(double(obs.size()));
-    reprojection->push_back(error);
-    source->push_back(kTexture);
+    AppendPoint(X, {bgr[2], bgr[1], bgr[0]}, int(obs.size()), error, kTexture, &result->points);
     ++result->texture_points;
   }
 }
@@ -248,9 +257,7 @@ bool FindStep(const View& view, const Eigen::Vector2d& c, const Eigen::Vector2d&
     if (best < 0 || g[i] > g[best]) best = i;
   }
   if (best <= 0 || best >= count - 1 || g[best] <= 0) return false;
-  const double curvature = g[best - 1] - 2 * g[best] + g[best + 1];
-  const double frac = curvature < 0 ? 0.5 * (g[best - 1] - g[best + 1]) / curvature : 0;
-  *offset = -reach + 0.5 * (best + frac);
+  *offset = -reach + 0.5 * (best + ParabolaPeak(g, best));
   *strength = g[best];
   return true;
 }
@@ -313,6 +320,74 @@ std::vector<EdgeSample> EdgeSamples(const View& ref, const Boundary& boundary,
   return samples;
 }
 
+// The depth along the reference ray through `pixel` at which its projection
+// crosses the edge found in each other view (obs[1...], edge normals
+// `normals`), by Gauss-Newton from *depth: residuals across the edge only
+// (along it a match is no evidence), so a view whose edge nearly follows its
+// epipolar line weighs little. False when the fit fails; else the largest
+// and mean absolute residual (pixels).
+bool DepthAcrossEdges(const PinholeCamera& ref, const Eigen::Vector2d& pixel,
+                      const std::vector<Observation>& obs,
+                      const std::vector<Eigen::Vector2d>& normals, double* depth, double* worst,
+                      double* mean) {
+  auto residuals = [&](double d, std::vector<double>* r) {
+    r->clear();
+    const Eigen::Vector3d X = RayPoint(ref, pixel, d);
+    for (size_t k = 1; k < obs.size(); ++k) {
+      const Eigen::Vector3d xc = obs[k].camera->CamFromWorld(X);
+      if (!(xc.z() > 0)) return false;
+      r->push_back(normals[k - 1].dot(obs[k].camera->ProjectCam(xc) - obs[k].pixel));
+    }
+    return true;
+  };
+  std::vector<double> r0, r1;
+  if (!(*depth > 0)) return false;
+  for (int iteration = 0; iteration < 8; ++iteration) {
+    const double step = 1e-6 * *depth;
+    if (!residuals(*depth, &r0) || !residuals(*depth + step, &r1)) return false;
+    double jtj = 0, jtr = 0;
+    for (size_t k = 0; k < r0.size(); ++k) {
+      const double j = (r1[k] - r0[k]) / step;
+      jtj += j * j;
+      jtr += j * r0[k];
+    }
+    if (!(jtj > 0)) return false;
+    const double delta = -jtr / jtj;
+    *depth += delta;
+    if (!(*depth > 0) || std::abs(delta) < 1e-9 * *depth) break;
+  }
+  if (!(*depth > 0) || !residuals(*depth, &r0)) return false;
+  *worst = *mean = 0;
+  for (const double r : r0) {
+    *worst = std::max(*worst, std::abs(r));
+    *mean += std::abs(r) / double(r0.size());
+  }
+  return true;
+}
+
+// Whether `depth` at `pixel` continues the surface of the known points
+// within continuity_radius_px (an affine fit of 1/depth, when at least 6 are
+// there and they span an area) to max_depth_jump of the depth.
+bool ContinuesSurface(const Eigen::Vector2d& pixel, double depth,
+                      const std::vector<Eigen::Vector2d>& known_pixels,
+                      const std::vector<double>& known_depths, const OutlineOptions& o) {
+  Eigen::Matrix3d ata = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d atb = Eigen::Vector3d::Zero();
+  int near = 0;
+  const double r2 = o.continuity_radius_px * o.continuity_radius_px;
+  for (size_t i = 0; i < known_pixels.size(); ++i) {
+    const Eigen::Vector2d d = known_pixels[i] - pixel;
+    if (d.squaredNorm() > r2) continue;
+    const Eigen::Vector3d a(d.x(), d.y(), 1);
+    ata += a * a.transpose();
+    atb += a / known_depths[i];
+    ++near;
+  }
+  if (near < 6 || !(std::abs(ata.determinant()) > 1e-6 * std::pow(ata.trace(), 3))) return true;
+  const double inverse_depth = ata.ldlt().solve(atb)(2);
+  return !(inverse_depth > 0 && std::abs(1 / inverse_depth - depth) > o.max_depth_jump * depth);
+}
+
 void AddOutlinePoints(const View& ref, const std::vector<View>& others, int num_views,
                       const Boundary& boundary, const cv::Mat1b& page,
                       const std::vector<Eigen::Vector2d>& known_pixels,
@@ -369,9 +444,7 @@ void AddOutlinePoints(const View& ref, const std::vector<View>& others, int num_
       const double floor = o.min_contrast * std::abs(cos_cross);
       for (int i = 1; i + 1 < count; ++i) {
         if (g[i] < floor || g[i] < g[i - 1] || g[i] <= g[i + 1]) continue;
-        const double curvature = g[i - 1] - 2 * g[i] + g[i + 1];
-        const double frac = curvature < 0 ? 0.5 * (g[i - 1] - g[i + 1]) / curvature : 0;
-        const Eigen::Vector2d c = a + 0.5 * (i + frac) * dir;
+        const Eigen::Vector2d c = a + 0.5 * (i + ParabolaPeak(g, i)) * dir;
         const Eigen::Vector2d grad = view.Gradient(c);
         if (e.sign * grad.normalized().dot(nj) < 0.85) continue;  // not this edge's direction
         // The step continues along the edge as this image shows it (a
@@ -395,9 +468,6 @@ void AddOutlinePoints(const View& ref, const std::vector<View>& others, int num_
     }
   }
 
-  auto* track_length = &result->points.properties[0].values;
-  auto* reprojection = &result->points.properties[1].values;
-  auto* source = &result->points.properties[2].values;
   const std::vector<const View*> view_of = [&] {
     std::vector<const View*> v(num_views, nullptr);
     for (const View& view : others) v[view.index] = &view;
@@ -469,87 +539,20 @@ void AddOutlinePoints(const View& ref, const std::vector<View>& others, int num_
       ++result->outline_ambiguous;
       continue;
     }
-    // The depth along the sample's ray at which its projection crosses the
-    // edge found in each view: residuals across the edge only (along it a
-    // match is no evidence), so a view whose edge nearly follows its
-    // epipolar line weighs little.
     const Hypothesis& h = hypotheses[best];
-    double depth = ref.camera.CamFromWorld(h.point).z();
-    auto residuals = [&](double d, std::vector<double>* r) {
-      r->clear();
-      const Eigen::Vector3d X = RayPoint(ref.camera, e.pixel, d);
-      for (size_t k = 1; k < h.obs.size(); ++k) {
-        const Eigen::Vector3d xc = h.obs[k].camera->CamFromWorld(X);
-        if (!(xc.z() > 0)) return false;
-        r->push_back(h.normals[k - 1].dot(h.obs[k].camera->ProjectCam(xc) - h.obs[k].pixel));
-      }
-      return true;
-    };
-    std::vector<double> r0, r1;
-    bool solved = depth > 0;
-    for (int iteration = 0; solved && iteration < 8; ++iteration) {
-      const double step = 1e-6 * depth;
-      if (!residuals(depth, &r0) || !residuals(depth + step, &r1)) {
-        solved = false;
-        break;
-      }
-      double jtj = 0, jtr = 0;
-      for (size_t k = 0; k < r0.size(); ++k) {
-        const double j = (r1[k] - r0[k]) / step;
-        jtj += j * j;
-        jtr += j * r0[k];
-      }
-      if (!(jtj > 0)) {
-        solved = false;
-        break;
-      }
-      const double delta = -jtr / jtj;
-      depth += delta;
-      if (!(depth > 0) || std::abs(delta) < 1e-9 * depth) break;
-    }
-    double worst = 0, error = 0;
-    if (solved && depth > 0 && residuals(depth, &r0)) {
-      for (const double r : r0) {
-        worst = std::max(worst, std::abs(r));
-        error += std::abs(r) / double(r0.size());
-      }
-    } else {
-      solved = false;
-    }
-    if (!solved || worst > o.max_reprojection_px) {
+    double depth = ref.camera.CamFromWorld(h.point).z(), worst = 0, error = 0;
+    if (!DepthAcrossEdges(ref.camera, e.pixel, h.obs, h.normals, &depth, &worst, &error) ||
+        worst > o.max_reprojection_px) {
       ++result->outline_unmatched;
       continue;
     }
-    // Continuity with the page seen just inside the edge.
-    {
-      Eigen::Matrix3d ata = Eigen::Matrix3d::Zero();
-      Eigen::Vector3d atb = Eigen::Vector3d::Zero();
-      int near = 0;
-      const double r2 = o.continuity_radius_px * o.continuity_radius_px;
-      for (size_t i = 0; i < known_pixels.size(); ++i) {
-        const Eigen::Vector2d d = known_pixels[i] - e.pixel;
-        if (d.squaredNorm() > r2) continue;
-        const Eigen::Vector3d a(d.x(), d.y(), 1);
-        ata += a * a.transpose();
-        atb += a / known_depths[i];
-        ++near;
-      }
-      if (near >= 6 && std::abs(ata.determinant()) > 1e-6 * std::pow(ata.trace(), 3)) {
-        const double inverse_depth = ata.ldlt().solve(atb)(2);
-        if (inverse_depth > 0 &&
-            std::abs(1 / inverse_depth - depth) > o.max_depth_jump * depth) {
-          ++result->outline_off_surface;
-          continue;
-        }
-      }
+    if (!ContinuesSurface(e.pixel, depth, known_pixels, known_depths, o)) {
+      ++result->outline_off_surface;
+      continue;
     }
-    const Eigen::Vector3d X = RayPoint(ref.camera, e.pixel, depth);
-    result->points.vertices.push_back(X);
-    result->points.colors.push_back({255, 0, 255});
-    track_length->push_back(double(hypotheses[best].obs.size()));
-    reprojection->push_back(error);
-    source->push_back(kOutline);
-    for (int vi : hypotheses[best].views) ++result->views[vi].outline_votes;
+    AppendPoint(RayPoint(ref.camera, e.pixel, depth), {255, 0, 255}, int(h.obs.size()), error,
+                kOutline, &result->points);
+    for (int vi : h.views) ++result->views[vi].outline_votes;
     ++result->outline_points;
   }
 }
