@@ -4,6 +4,8 @@
 // regrouped and markers projected onto their lines every outer iteration.
 #pragma once
 
+#include <array>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -47,7 +49,8 @@ struct OptimizeOptions {
 struct OptimizeInputs {
   MeshPair init;                         // 40_init/
   PinholeCamera reference;               // reference camera (world = its frame)
-  std::vector<Eigen::Vector3d> points;   // SfM points
+  std::vector<Eigen::Vector3d> points;   // points to fit (sfm's or densify's)
+  std::vector<std::array<uint8_t, 3>> point_colors;  // empty, or one per point
   Boundary boundary;
   FeatureFile features;
 };

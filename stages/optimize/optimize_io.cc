@@ -38,6 +38,7 @@ OptimizeInputs ReadInputs(const InputPaths& paths) {
   if (points.vertices.empty())
     throw InputError(paths.PointsFile().string() + ": no points");
   in.points = points.vertices;
+  in.point_colors = points.colors;
   const fs::path boundary_file =
       fs::is_directory(paths.boundary) ? paths.boundary / "boundary.json" : paths.boundary;
   in.boundary = ReadBoundary(boundary_file);
@@ -158,15 +159,13 @@ void WriteOutputs(const fs::path& out, const InputPaths& paths, const OptimizeIn
   }
   GltfPoints cloud;
   cloud.name = "SfM points (inliers)";
-  const PlyData points = ReadPly(paths.PointsFile());
   for (size_t k = 0; k < result.region_points.size(); ++k) {
     if (k < result.inliers.size() && !result.inliers[k]) continue;
-    const size_t i = size_t(result.region_points[k]);
-    if (i >= points.vertices.size()) continue;
-    cloud.positions.push_back(points.vertices[i]);
-    if (!points.colors.empty())
-      cloud.colors.emplace_back(points.colors[i][0] / 255.f, points.colors[i][1] / 255.f,
-                                points.colors[i][2] / 255.f);
+    const size_t i = size_t(result.region_points[k]);  // into in.points
+    cloud.positions.push_back(in.points[i]);
+    if (!in.point_colors.empty())
+      cloud.colors.emplace_back(in.point_colors[i][0] / 255.f, in.point_colors[i][1] / 255.f,
+                                in.point_colors[i][2] / 255.f);
   }
   WriteGlb(out / "scene.glb", {m3, m2}, {cloud});
 }

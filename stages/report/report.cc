@@ -250,7 +250,7 @@ void MeshSection(const ReportOptions& o, const Json& cameras, Page* page, fs::pa
     page->Add("<p>M and M' from <code>" + Escape(mesh_dir->filename().string()) + "/</code>: " +
               std::to_string(mesh.grid.nx) + " × " + std::to_string(mesh.grid.ny) +
               " vertices; " + std::to_string(points.size()) +
-              " SfM points. Open <code>mesh3d.ply</code> in MeshLab to see M textured, or "
+              " points. Open <code>mesh3d.ply</code> in MeshLab to see M textured, or "
               "<code>50_optimize/scene.glb</code> in any glTF viewer.</p>");
   } catch (const std::exception& e) {
     page->Add(Missing(std::string("Cannot draw the meshes: ") + e.what()));
