@@ -30,6 +30,14 @@ int main(int argc, char** argv) {
                  "colour distance (std. deviations of the background) beyond which a "
                  "pixel is not background")
       ->capture_default_str()->check(CLI::Range(1.0, 100.0));
+  app.add_option("--weak-table-distance", opt.weak_table_distance,
+                 "pixels this far from the background (but not --table-distance) are "
+                 "page where they touch it in areas --weak-min-width wide (e.g. the "
+                 "shaded panel of a fold); set it to --table-distance to turn off")
+      ->capture_default_str()->check(CLI::Range(1.0, 100.0));
+  app.add_option("--weak-min-width", opt.weak_min_width,
+                 "smallest width (px of the downscaled image) of such an area")
+      ->capture_default_str()->check(CLI::Range(1, 101));
   app.add_option("--min-area", opt.min_area_fraction,
                  "smallest page area, as a fraction of the image")
       ->capture_default_str()->check(CLI::Range(0.0, 1.0));

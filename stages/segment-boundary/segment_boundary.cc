@@ -202,6 +202,29 @@ cv::Mat1f TableDistance(const FeatureImage& lab, const TableModel& m) {
   return out;
 }
 
+// The pixels of `weak` outside `strong` whose 8-connected region of `weak`
+// touches `strong`, opened by a disc `min_width` wide: broad areas of
+// ambiguous colour joined to the page (a fold's shaded panel), without the
+// narrow specks a textured table adds along the outline.
+cv::Mat1b WeakPageAttached(const cv::Mat1b& weak, const cv::Mat1b& strong, int min_width) {
+  cv::Mat1i labels;
+  const int n = cv::connectedComponents(weak, labels, 8, CV_32S);
+  std::vector<char> touches(n, 0);
+  for (int y = 0; y < labels.rows; ++y)
+    for (int x = 0; x < labels.cols; ++x)
+      if (strong(y, x)) touches[labels(y, x)] = 1;
+  cv::Mat1b added(weak.size(), uchar(0));
+  for (int y = 0; y < labels.rows; ++y)
+    for (int x = 0; x < labels.cols; ++x) {
+      const int l = labels(y, x);
+      if (l > 0 && touches[l] && !strong(y, x)) added(y, x) = 255;
+    }
+  if (min_width > 1)
+    cv::morphologyEx(added, added, cv::MORPH_OPEN,
+                     cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(min_width, min_width)));
+  return added;
+}
+
 // The largest 8-connected region of `mask` with its holes filled.
 cv::Mat1b LargestFilledRegion(const cv::Mat1b& mask, double* area = nullptr) {
   std::vector<std::vector<cv::Point>> contours;
@@ -583,6 +606,8 @@ Json BoundaryOptions::ToJson() const {
   return Json{{"work_size", work_size},
               {"frame_fraction", frame_fraction},
               {"table_distance", table_distance},
+              {"weak_table_distance", weak_table_distance},
+              {"weak_min_width", weak_min_width},
               {"min_area_fraction", min_area_fraction},
               {"border_tolerance_px", border_tolerance_px},
               {"max_cut_fraction", max_cut_fraction},
@@ -620,6 +645,8 @@ BoundaryResult SegmentBoundary(const cv::Mat& image, const BoundaryOptions& opti
         "(does the page fill the whole image?)");
   const cv::Mat1f distance = TableDistance(lab, table);
   cv::Mat1b candidate = distance > float(options.table_distance);
+  candidate |= WeakPageAttached(distance > float(options.weak_table_distance), candidate,
+                                options.weak_min_width);
   // Opening removes thin shadow bands and specks the table texture leaves;
   // closing fills notches that shaded paper at a crease leaves in the
   // outline. Both round the corners a little, which the full-resolution

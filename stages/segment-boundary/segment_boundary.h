@@ -33,6 +33,13 @@ struct BoundaryOptions {
   // Mahalanobis distance to the table's colour is below this (in standard
   // deviations of the table's colour spread).
   double table_distance = 5.0;
+  // Hysteresis: pixels between this distance and `table_distance` are page
+  // where they touch the page found above and fill an area at least
+  // `weak_min_width` work pixels wide. Paper in a fold's shadow can be as
+  // dark as a textured table; the width keeps the table's own light specks
+  // (at the outline, where they would pull a corner) out.
+  double weak_table_distance = 3.0;
+  int weak_min_width = 9;
   // The page must cover at least this fraction of the image.
   double min_area_fraction = 0.01;
   // Contour points closer than this to the image border (pixels) lie on the

@@ -184,15 +184,17 @@ TEST_P(EndToEnd, BoundaryMatchesThePageInTheReferenceView) {
               "sides\n", set_.c_str(), iou, 100 * worst, b.RealSides());
   RecordProperty("iou", std::to_string(iou));
   RecordProperty("worst_corner_pct", std::to_string(100 * worst));
-  // Measured 2026-11-23 (with fold kinks told from corners and corners
-  // sharpened): IoU >= 0.99 on every whole page; corners within 0.3 % on six
-  // samples, but 5.1 % on set02 (a corner curled up, seen nearly edge-on)
-  // and 2.6 % on set04 (a ragged outline on granite), and the cut-off set08
-  // reaches IoU 0.58 (its far panel is as dark as the granite): the 1 %
-  // corner target of issue 3 is not met everywhere, so corners are
-  // reported, and IoU is asserted where the page is whole.
-  if (!cut) EXPECT_GE(iou, 0.97) << set_;
-  if (cut) EXPECT_LT(b.RealSides(), 4) << set_ << ": the page is cut off, some side is not real";
+  // Measured 2026-11-24 (with the shaded panels of folds taken in by
+  // hysteresis): IoU >= 0.99 in every view of every sample, the cut-off
+  // set08 included (0.58 before: its far panel is as dark as the granite);
+  // corners within 0.3 % on six samples, but 5.1 % on set02 (a corner curled
+  // up, seen nearly edge-on) and 2.6 % on set04 (a ragged outline on
+  // granite): the 1 % corner target of issue 3 is not met everywhere, so
+  // corners are reported and IoU is asserted.
+  EXPECT_GE(iou, 0.97) << set_;
+  if (cut) {
+    EXPECT_LT(b.RealSides(), 4) << set_ << ": the page is cut off, some side is not real";
+  }
   // A side flagged not real runs along the image border for most of its
   // length (its simplified polyline may end in a few short vertices where
   // the outline leaves the border, so count length, not vertices).
@@ -270,7 +272,9 @@ TEST_P(EndToEnd, FeatureSegmentsLieOnTrueLines) {
   const bool cut_off = fs::exists(data_ / "ground_truth/synth.json") &&
       ReadJsonFile(data_ / "ground_truth/synth.json")["producer"]["options"].value("cut_off", false);
   EXPECT_GE(precision, 0.95) << set_;
-  if ((kind == "text" || kind == "table") && !cut_off) EXPECT_GE(recall, 0.5) << set_;
+  if ((kind == "text" || kind == "table") && !cut_off) {
+    EXPECT_GE(recall, 0.5) << set_;
+  }
 }
 
 TEST_P(EndToEnd, MeshesAreCloseToTheTruthAndReadable) {
@@ -322,9 +326,10 @@ TEST_P(EndToEnd, OptimizeLowersFWithinEveryRound) {
     const double first = it.front().at("F"), last = it.back().at("F");
     // Every step lowers F on the data it was taken with.
     for (const Json& i : it)
-      if (i.contains("F_after_step"))
+      if (i.contains("F_after_step")) {
         EXPECT_LE(i["F_after_step"].get<double>(), i.at("F").get<double>() * (1 + 1e-9))
             << set_ << " round " << round.value("round", -1) << " iteration " << i["iteration"];
+      }
     // Between iterations footpoints, outliers and the feature markers
     // (re-cast, and projected onto their lines, which moves them off their
     // rays: the ray term rises) are re-decided, so F from one iteration to
