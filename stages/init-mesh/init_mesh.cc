@@ -411,9 +411,13 @@ MeshPair RegridOnPage(const MeshPair& m) {
   return out;
 }
 
-// Fails with a message naming the part of the page without points.
-void CheckCoverage(const ImageGrid& g, const std::vector<Eigen::Vector2d>& pixels, int width,
-                   int height, const Options& o, const std::string& image) {
+// Where on the page (ninths of the grid) the points fall. Fails when they
+// cover less than `min_covered_ninths` of it; otherwise returns a warning
+// naming each third (left, right, top, bottom) without points, empty when
+// every third has some: the mesh is carried over such a part by fairness
+// and isometry alone (a panel of a fold seen by one other photo has none).
+std::string CheckCoverage(const ImageGrid& g, const std::vector<Eigen::Vector2d>& pixels,
+                          int width, int height, const Options& o, const std::string& image) {
   cv::Mat1i label(height, width, -1);
   for (int q = 0; q < g.grid.NumQuads(); ++q) {
     const auto c = g.grid.Quad(q);
@@ -429,19 +433,28 @@ void CheckCoverage(const ImageGrid& g, const std::vector<Eigen::Vector2d>& pixel
     const int q = label(y, x), qr = q / (g.grid.nx - 1), qc = q % (g.grid.nx - 1);
     ++count[std::min(2, 3 * qr / (g.grid.ny - 1))][std::min(2, 3 * qc / (g.grid.nx - 1))];
   }
+  int covered = 0;
+  for (const auto& row : count)
+    for (const int n : row) covered += n >= o.min_points_per_ninth;
   const int left = count[0][0] + count[1][0] + count[2][0];
   const int right = count[0][2] + count[1][2] + count[2][2];
   const int top = count[0][0] + count[0][1] + count[0][2];
   const int bottom = count[2][0] + count[2][1] + count[2][2];
   const std::pair<const char*, int> parts[4] = {
       {"left", left}, {"right", right}, {"top", top}, {"bottom", bottom}};
+  std::string empty;
   for (const auto& [name, n] : parts)
-    if (n < o.min_points_per_third)
-      throw InputError(
-          (n == 0 ? std::string("no SfM points") : "only " + std::to_string(n) + " SfM points") +
-          " in the " + name + " third of the page in " + image + " (need at least " +
-          std::to_string(o.min_points_per_third) + "; " + std::to_string(pixels.size()) +
-          " points inside the document region): the page cannot be reconstructed there");
+    if (n < o.min_points_per_ninth) empty += std::string(empty.empty() ? "" : ", ") + name;
+  if (covered < o.min_covered_ninths)
+    throw InputError(
+        "points cover only " + std::to_string(covered) + " of the page's 9 parts in " + image +
+        " (need " + std::to_string(o.min_covered_ninths) + "; " + std::to_string(pixels.size()) +
+        " points inside the document region" +
+        (empty.empty() ? std::string() : ", none in the " + empty + " third") +
+        "): the page cannot be reconstructed");
+  if (empty.empty()) return "";
+  return "no points in the " + empty + " third of the page in " + image +
+         ": its shape there is carried over from the rest";
 }
 
 // ---------------------------------------------------------------------------
@@ -635,7 +648,8 @@ Result Run(const Inputs& in, const Options& o) {
     g = BoundingBoxGrid(in.mask, o, lift);
     res.grid_source = "mask_bbox";
   }
-  CheckCoverage(g, pixels, cam.width, cam.height, o, image_name);
+  const std::string coverage = CheckCoverage(g, pixels, cam.width, cam.height, o, image_name);
+  if (!coverage.empty()) res.warnings.push_back(coverage);
   MeshPair& m = res.meshes;
   m.grid = g.grid;
   for (const auto& px : g.pixels) m.mesh3d.push_back(lift(px));
@@ -736,7 +750,8 @@ Json OptionsToJson(const Options& o) {
       {"depth_outlier", o.depth_outlier},
       {"mask_margin_px", o.mask_margin_px},
       {"min_points", o.min_points},
-      {"min_points_per_third", o.min_points_per_third},
+      {"min_points_per_ninth", o.min_points_per_ninth},
+      {"min_covered_ninths", o.min_covered_ninths},
       {"upright", o.upright},
       {"refine",
        {{"lambda", {r.weights.iso, r.weights.dist, r.weights.fair3d, r.weights.fair2d, 0.0, 0.0}},

@@ -58,11 +58,14 @@ struct Options {
   // Points projecting at most this far outside mask.png count as inside.
   double mask_margin_px = 4;
   // Bad input (exit 3): fewer points than this in the document region, or
-  // fewer than min_points_per_third in a whole third (left, right, top,
-  // bottom) of the page. One point is enough for a third: fairness carries
-  // the mesh over blank paper (realistic/r04 has 2 in its right third).
+  // points (at least min_points_per_ninth) in fewer than min_covered_ninths
+  // of the page's 3x3 parts. A third of the page without points is a
+  // warning: fairness and isometry carry the mesh over it (set08's far panel
+  // is seen by one other photo only, realistic/r04 has 2 points in its right
+  // third).
   int min_points = 30;
-  int min_points_per_third = 1;
+  int min_points_per_ninth = 1;
+  int min_covered_ninths = 5;
   // After unfolding, re-grid uniformly on the page (a Coons patch of the
   // border of M'), so that M' starts fair.
   bool regrid_on_page = true;

@@ -59,10 +59,13 @@ int main(int argc, char** argv) {
   app.add_option("--min-points", o.min_points,
                  "fewer SfM points on the page is bad input (exit 3)")
       ->capture_default_str()->check(CLI::Range(4, 1000000));
-  app.add_option("--min-points-per-third", o.min_points_per_third,
-                 "fewer SfM points in a third of the page (left, right, top, bottom) is bad "
-                 "input (exit 3)")
-      ->capture_default_str()->check(CLI::Range(0, 1000000));
+  app.add_option("--min-points-per-ninth", o.min_points_per_ninth,
+                 "a ninth of the page (3x3 parts of the grid) with fewer SfM points has none")
+      ->capture_default_str()->check(CLI::Range(1, 1000000));
+  app.add_option("--min-covered-ninths", o.min_covered_ninths,
+                 "points in fewer of the page's 9 parts are bad input (exit 3); an empty "
+                 "third is a warning")
+      ->capture_default_str()->check(CLI::Range(0, 9));
   app.add_option("--outlier-distance", o.refine.outlier_distance,
                  "phi: points farther from M than this fraction of the model size are "
                  "ignored (re-decided every iteration)")
