@@ -69,6 +69,11 @@ struct Weights {
 struct FeatureLine {
   double theta = 0;   // radians
   double offset = 0;  // M' units
+  // θ is held at the nearest multiple of 90 degrees (only the offset is
+  // fitted or varied): printed rows and rules run along the page's axes,
+  // parallel or perpendicular to each other, which straightness alone does
+  // not ask (the paper's E_line leaves M' free to shear).
+  bool axis_aligned = false;
   Eigen::Vector2d Normal() const { return {std::cos(theta), std::sin(theta)}; }
   double SignedDistance(const Eigen::Vector2d& p) const { return Normal().dot(p) - offset; }
 };

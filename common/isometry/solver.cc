@@ -32,6 +32,8 @@ using internal::State;
 using internal::StepData;
 using internal::Vec5;
 
+constexpr double kHalfPi = 1.57079632679489661923;
+
 namespace internal {
 namespace {
 
@@ -319,7 +321,12 @@ void FitLines(State& s, const StepData& data) {
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(scatter);
     Eigen::Vector2d normal = eig.eigenvectors().col(0);
     if (normal.dot(s.lines[l].Normal()) < 0) normal = -normal;
-    s.lines[l].theta = std::atan2(normal.y(), normal.x());
+    double theta = std::atan2(normal.y(), normal.x());
+    if (s.lines[l].axis_aligned) {
+      theta = kHalfPi * std::round(theta / kHalfPi);
+      normal = Eigen::Vector2d(std::cos(theta), std::sin(theta));
+    }
+    s.lines[l].theta = theta;
     s.lines[l].offset = normal.dot(mean);
   }
 }
@@ -615,7 +622,7 @@ class LbfgsObjective {
       const double k = 2 * weight * r.value;
       for (int a = 0; a < r.count; ++a) grad.segment<5>(5 * r.vertex[a]) += k * r.d[a];
       if (r.line >= 0) {
-        grad[5 * n + 2 * r.line] += k * r.d_theta;
+        if (!s.lines[r.line].axis_aligned) grad[5 * n + 2 * r.line] += k * r.d_theta;
         grad[5 * n + 2 * r.line + 1] += k * r.d_offset;
       }
     });
@@ -769,6 +776,8 @@ Result Solve(const Problem& problem, const SolveOptions& o) {
       Validate(check);
     }
     if (!w.data.markers.empty() && !w.state.lines.empty()) {
+      for (FeatureLine& l : w.state.lines)  // the caller's may be slanted
+        if (l.axis_aligned) l.theta = kHalfPi * std::round(l.theta / kHalfPi);
       if (o.refit_lines) FitLines(w.state, w.data);
       if (o.project_markers) ProjectMarkers(w.state, w.data);
     }

@@ -220,8 +220,54 @@ Grouping GroupSegments(const MeshPair& meshes, const MarkerSet& markers,
   return g;
 }
 
+LineDirection DominantLineDirection(const MeshPair& meshes, const MarkerSet& markers,
+                                    const std::vector<Segment>& segments) {
+  std::vector<std::vector<Eigen::Vector2d>> flat(segments.size());
+  for (size_t i = 0; i < markers.markers.size(); ++i)
+    flat[markers.segment[i]].push_back(PointOnMesh2d(meshes, markers.markers[i].where));
+  auto wrap = [](double a) {  // to (-45, 45]
+    a = std::fmod(a, 90.0);
+    if (a > 45) a -= 90;
+    if (a <= -45) a += 90;
+    return a;
+  };
+  std::vector<std::pair<double, double>> votes;  // (angle, length)
+  LineDirection out;
+  for (size_t s = 0; s < segments.size(); ++s) {
+    if (segments[s].kind == "boundary" || flat[s].size() < 3) continue;
+    Cluster c;
+    c.points = flat[s];
+    c.Update();
+    if (c.Width() <= 0 || c.height > 0.1 * c.Width()) continue;  // not straight in M'
+    votes.push_back({wrap(std::atan2(c.direction.y(), c.direction.x()) * 180 / kPi), c.Width()});
+    out.length += c.Width();
+    ++out.segments;
+  }
+  if (votes.empty()) return out;
+  // Length per half degree, smoothed over +-1.5 degrees (circular, period 90).
+  constexpr int kBins = 180;
+  std::vector<double> hist(kBins, 0.0);
+  for (const auto& [a, w] : votes)
+    for (int k = -6; k <= 6; ++k) {
+      const int b = ((int(std::floor((a + 45) * 2)) + k) % kBins + kBins) % kBins;
+      hist[b] += w * std::exp(-0.5 * (k / 3.0) * (k / 3.0));
+    }
+  const int peak = int(std::max_element(hist.begin(), hist.end()) - hist.begin());
+  const double centre = wrap(peak / 2.0 - 45 + 0.25);
+  double sum = 0, weight = 0;
+  for (const auto& [a, w] : votes) {
+    const double d = wrap(a - centre);
+    if (std::abs(d) > 3) continue;
+    sum += w * d;
+    weight += w;
+  }
+  out.angle_deg = wrap(centre + (weight > 0 ? sum / weight : 0));
+  out.share = weight / out.length;
+  return out;
+}
+
 std::vector<isometry::FeatureLine> AssignLines(const MeshPair& meshes, const Grouping& grouping,
-                                               MarkerSet* markers) {
+                                               MarkerSet* markers, AxisLines axis_lines) {
   const int n = int(grouping.line_kind.size());
   std::vector<Eigen::Vector2d> sum(n, Eigen::Vector2d::Zero());
   std::vector<Eigen::Matrix2d> outer(n, Eigen::Matrix2d::Zero());
@@ -245,6 +291,9 @@ std::vector<isometry::FeatureLine> AssignLines(const MeshPair& meshes, const Gro
     lines[l].theta = std::atan2(normal.y(), normal.x());
     lines[l].offset = normal.dot(mean);
   }
+  for (int l = 0; l < n; ++l)
+    lines[l].axis_aligned = axis_lines == AxisLines::kAll ||
+                            (axis_lines == AxisLines::kFeatures && grouping.line_kind[l] != "boundary");
   return lines;
 }
 

@@ -77,6 +77,17 @@ int main(int argc, char** argv) {
   app.add_option("--axis-tolerance", o.grouping.axis_tolerance_deg,
                  "lines kept within this many degrees of horizontal or vertical")
       ->capture_default_str();
+  std::string axis_lines = "none";
+  app.add_option("--axis-lines", axis_lines,
+                 "lines held along the axes of M': none (only straight, as in the paper), "
+                 "features (text and rules), all (and the real page sides)")
+      ->capture_default_str()->check(CLI::IsMember({"none", "features", "all"}));
+  bool no_upright = false;
+  app.add_flag("--no-upright-by-lines", no_upright,
+               "keep init-mesh's upright M' even where the segments run off its axes");
+  app.add_option("--upright-min-deg", o.upright_min_deg,
+                 "turn M' when the segments run at least this many degrees off its axes")
+      ->capture_default_str()->check(CLI::Range(0.0, 45.0));
   app.add_option("--threads", o.threads, "threads")->capture_default_str();
   app.add_flag("--no-scene", no_scene, "do not write scene.glb");
   return RunStage("optimize", app, argc, argv, [&] {
@@ -98,6 +109,10 @@ int main(int argc, char** argv) {
     }
     o.features = !no_features;
     o.project = !no_projection;
+    o.upright_by_lines = !no_upright;
+    o.axis_lines = axis_lines == "none"     ? optimize::AxisLines::kNone
+                   : axis_lines == "features" ? optimize::AxisLines::kFeatures
+                                              : optimize::AxisLines::kAll;
     const Json options_json = {{"rounds", o.rounds},
                                {"solver", solver},
                                {"linear_solver", linear},
@@ -117,7 +132,10 @@ int main(int argc, char** argv) {
                                {"merge_gap", o.grouping.gap},
                                {"merge_offset", o.grouping.offset},
                                {"straightness", o.grouping.straightness},
-                               {"axis_tolerance", o.grouping.axis_tolerance_deg}};
+                               {"axis_tolerance", o.grouping.axis_tolerance_deg},
+                               {"upright_by_lines", o.upright_by_lines},
+                               {"axis_lines", axis_lines},
+                               {"upright_min_deg", o.upright_min_deg}};
     const optimize::OptimizeInputs in = optimize::ReadInputs(paths);
     const optimize::OptimizeResult r = optimize::Run(in, o);
     optimize::OutputOptions output;

@@ -3,6 +3,8 @@
 #include <chrono>
 #include <cstdio>
 
+#include <Eigen/Geometry>
+
 #include "common/cli.h"
 #include "common/errors.h"
 #include "common/isometry/subdivision.h"
@@ -67,6 +69,34 @@ OptimizeResult Run(const OptimizeInputs& in, const OptimizeOptions& o) {
   for (const int i : result.region_points) region_points.push_back(in.points[i]);
 
   MeshPair meshes = in.init;
+  // init-mesh turned M' upright by the real sides; where the detected
+  // segments disagree with that by more than a few degrees (a fold taken for
+  // a side), they turn it, as the lines are kept only near the axes. A turn
+  // of M' changes no term of F.
+  if (o.upright_by_lines && !segments.empty()) {
+    const LineDirection dir =
+        DominantLineDirection(meshes, CastMarkers(meshes, in.reference, segments, o.cast), segments);
+    result.line_direction = dir;
+    char buf[200];
+    std::snprintf(buf, sizeof buf,
+                  "segments run %.2f deg off the axes of M' (%d segments, %.0f %% of their "
+                  "length within 3 deg)",
+                  dir.angle_deg, dir.segments, 100 * dir.share);
+    if (dir.segments >= o.upright_min_segments && dir.share >= o.upright_min_share &&
+        std::abs(dir.angle_deg) >= o.upright_min_deg) {
+      const double a = -dir.angle_deg * 3.14159265358979323846 / 180;
+      const Eigen::Rotation2Dd turn(a);
+      Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+      for (const auto& p : meshes.mesh2d) centre += p;
+      centre /= double(meshes.mesh2d.size());
+      for (auto& p : meshes.mesh2d) p = centre + turn * (p - centre);
+      result.upright_turn_deg = -dir.angle_deg;
+      Log(std::string(buf) + ": M' turned by " + std::to_string(-dir.angle_deg).substr(0, 6) +
+          " deg");
+    } else {
+      Log(std::string(buf) + ": M' left as it is");
+    }
+  }
   isometry::Weights weights = o.weights;
   if (segments.empty()) weights.line = weights.ray = 0;
   for (int r = 0; r < o.rounds; ++r) {
@@ -104,7 +134,7 @@ OptimizeResult Run(const OptimizeInputs& in, const OptimizeOptions& o) {
       so.on_outer_iteration = [&](const isometry::OuterIterationContext& c) {
         current = CastMarkers(*c.meshes, in.reference, segments, o.cast);
         grouping = GroupSegments(*c.meshes, current, segments, o.grouping);
-        *c.lines = AssignLines(*c.meshes, grouping, &current);
+        *c.lines = AssignLines(*c.meshes, grouping, &current, o.axis_lines);
         c.markers->clear();
         kept.clear();
         for (size_t i = 0; i < current.markers.size(); ++i)

@@ -82,6 +82,10 @@ Json LogJson(const OptimizeResult& result, const Json& options_json) {
   Json doc = MakeHeader("docunfold.optimize-log", 1, "optimize", options_json);
   doc["segments"] = result.segments;
   doc["segments_off_page"] = result.segments_off_page;
+  doc["line_direction"] = {{"angle_deg", result.line_direction.angle_deg},
+                           {"share", result.line_direction.share},
+                           {"segments", result.line_direction.segments},
+                           {"turned_deg", result.upright_turn_deg}};
   doc["boundary_lines"] = result.boundary_lines;
   doc["points_in_region"] = result.region_points.size();
   doc["seconds"] = result.seconds;

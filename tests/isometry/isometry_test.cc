@@ -438,6 +438,22 @@ TEST(Isometry, MarkersStraightenLinesAndFollowTheirRays) {
   for (size_t i = 0; i < p.markers.size(); ++i)
     moved = moved || (projected.markers[i].where.bary - p.markers[i].where.bary).norm() > 1e-9;
   EXPECT_TRUE(moved);
+
+  // Axis-aligned lines given slanted keep exactly the nearest axis under
+  // both solvers; only their offsets move.
+  o.project_markers = false;
+  Problem slanted = p;
+  slanted.lines[0].theta = M_PI / 2 + 0.05;
+  slanted.lines[1].theta = -0.04;
+  for (auto& l : slanted.lines) l.axis_aligned = true;
+  for (const auto method : {isometry::Method::kGaussNewton, isometry::Method::kLbfgs}) {
+    o.method = method;
+    o.max_outer_iterations = 5;
+    const auto held = isometry::Solve(slanted, o);
+    EXPECT_EQ(held.lines[0].theta, M_PI / 2);
+    EXPECT_EQ(held.lines[1].theta, 0);
+    EXPECT_LT(held.report.iterations.back().terms.line, 0.05 * before.terms.line);
+  }
 }
 
 TEST(Isometry, CallbackSeesEveryOuterIteration) {

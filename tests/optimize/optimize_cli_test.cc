@@ -1,5 +1,6 @@
 // optimize on an analytic curled sheet (no data set needed): points of the
-// table beside the page, outside the document region, change nothing.
+// table beside the page, outside the document region, change nothing; an
+// M' turned off upright is turned back by the text rows.
 #include <gtest/gtest.h>
 
 #include "common/grid_mesh.h"
@@ -56,6 +57,79 @@ TEST(OptimizeCli, PointsOutsideTheDocumentRegionAreNotFitted) {
   ASSERT_EQ(a.mesh3d.size(), b.mesh3d.size());
   for (size_t i = 0; i < a.mesh3d.size(); ++i)
     ASSERT_LT((a.mesh3d[i] - b.mesh3d[i]).norm(), 1e-9) << i;
+}
+
+// init-mesh's M' turned 25 degrees off upright (as a fold taken for a page
+// side turns it): the text rows of the sheet, given as segments, run 25
+// degrees off its axes, and optimize turns M' back before the first round, so
+// that they are kept as lines; --no-upright-by-lines leaves it.
+TEST(OptimizeCli, TextRowsTurnAnOffUprightFlatMesh) {
+  TempDir dir;
+  const MeshPair truth = WriteSyntheticWork(dir.path(), 1500);
+  ASSERT_EQ(RunCommand(InitMeshCommand(dir.path(), "--grid 8x12")).exit_code, 0);
+  MeshPair init = ReadMeshPair(dir / "40_init");
+  const Eigen::Rotation2Dd off(25 * M_PI / 180);
+  for (auto& p : init.mesh2d) p = off * p;
+  WriteMeshPair(dir / "40_init", init);
+  // Rows of the true sheet (constant flat y), in pieces of 4 grid steps,
+  // seen from the reference camera.
+  const CameraSet cameras = ReadCameras(dir / "10_sfm/cameras.json");
+  const PinholeCamera& cam = *cameras.Find(cameras.reference);
+  Json segments = Json::array();
+  for (int r = 2; r + 2 < truth.grid.ny; r += 2)
+    for (int c = 1; c + 4 < truth.grid.nx; c += 4) {
+      Json points = Json::array();
+      for (int k = 0; k <= 4; ++k) {
+        const Eigen::Vector2d px = cam.Project(truth.mesh3d[truth.grid.Index(r, c + k)]);
+        points.push_back({px.x(), px.y()});
+      }
+      segments.push_back({{"kind", "text"}, {"points", points}});
+    }
+  ASSERT_GE(segments.size(), 40u);
+  WriteJsonAtomic(dir / "features.json",
+                  {{"format", "docunfold.features"}, {"version", 1}, {"segments", segments}});
+
+  const fs::path points = dir / "10_sfm/points.ply";
+  const CommandResult turned = RunCommand(OptimizeCommand(dir.path(), points, dir / "turned"));
+  ASSERT_EQ(turned.exit_code, 0) << turned.output;
+  const Json log = ReadJsonFile(dir / "turned/log.json");
+  const Json& direction = log.at("line_direction");
+  EXPECT_NEAR(direction.at("angle_deg").get<double>(), 25, 1) << direction.dump();
+  EXPECT_NEAR(direction.at("turned_deg").get<double>(), -25, 1) << direction.dump();
+  EXPECT_GE(direction.at("share").get<double>(), 0.9) << direction.dump();
+  const CommandResult kept = RunCommand(
+      OptimizeCommand(dir.path(), points, dir / "kept") + " --no-upright-by-lines");
+  ASSERT_EQ(kept.exit_code, 0) << kept.output;
+  EXPECT_EQ(ReadJsonFile(dir / "kept/log.json")["line_direction"]["turned_deg"].get<double>(), 0);
+  // Lines found: the rows, once M' is upright; none 25 degrees off it.
+  auto lines = [](const fs::path& out) {
+    const Json doc = ReadJsonFile(out / "lines.json");
+    return doc.at("lines").size();
+  };
+  std::printf("[optimize] segments %.2f deg off M's axes; lines %zu after the turn, %zu without\n",
+              direction.at("angle_deg").get<double>(), lines(dir / "turned"), lines(dir / "kept"));
+  EXPECT_GE(lines(dir / "turned"), 10u);
+  EXPECT_LE(lines(dir / "kept"), 4u);  // the real sides only
+
+  // --axis-lines features: the text lines run exactly along the axes of M',
+  // the page sides only straight; by default (the paper) neither is held.
+  const CommandResult axis = RunCommand(
+      OptimizeCommand(dir.path(), points, dir / "axis") + " --axis-lines features");
+  ASSERT_EQ(axis.exit_code, 0) << axis.output;
+  auto slants = [](const fs::path& out, const std::string& kind) {
+    std::vector<double> off;
+    const Json doc = ReadJsonFile(out / "lines.json");
+    for (const Json& l : doc.at("lines"))
+      if (l.at("kind") == kind) {
+        const double nx = l.at("normal")[0], ny = l.at("normal")[1];
+        off.push_back(std::min(std::abs(nx), std::abs(ny)));
+      }
+    return off;
+  };
+  const auto held = slants(dir / "axis", "text"), free = slants(dir / "turned", "text");
+  ASSERT_GE(held.size(), 10u);
+  for (const double s : held) EXPECT_LT(s, 1e-12);
+  EXPECT_GT(*std::max_element(free.begin(), free.end()), 1e-6);
 }
 
 }  // namespace
