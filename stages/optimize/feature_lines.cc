@@ -8,6 +8,8 @@
 #include <Eigen/Eigenvalues>
 #include <nanoflann.hpp>
 
+#include "common/axis_direction.h"
+
 namespace docunfold::optimize {
 namespace {
 
@@ -225,44 +227,21 @@ LineDirection DominantLineDirection(const MeshPair& meshes, const MarkerSet& mar
   std::vector<std::vector<Eigen::Vector2d>> flat(segments.size());
   for (size_t i = 0; i < markers.markers.size(); ++i)
     flat[markers.segment[i]].push_back(PointOnMesh2d(meshes, markers.markers[i].where));
-  auto wrap = [](double a) {  // to (-45, 45]
-    a = std::fmod(a, 90.0);
-    if (a > 45) a -= 90;
-    if (a <= -45) a += 90;
-    return a;
-  };
-  std::vector<std::pair<double, double>> votes;  // (angle, length)
-  LineDirection out;
+  std::vector<DirectionVote> votes;
   for (size_t s = 0; s < segments.size(); ++s) {
     if (segments[s].kind == "boundary" || flat[s].size() < 3) continue;
     Cluster c;
     c.points = flat[s];
     c.Update();
     if (c.Width() <= 0 || c.height > 0.1 * c.Width()) continue;  // not straight in M'
-    votes.push_back({wrap(std::atan2(c.direction.y(), c.direction.x()) * 180 / kPi), c.Width()});
-    out.length += c.Width();
-    ++out.segments;
+    votes.push_back({std::atan2(c.direction.y(), c.direction.x()) * 180 / kPi, c.Width()});
   }
-  if (votes.empty()) return out;
-  // Length per half degree, smoothed over +-1.5 degrees (circular, period 90).
-  constexpr int kBins = 180;
-  std::vector<double> hist(kBins, 0.0);
-  for (const auto& [a, w] : votes)
-    for (int k = -6; k <= 6; ++k) {
-      const int b = ((int(std::floor((a + 45) * 2)) + k) % kBins + kBins) % kBins;
-      hist[b] += w * std::exp(-0.5 * (k / 3.0) * (k / 3.0));
-    }
-  const int peak = int(std::max_element(hist.begin(), hist.end()) - hist.begin());
-  const double centre = wrap(peak / 2.0 - 45 + 0.25);
-  double sum = 0, weight = 0;
-  for (const auto& [a, w] : votes) {
-    const double d = wrap(a - centre);
-    if (std::abs(d) > 3) continue;
-    sum += w * d;
-    weight += w;
-  }
-  out.angle_deg = wrap(centre + (weight > 0 ? sum / weight : 0));
-  out.share = weight / out.length;
+  const AxisDirection mode = DominantAxisDirection(votes);
+  LineDirection out;
+  out.angle_deg = mode.angle_deg;
+  out.share = mode.share;
+  out.length = mode.length;
+  out.segments = mode.lines;
   return out;
 }
 

@@ -62,6 +62,10 @@ int main(int argc, char** argv) {
                "plain bicubic even when minifying");
   app.add_flag("--no-deskew", no_deskew,
                "do not turn M' to make the boundary lines axis aligned");
+  app.add_option("--deskew-by", o.deskew_by,
+                 "lines: the direction most of optimize's lines (lines.json beside the "
+                 "meshes) follow, else the sides; sides: the real boundary sides")
+      ->capture_default_str()->check(CLI::IsMember({"lines", "sides"}));
   app.add_option("--max-deskew-deg", o.max_deskew_deg, "largest tilt corrected")
       ->capture_default_str();
   app.add_option("--side-snap", o.side_snap,

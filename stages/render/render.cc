@@ -466,6 +466,7 @@ Json OptionsToJson(const RenderOptions& o) {
           {"antialias", o.antialias},
           {"deskew", o.deskew},
           {"max_deskew_deg", o.max_deskew_deg},
+          {"deskew_by", o.deskew_by},
           {"sample_hidden", o.sample_hidden},
           {"side_snap", o.side_snap}};
 }
@@ -487,6 +488,7 @@ Json MakeReport(const RenderOptions& options, const RenderInputs& in,
   doc["size_rule"] = r.size_rule;
   doc["capped"] = r.capped;
   doc["rotation_deg"] = r.rotation_deg;
+  doc["deskew_source"] = r.deskew_source;
   doc["crop"] = {{"x0", r.crop_x0},
                  {"y0", r.crop_y0},
                  {"x1", r.crop_x1},
@@ -572,11 +574,21 @@ RenderResult Run(const RenderOptions& options, const RenderInputs& in) {
   }
   double angle = 0;
   if (options.deskew) {
-    const double tilt = TiltOfSides(r.sides);
+    double tilt = TiltOfSides(r.sides);
+    std::string source = "sides", what = "boundary lines";
+    if (options.deskew_by == "lines") {
+      const AxisDirection mode = DominantAxisDirection(in.lines);
+      if (mode.lines >= options.deskew_min_lines && mode.share >= 0.5) {
+        tilt = mode.angle_deg * M_PI / 180;
+        source = "lines";
+        what = "the page's lines";
+      }
+    }
     if (std::abs(tilt) * 180 / M_PI <= options.max_deskew_deg) {
       angle = -tilt;
+      r.deskew_source = source;
     } else {
-      Log("boundary lines are " + std::to_string(tilt * 180 / M_PI) +
+      Log(what + " are " + std::to_string(tilt * 180 / M_PI) +
           " degrees off upright; more than --max-deskew-deg, left as is");
     }
   }

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "common/axis_direction.h"
 #include "common/camera.h"
 #include "common/grid_mesh.h"
 #include "common/json_io.h"
@@ -53,10 +54,16 @@ struct RenderOptions {
   // Pre-filter when minifying (image pyramid + anisotropic taps). Off only to
   // measure what it buys.
   bool antialias = true;
-  // Turn M' by the small angle that makes the fitted boundary lines axis
-  // aligned (at most max_deskew_deg; larger tilts are left alone and logged).
+  // Turn M' by the small angle that makes the page's lines axis aligned (at
+  // most max_deskew_deg; larger tilts are left alone and logged). "lines":
+  // the direction most of the length of optimize's lines (lines.json beside
+  // the meshes: text rows, rules and the real sides) follows, when at least
+  // deskew_min_lines agree on it; else, and with "sides", the lines fitted
+  // to the real boundary sides mapped onto M'.
   bool deskew = true;
   double max_deskew_deg = 20;
+  std::string deskew_by = "lines";
+  int deskew_min_lines = 8;
   // Sample the reference image even where the page is hidden from the
   // reference view by the page itself or seen from behind (by default such
   // pixels get the fill colour). Points outside the image are always filled.
@@ -83,6 +90,9 @@ struct RenderInputs {
   cv::Mat reference;     // reference.png, 8-bit BGR
   Boundary boundary;
   MeshPair meshes;
+  // Directions and lengths in M' of the lines in lines.json beside the
+  // meshes (optimize's); empty when there is none (init-mesh's meshes).
+  std::vector<DirectionVote> lines;
   // Where each input came from, for error messages and the report.
   fs::path cameras_file, reference_file, meshes_dir;
 };
@@ -108,6 +118,7 @@ struct RenderResult {
   double pixels_per_unit = 0;
   double reference_pixels_per_unit = 0;  // the reference image's density
   double rotation_deg = 0;               // deskew applied to M'
+  std::string deskew_source = "none";    // what it was taken from: lines, sides, none
   std::string crop_rule;  // "boundary-lines", "real-sides-and-visible-mesh",
                           // "visible-mesh"
   std::string

@@ -1,4 +1,5 @@
 // Reading render's inputs and writing its outputs (all or nothing).
+#include <cmath>
 #include <memory>
 #include <opencv2/imgcodecs.hpp>
 
@@ -29,6 +30,32 @@ RenderInputs ReadRenderInputs(const fs::path& sfm_dir,
     throw InputError(meshes_dir.string() +
                      ": no such directory (expected mesh3d.ply, mesh2d.ply)");
   in.meshes = ReadMeshPair(meshes_dir);
+  // optimize's lines, for the deskew: each line's direction (its normal
+  // turned, the same modulo 90 degrees) and its extent in M'.
+  const fs::path lines_file = meshes_dir / "lines.json";
+  if (fs::is_regular_file(lines_file, ec)) {
+    const Json doc = ReadJsonFile(lines_file);
+    if (!doc.contains("lines") || !doc["lines"].is_array())
+      throw InputError(lines_file.string() + ":/lines: missing or not an array");
+    for (size_t i = 0; i < doc["lines"].size(); ++i) {
+      const Json& l = doc["lines"][i];
+      const std::string where = lines_file.string() + ":/lines/" + std::to_string(i);
+      if (!l.contains("normal") || !l["normal"].is_array() || l["normal"].size() != 2 ||
+          !l.contains("flat") || !l["flat"].is_array())
+        throw InputError(where + ": needs normal [x, y] and flat [[x, y], ...]");
+      const Eigen::Vector2d n(l["normal"][0].get<double>(), l["normal"][1].get<double>());
+      const Eigen::Vector2d along(-n.y(), n.x());
+      double lo = 1e300, hi = -1e300;
+      for (const Json& p : l["flat"]) {
+        if (!p.is_array() || p.size() != 2) throw InputError(where + "/flat: points are [x, y]");
+        const double t = along.dot(Eigen::Vector2d(p[0].get<double>(), p[1].get<double>()));
+        lo = std::min(lo, t);
+        hi = std::max(hi, t);
+      }
+      if (hi > lo && std::isfinite(hi - lo))
+        in.lines.push_back({std::atan2(n.y(), n.x()) * 180 / M_PI, hi - lo});
+    }
+  }
   return in;
 }
 

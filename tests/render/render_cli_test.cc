@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 
+#include "common/atomic_file.h"
 #include "common/grid_mesh.h"
 #include "common/json_io.h"
 #include "common/ply.h"
@@ -100,6 +101,54 @@ TEST_F(RenderCli, WidthFlagSetsTheOutputWidth) {
   const Json report = ReadJsonFile(out / "render.json");
   EXPECT_EQ(report["size_rule"], "width");
   EXPECT_EQ(report["fill_rgb"], Json::array({255, 255, 255}));
+}
+
+// optimize's lines.json beside the meshes turns the page: its lines, 3
+// degrees off the axes of M' while the sides are on them, set the deskew;
+// --deskew-by sides (or too few lines) keeps the sides'. A broken
+// lines.json is bad input.
+TEST_F(RenderCli, DeskewFollowsTheLinesOfLinesJson) {
+  const fs::path work = CopyScene();
+  const MeshPair m = ReadMeshPair(work / "40_init");
+  Eigen::Vector2d lo = m.mesh2d[0], hi = lo;
+  for (const auto& q : m.mesh2d) {
+    lo = lo.cwiseMin(q);
+    hi = hi.cwiseMax(q);
+  }
+  const double a = 3 * M_PI / 180;
+  const Eigen::Vector2d along(std::cos(a), std::sin(a)), normal(-std::sin(a), std::cos(a));
+  auto write_lines = [&](int n) {
+    Json lines = Json::array();
+    for (int k = 0; k < n; ++k) {
+      const Eigen::Vector2d start = lo + Eigen::Vector2d(0.1, 0.1 + 0.08 * k).cwiseProduct(hi - lo);
+      Json flat = Json::array();
+      for (int j = 0; j <= 10; ++j) {
+        const Eigen::Vector2d p = start + along * (0.05 * j * (hi - lo).x());
+        flat.push_back({p.x(), p.y()});
+      }
+      lines.push_back({{"kind", "text"}, {"normal", {normal.x(), normal.y()}}, {"flat", flat}});
+    }
+    WriteJsonAtomic(work / "40_init/lines.json", {{"format", "docunfold.lines"}, {"lines", lines}});
+  };
+  auto rotation = [&](const std::string& flags, const std::string& name) {
+    const CommandResult r = Render(work, dir_ / name, flags);
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    const Json report = ReadJsonFile(dir_ / name / "render.json");
+    return std::make_pair(report["rotation_deg"].get<double>(),
+                          report["deskew_source"].get<std::string>());
+  };
+  const auto [sides_deg, sides_source] = rotation("", "none");
+  EXPECT_EQ(sides_source, "sides");
+  write_lines(10);
+  const auto [lines_deg, lines_source] = rotation("", "lines");
+  EXPECT_EQ(lines_source, "lines");
+  EXPECT_NEAR(lines_deg, -3, 0.05);
+  EXPECT_GT(std::abs(lines_deg - sides_deg), 2);
+  EXPECT_EQ(rotation("--deskew-by sides", "forced").first, sides_deg);
+  write_lines(3);
+  EXPECT_EQ(rotation("", "few").second, "sides");
+  WriteTextAtomic(work / "40_init/lines.json", "{\"lines\": [{\"normal\": [0, 1]}]}");
+  ExpectFailure(Render(work, dir_ / "broken"), 3, "lines.json:/lines/0", dir_ / "broken");
 }
 
 TEST_F(RenderCli, ContradictoryFlagsAreUsageErrors) {
