@@ -73,6 +73,11 @@ FeatureFile ReadFeatures(const fs::path& file) {
     f.producer = doc["producer"].value("stage", doc["producer"].value("program", ""));
   if (r.Has("/width")) f.width = r.Integer("/width");
   if (r.Has("/height")) f.height = r.Integer("/height");
+  if (r.Has("/text_down")) {
+    const Eigen::Vector2d d = Point(r, "/text_down");
+    if (!(d.norm() > 0.5 && d.norm() < 2)) r.Fail("/text_down", "expected a unit vector");
+    f.text_down = d.normalized();
+  }
   const Json& segments = r.At("/segments");
   if (!segments.is_array()) r.Fail("/segments", "expected an array");
   for (size_t i = 0; i < segments.size(); ++i) {

@@ -7,6 +7,7 @@
 
 #include <array>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -49,6 +50,9 @@ struct FeatureFile {
   int width = 0;         // image size the segments refer to (0: not given)
   int height = 0;
   std::vector<FeatureSegment> segments;
+  // Optional: unit vector in the image towards the text's baselines (the
+  // reader's down), when the detector could tell.
+  std::optional<Eigen::Vector2d> text_down;
 };
 
 // Any detector's file: only format, version and segments[].kind/points are

@@ -96,6 +96,7 @@ FeaturesResult DetectFeatures(const cv::Mat& image, const cv::Mat& mask_in,
   result.text_height = text.height;
   result.text_direction = text.direction_deg;
   result.text_upside_down = text.upside_down;
+  if (text.orientation_known) result.text_down = text.down;
   result.votes_upright = text.votes_upright;
   result.votes_upside_down = text.votes_upside_down;
   step(std::string("text orientation ") + (text.orientation_known ? "" : "not ") +
@@ -119,6 +120,7 @@ Json FeaturesToJson(const FeaturesResult& r, const std::string& image_name, int 
   doc["text_height_px"] = r.text_height;
   doc["text_direction_deg"] = r.text_direction;
   doc["text_upside_down"] = r.text_upside_down;
+  if (r.text_down) doc["text_down"] = {r.text_down->x, r.text_down->y};
   doc["segments"] = Json::array();
   for (const Segment& s : r.segments) {
     Json pts = Json::array();

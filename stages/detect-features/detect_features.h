@@ -15,6 +15,7 @@
 //     page, and precision comes first (paper, Remarks).
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -62,6 +63,7 @@ struct FeaturesResult {
   double text_height = 0;       // median character height (pixels), 0 if no text
   double text_direction = 0;    // degrees, of the text lines in the image
   bool text_upside_down = false;  // baselines on the image-up side of the text
+  std::optional<cv::Point2d> text_down;  // unit, towards the baselines, when known
   int votes_upright = 0, votes_upside_down = 0;  // evidence for either
   int text_segments = 0;
   int edge_segments = 0;

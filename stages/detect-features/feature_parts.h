@@ -33,6 +33,7 @@ struct TextResult {
   // Small marks: periods on the baseline, dots beyond the other side.
   int dots_upright = 0, dots_upside_down = 0;
   bool orientation_known = false;  // if not, no text segments are made
+  cv::Point2d down;                // unit, towards the baselines (the reader's down)
   std::vector<char> is_character;  // per component label: chained as text
 };
 TextResult DetectTextSegments(const InkComponents& ink, const FeaturesOptions& options);

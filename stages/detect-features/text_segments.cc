@@ -429,6 +429,7 @@ TextResult DetectTextSegments(const InkComponents& ink, const FeaturesOptions& o
                    : by_stray != 0 ? by_stray : by_dots;
   const double sign = side < 0 ? -1.0 : 1.0;
   result.orientation_known = side != 0;
+  if (side != 0) result.down = sign * n;
   // Upside down: the baselines lie on the image-up side of their letters.
   result.upside_down = side != 0 && sign * n.y < 0;
 

@@ -175,6 +175,24 @@ OptimizeResult Run(const OptimizeInputs& in, const OptimizeOptions& o) {
     result.rounds.push_back(std::move(round));
   }
   result.meshes = meshes;
+  if (in.features.text_down && !result.rounds.empty()) {
+    // Least squares flat = A pixel + b over every marker of the last round.
+    Eigen::Matrix3d ata = Eigen::Matrix3d::Zero();
+    Eigen::Matrix<double, 3, 2> atb = Eigen::Matrix<double, 3, 2>::Zero();
+    int n = 0;
+    for (const LineRecord& l : result.rounds.back().lines)
+      for (size_t k = 0; k < l.pixels.size() && k < l.flat.size(); ++k) {
+        const Eigen::Vector3d a(l.pixels[k].x(), l.pixels[k].y(), 1);
+        ata += a * a.transpose();
+        atb += a * l.flat[k].transpose();
+        ++n;
+      }
+    if (n >= 10 && std::abs(ata.determinant()) > 1e-12) {
+      const Eigen::Matrix<double, 3, 2> x = ata.ldlt().solve(atb);
+      const Eigen::Vector2d down = x.topRows<2>().transpose() * *in.features.text_down;
+      if (down.norm() > 0) result.text_down_flat = down.normalized();
+    }
+  }
   result.seconds = SecondsSince(start);
   return result;
 }

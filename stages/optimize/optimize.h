@@ -97,6 +97,9 @@ struct OptimizeResult {
   std::vector<RoundResult> rounds;
   std::vector<int> region_points;  // indices of the SfM points in the document region
   LineDirection line_direction;    // of the segments in M' before the first round
+  // The reader's down in the final M' (unit), from the feature file's
+  // text_down through an affine fit of the final lines' pixels to M'.
+  std::optional<Eigen::Vector2d> text_down_flat;
   double upright_turn_deg = 0;     // M' turned by this before the first round
   std::vector<bool> inliers;       // per region point, after the last round
   int segments = 0;                // feature segments given (text + edge)

@@ -58,7 +58,8 @@ OptimizeInputs ReadInputs(const InputPaths& paths) {
   return in;
 }
 
-Json LinesJson(const std::vector<LineRecord>& lines, const Json& options_json) {
+Json LinesJson(const std::vector<LineRecord>& lines, const Json& options_json,
+               const std::optional<Eigen::Vector2d>& text_down_flat) {
   Json doc = MakeHeader("docunfold.lines", 1, "optimize", options_json);
   doc["description"] =
       "Feature lines straightened in M': n.p' = offset with n = normal; markers in "
@@ -75,6 +76,8 @@ Json LinesJson(const std::vector<LineRecord>& lines, const Json& options_json) {
     if (l.side >= 0) j["side"] = kSideNames[l.side];
     doc["lines"].push_back(j);
   }
+  if (text_down_flat)
+    doc["text_down_flat"] = {text_down_flat->x(), text_down_flat->y()};
   return doc;
 }
 
@@ -131,7 +134,8 @@ void WriteOutputs(const fs::path& out, const InputPaths& paths, const OptimizeIn
   }
   mesh_options.comments = {"docunfold optimize: final meshes"};
   WriteMeshPair(out, result.meshes, mesh_options);
-  WriteJsonAtomic(out / "lines.json", LinesJson(result.rounds.back().lines, options_json));
+  WriteJsonAtomic(out / "lines.json",
+                  LinesJson(result.rounds.back().lines, options_json, result.text_down_flat));
   WriteJsonAtomic(out / "log.json", LogJson(result, options_json));
   if (!output_options.scene) return;
 

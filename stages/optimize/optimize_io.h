@@ -4,6 +4,7 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 
 #include <opencv2/core.hpp>
 
@@ -36,7 +37,9 @@ void WriteOutputs(const fs::path& out, const InputPaths& paths, const OptimizeIn
                   const OptimizeResult& result, const Json& options_json,
                   const OutputOptions& output_options);
 
-Json LinesJson(const std::vector<LineRecord>& lines, const Json& options_json);
+// `text_down_flat`, when given, is the reader's down in M' (unit).
+Json LinesJson(const std::vector<LineRecord>& lines, const Json& options_json,
+               const std::optional<Eigen::Vector2d>& text_down_flat = std::nullopt);
 Json LogJson(const OptimizeResult& result, const Json& options_json);
 
 }  // namespace docunfold::optimize

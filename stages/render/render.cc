@@ -658,7 +658,20 @@ RenderResult Run(const RenderOptions& options, const RenderInputs& in) {
   timer.Mark("fill_and_grid");
   Json orientation = {{"checked", options.orient}};
   if (options.orient) {
-    const Orientation o = FindOrientation(r.rectified);
+    Orientation o = FindOrientation(r.rectified);
+    if (!o.decided && in.text_down) {
+      // Print too small to read: the side the baselines lie on (found by
+      // detect-features, carried into M' by optimize) says which way is
+      // down. Output y is M' turned by `angle`; turn so that down is +y.
+      const Eigen::Vector2d d = Eigen::Rotation2Dd(angle) * *in.text_down;
+      // Clockwise quarter turns map the image's down (0, 1) to: 0 -> (0, 1),
+      // 1 -> (-1, 0), 2 -> (0, -1), 3 -> (1, 0); pick the one taking d there.
+      const int turns = std::abs(d.y()) >= std::abs(d.x()) ? (d.y() > 0 ? 0 : 2)
+                                                           : (d.x() > 0 ? 1 : 3);
+      o.quarter_turns = turns;
+      o.note += "; turned by the side the text's baselines lie on (lines.json)";
+      orientation["by"] = "baselines";
+    }
     orientation["readable_words"] = o.words;
     orientation["decided"] = o.decided;
     if (!o.note.empty()) {

@@ -10,6 +10,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <filesystem>
+#include <optional>
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
@@ -93,6 +94,9 @@ struct RenderInputs {
   // Directions and lengths in M' of the lines in lines.json beside the
   // meshes (optimize's); empty when there is none (init-mesh's meshes).
   std::vector<DirectionVote> lines;
+  // The reader's down in M' (lines.json text_down_flat), when known: which
+  // way up the page is when Tesseract cannot read its print.
+  std::optional<Eigen::Vector2d> text_down;
   // Where each input came from, for error messages and the report.
   fs::path cameras_file, reference_file, meshes_dir;
 };

@@ -37,6 +37,12 @@ RenderInputs ReadRenderInputs(const fs::path& sfm_dir,
     const Json doc = ReadJsonFile(lines_file);
     if (!doc.contains("lines") || !doc["lines"].is_array())
       throw InputError(lines_file.string() + ":/lines: missing or not an array");
+    if (doc.contains("text_down_flat")) {
+      const Json& d = doc["text_down_flat"];
+      if (!d.is_array() || d.size() != 2 || !d[0].is_number() || !d[1].is_number())
+        throw InputError(lines_file.string() + ":/text_down_flat: expected [x, y]");
+      in.text_down = Eigen::Vector2d(d[0].get<double>(), d[1].get<double>());
+    }
     for (size_t i = 0; i < doc["lines"].size(); ++i) {
       const Json& l = doc["lines"][i];
       const std::string where = lines_file.string() + ":/lines/" + std::to_string(i);

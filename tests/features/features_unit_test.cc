@@ -65,6 +65,8 @@ TEST(DetectFeatures, TextBaselinesAndRuleCentres) {
   ASSERT_GT(r.text_segments, 0);
   ASSERT_EQ(r.edge_segments, 3);
   EXPECT_FALSE(r.text_upside_down);
+  ASSERT_TRUE(r.text_down);  // the reader's down: image down
+  EXPECT_GT(r.text_down->y, 0.99);
   double text_length = 0;
   for (const Segment& s : r.segments) {
     ASSERT_GE(s.points.size(), 2u);
@@ -91,6 +93,8 @@ TEST(DetectFeatures, UpsideDownTextStillGivesBaselines) {
   const FeaturesResult r = DetectFeatures(p.image, p.mask, {});
   ASSERT_GT(r.text_segments, 5);
   EXPECT_TRUE(r.text_upside_down);
+  ASSERT_TRUE(r.text_down);
+  EXPECT_LT(r.text_down->y, -0.99);
   for (const Segment& s : r.segments) {
     if (s.kind == "text") {
       EXPECT_LE(WorstOffset(s, baselines), 1.5);

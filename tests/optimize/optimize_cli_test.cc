@@ -86,8 +86,15 @@ TEST(OptimizeCli, TextRowsTurnAnOffUprightFlatMesh) {
       segments.push_back({{"kind", "text"}, {"points", points}});
     }
   ASSERT_GE(segments.size(), 40u);
-  WriteJsonAtomic(dir / "features.json",
-                  {{"format", "docunfold.features"}, {"version", 1}, {"segments", segments}});
+  // The reader's down: the sheet's rows run along flat x, so down is flat +y,
+  // seen in the image between two rows.
+  const Eigen::Vector2d down_px =
+      (cam.Project(truth.mesh3d[truth.grid.Index(16, 10)]) -
+       cam.Project(truth.mesh3d[truth.grid.Index(14, 10)])).normalized();
+  WriteJsonAtomic(dir / "features.json", {{"format", "docunfold.features"},
+                                          {"version", 1},
+                                          {"text_down", {down_px.x(), down_px.y()}},
+                                          {"segments", segments}});
 
   const fs::path points = dir / "10_sfm/points.ply";
   const CommandResult turned = RunCommand(OptimizeCommand(dir.path(), points, dir / "turned"));
@@ -97,6 +104,10 @@ TEST(OptimizeCli, TextRowsTurnAnOffUprightFlatMesh) {
   EXPECT_NEAR(direction.at("angle_deg").get<double>(), 25, 1) << direction.dump();
   EXPECT_NEAR(direction.at("turned_deg").get<double>(), -25, 1) << direction.dump();
   EXPECT_GE(direction.at("share").get<double>(), 0.9) << direction.dump();
+  // ... and it is carried into M': across the rows, which now run along x.
+  const Json turned_lines = ReadJsonFile(dir / "turned/lines.json");
+  ASSERT_TRUE(turned_lines.contains("text_down_flat")) << turned.output;
+  EXPECT_GT(std::abs(turned_lines["text_down_flat"][1].get<double>()), 0.99);
   const CommandResult kept = RunCommand(
       OptimizeCommand(dir.path(), points, dir / "kept") + " --no-upright-by-lines");
   ASSERT_EQ(kept.exit_code, 0) << kept.output;

@@ -147,6 +147,23 @@ TEST_F(RenderCli, DeskewFollowsTheLinesOfLinesJson) {
   EXPECT_EQ(rotation("--deskew-by sides", "forced").first, sides_deg);
   write_lines(3);
   EXPECT_EQ(rotation("", "few").second, "sides");
+  // Print too small for Tesseract (the page 100 px wide): the reader's down
+  // from lines.json decides the quarter turn (down along +x in the output
+  // takes one clockwise turn, along -x three); without it the page stays.
+  ASSERT_EQ(Render(work, dir_ / "small", "--width 100").exit_code, 0);
+  const Json quiet = ReadJsonFile(dir_ / "small" / "render.json")["orientation"];
+  ASSERT_FALSE(quiet["decided"].get<bool>()) << quiet.dump();
+  EXPECT_EQ(quiet["quarter_turns_clockwise"], 0);
+  for (const auto& [down, turns] : std::vector<std::pair<double, int>>{{1, 1}, {-1, 3}}) {
+    Json doc = ReadJsonFile(work / "40_init/lines.json");
+    doc["text_down_flat"] = {down, 0.0};
+    WriteJsonAtomic(work / "40_init/lines.json", doc);
+    const std::string name = "down" + std::to_string(turns);
+    ASSERT_EQ(Render(work, dir_ / name, "--width 100").exit_code, 0);
+    const Json o = ReadJsonFile(dir_ / name / "render.json")["orientation"];
+    EXPECT_EQ(o["quarter_turns_clockwise"], turns) << o.dump();
+    EXPECT_EQ(o["by"], "baselines") << o.dump();
+  }
   WriteTextAtomic(work / "40_init/lines.json", "{\"lines\": [{\"normal\": [0, 1]}]}");
   ExpectFailure(Render(work, dir_ / "broken"), 3, "lines.json:/lines/0", dir_ / "broken");
 }
