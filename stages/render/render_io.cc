@@ -33,27 +33,30 @@ RenderInputs ReadRenderInputs(const fs::path& sfm_dir,
   // optimize's lines, for the deskew: each line's direction (its normal
   // turned, the same modulo 90 degrees) and its extent in M'.
   const fs::path lines_file = meshes_dir / "lines.json";
+  auto is_xy = [](const Json& v) {
+    return v.is_array() && v.size() == 2 && v[0].is_number() && v[1].is_number();
+  };
   if (fs::is_regular_file(lines_file, ec)) {
     const Json doc = ReadJsonFile(lines_file);
     if (!doc.contains("lines") || !doc["lines"].is_array())
       throw InputError(lines_file.string() + ":/lines: missing or not an array");
     if (doc.contains("text_down_flat")) {
       const Json& d = doc["text_down_flat"];
-      if (!d.is_array() || d.size() != 2 || !d[0].is_number() || !d[1].is_number())
+      if (!is_xy(d))
         throw InputError(lines_file.string() + ":/text_down_flat: expected [x, y]");
       in.text_down = Eigen::Vector2d(d[0].get<double>(), d[1].get<double>());
     }
     for (size_t i = 0; i < doc["lines"].size(); ++i) {
       const Json& l = doc["lines"][i];
       const std::string where = lines_file.string() + ":/lines/" + std::to_string(i);
-      if (!l.contains("normal") || !l["normal"].is_array() || l["normal"].size() != 2 ||
-          !l.contains("flat") || !l["flat"].is_array())
+      if (!l.is_object() || !l.contains("normal") || !is_xy(l["normal"]) || !l.contains("flat") ||
+          !l["flat"].is_array())
         throw InputError(where + ": needs normal [x, y] and flat [[x, y], ...]");
       const Eigen::Vector2d n(l["normal"][0].get<double>(), l["normal"][1].get<double>());
       const Eigen::Vector2d along(-n.y(), n.x());
       double lo = 1e300, hi = -1e300;
       for (const Json& p : l["flat"]) {
-        if (!p.is_array() || p.size() != 2) throw InputError(where + "/flat: points are [x, y]");
+        if (!is_xy(p)) throw InputError(where + "/flat: points are [x, y]");
         const double t = along.dot(Eigen::Vector2d(p[0].get<double>(), p[1].get<double>()));
         lo = std::min(lo, t);
         hi = std::max(hi, t);

@@ -166,6 +166,9 @@ TEST_F(RenderCli, DeskewFollowsTheLinesOfLinesJson) {
   }
   WriteTextAtomic(work / "40_init/lines.json", "{\"lines\": [{\"normal\": [0, 1]}]}");
   ExpectFailure(Render(work, dir_ / "broken"), 3, "lines.json:/lines/0", dir_ / "broken");
+  WriteTextAtomic(work / "40_init/lines.json",
+                  "{\"lines\": [{\"normal\": [0, 1], \"flat\": [[0, \"a\"]]}]}");
+  ExpectFailure(Render(work, dir_ / "typed"), 3, "lines.json:/lines/0/flat", dir_ / "typed");
 }
 
 TEST_F(RenderCli, ContradictoryFlagsAreUsageErrors) {
