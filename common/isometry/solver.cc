@@ -32,7 +32,13 @@ using internal::State;
 using internal::StepData;
 using internal::Vec5;
 
-constexpr double kHalfPi = 1.57079632679489661923;
+namespace {
+// θ of an axis-aligned line: the nearest multiple of 90 degrees.
+double NearestAxisTheta(double theta) {
+  constexpr double kHalfPi = 1.57079632679489661923;
+  return kHalfPi * std::round(theta / kHalfPi);
+}
+}  // namespace
 
 namespace internal {
 namespace {
@@ -323,7 +329,7 @@ void FitLines(State& s, const StepData& data) {
     if (normal.dot(s.lines[l].Normal()) < 0) normal = -normal;
     double theta = std::atan2(normal.y(), normal.x());
     if (s.lines[l].axis_aligned) {
-      theta = kHalfPi * std::round(theta / kHalfPi);
+      theta = NearestAxisTheta(theta);
       normal = Eigen::Vector2d(std::cos(theta), std::sin(theta));
     }
     s.lines[l].theta = theta;
@@ -777,7 +783,7 @@ Result Solve(const Problem& problem, const SolveOptions& o) {
     }
     if (!w.data.markers.empty() && !w.state.lines.empty()) {
       for (FeatureLine& l : w.state.lines)  // the caller's may be slanted
-        if (l.axis_aligned) l.theta = kHalfPi * std::round(l.theta / kHalfPi);
+        if (l.axis_aligned) l.theta = NearestAxisTheta(l.theta);
       if (o.refit_lines) FitLines(w.state, w.data);
       if (o.project_markers) ProjectMarkers(w.state, w.data);
     }

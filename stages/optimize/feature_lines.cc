@@ -8,8 +8,6 @@
 #include <Eigen/Eigenvalues>
 #include <nanoflann.hpp>
 
-#include "common/axis_direction.h"
-
 namespace docunfold::optimize {
 namespace {
 
@@ -222,7 +220,7 @@ Grouping GroupSegments(const MeshPair& meshes, const MarkerSet& markers,
   return g;
 }
 
-LineDirection DominantLineDirection(const MeshPair& meshes, const MarkerSet& markers,
+AxisDirection DominantLineDirection(const MeshPair& meshes, const MarkerSet& markers,
                                     const std::vector<Segment>& segments) {
   std::vector<std::vector<Eigen::Vector2d>> flat(segments.size());
   for (size_t i = 0; i < markers.markers.size(); ++i)
@@ -236,13 +234,7 @@ LineDirection DominantLineDirection(const MeshPair& meshes, const MarkerSet& mar
     if (c.Width() <= 0 || c.height > 0.1 * c.Width()) continue;  // not straight in M'
     votes.push_back({std::atan2(c.direction.y(), c.direction.x()) * 180 / kPi, c.Width()});
   }
-  const AxisDirection mode = DominantAxisDirection(votes);
-  LineDirection out;
-  out.angle_deg = mode.angle_deg;
-  out.share = mode.share;
-  out.length = mode.length;
-  out.segments = mode.lines;
-  return out;
+  return DominantAxisDirection(votes);
 }
 
 std::vector<isometry::FeatureLine> AssignLines(const MeshPair& meshes, const Grouping& grouping,

@@ -9,6 +9,7 @@
 
 #include <Eigen/Core>
 
+#include "common/axis_direction.h"
 #include "common/camera.h"
 #include "common/grid_mesh.h"
 #include "common/isometry/isometry.h"
@@ -73,27 +74,20 @@ Grouping GroupSegments(const MeshPair& meshes, const MarkerSet& markers,
                        const std::vector<Segment>& segments, const GroupingOptions& options);
 
 // The direction, modulo 90 degrees, that most of the detected segments'
-// length follows in M' (text rows and rules run along the page's axes).
-// Boundary sides do not vote: init-mesh made M' upright by them already,
-// and a side found wrongly (a fold taken for it) is what this checks.
-struct LineDirection {
-  // Counter-clockwise from M's x axis, reduced to (-45, 45]: turning M' by
-  // -angle_deg puts the segments along the axes.
-  double angle_deg = 0;
-  double share = 0;      // fraction of their length within 3 degrees of it
-  double length = 0;     // total length of the voting segments in M'
-  int segments = 0;      // how many voted
-};
-LineDirection DominantLineDirection(const MeshPair& meshes, const MarkerSet& markers,
+// length follows in M' (text rows and rules run along the page's axes); the
+// votes are the segments straight in M' (`lines` counts them). Boundary
+// sides do not vote: init-mesh made M' upright by them already, and a side
+// found wrongly (a fold taken for it) is what this checks.
+AxisDirection DominantLineDirection(const MeshPair& meshes, const MarkerSet& markers,
                                     const std::vector<Segment>& segments);
 
-// Assigns each marker its segment's line; returns lines fitted (total least
-// squares) to their markers' points in M'.
 // Which lines are held along the axes of M' (isometry::FeatureLine::
 // axis_aligned): none (the paper), the detected text and rule lines, or
 // those and the real page sides.
 enum class AxisLines { kNone, kFeatures, kAll };
 
+// Assigns each marker its segment's line; returns lines fitted (total least
+// squares) to their markers' points in M'.
 std::vector<isometry::FeatureLine> AssignLines(const MeshPair& meshes, const Grouping& grouping,
                                                MarkerSet* markers,
                                                AxisLines axis_lines = AxisLines::kNone);

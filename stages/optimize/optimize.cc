@@ -74,18 +74,17 @@ OptimizeResult Run(const OptimizeInputs& in, const OptimizeOptions& o) {
   // a side), they turn it, as the lines are kept only near the axes. A turn
   // of M' changes no term of F.
   if (o.upright_by_lines && !segments.empty()) {
-    const LineDirection dir =
+    const AxisDirection dir =
         DominantLineDirection(meshes, CastMarkers(meshes, in.reference, segments, o.cast), segments);
     result.line_direction = dir;
     char buf[200];
     std::snprintf(buf, sizeof buf,
                   "segments run %.2f deg off the axes of M' (%d segments, %.0f %% of their "
                   "length within 3 deg)",
-                  dir.angle_deg, dir.segments, 100 * dir.share);
-    if (dir.segments >= o.upright_min_segments && dir.share >= o.upright_min_share &&
+                  dir.angle_deg, dir.lines, 100 * dir.share);
+    if (dir.lines >= o.upright_min_segments && dir.share >= o.upright_min_share &&
         std::abs(dir.angle_deg) >= o.upright_min_deg) {
-      const double a = -dir.angle_deg * 3.14159265358979323846 / 180;
-      const Eigen::Rotation2Dd turn(a);
+      const Eigen::Rotation2Dd turn(-dir.angle_deg * M_PI / 180);
       Eigen::Vector2d centre = Eigen::Vector2d::Zero();
       for (const auto& p : meshes.mesh2d) centre += p;
       centre /= double(meshes.mesh2d.size());

@@ -96,7 +96,7 @@ struct OptimizeResult {
   MeshPair meshes;                 // final M and M'
   std::vector<RoundResult> rounds;
   std::vector<int> region_points;  // indices of the SfM points in the document region
-  LineDirection line_direction;    // of the segments in M' before the first round
+  AxisDirection line_direction;    // of the segments in M' before the first round
   // The reader's down in the final M' (unit), from the feature file's
   // text_down through an affine fit of the final lines' pixels to M'.
   std::optional<Eigen::Vector2d> text_down_flat;

@@ -87,7 +87,7 @@ Json LogJson(const OptimizeResult& result, const Json& options_json) {
   doc["segments_off_page"] = result.segments_off_page;
   doc["line_direction"] = {{"angle_deg", result.line_direction.angle_deg},
                            {"share", result.line_direction.share},
-                           {"segments", result.line_direction.segments},
+                           {"segments", result.line_direction.lines},
                            {"turned_deg", result.upright_turn_deg}};
   doc["boundary_lines"] = result.boundary_lines;
   doc["points_in_region"] = result.region_points.size();
