@@ -601,6 +601,58 @@ Eigen::Vector3d Triangulate(const std::vector<const PinholeCamera*>& cameras,
   return X.head<3>() / X(3);
 }
 
+std::vector<bool> HiddenInReference(const std::vector<Eigen::Vector3d>& points,
+                                    const std::vector<std::array<uint8_t, 3>>& colours,
+                                    const std::vector<int>& indices, const PinholeCamera& camera,
+                                    const cv::Mat& reference, const HiddenOptions& o) {
+  std::vector<bool> hidden(indices.size(), false);
+  if (colours.size() != points.size() || reference.empty() || indices.empty()) return hidden;
+  // A cloud whose points all carry one colour (a writer's default) tells nothing.
+  if (std::all_of(indices.begin(), indices.end(),
+                  [&](int i) { return colours[i] == colours[indices[0]]; }))
+    return hidden;
+  // Projections and the exposure gain (median of reference / point, per channel).
+  std::vector<cv::Point> pixel(indices.size(), cv::Point(-1, -1));
+  std::array<std::vector<double>, 3> ratios;
+  for (size_t k = 0; k < indices.size(); ++k) {
+    const Eigen::Vector3d xc = camera.CamFromWorld(points[indices[k]]);
+    if (!(xc.z() > 0)) continue;
+    const Eigen::Vector2d p = camera.ProjectCam(xc);
+    const long u = std::lround(p.x()), v = std::lround(p.y());
+    if (u < 0 || v < 0 || u >= reference.cols || v >= reference.rows) continue;
+    pixel[k] = cv::Point(int(u), int(v));
+    const cv::Vec3b bgr = reference.at<cv::Vec3b>(pixel[k]);
+    const std::array<uint8_t, 3>& rgb = colours[indices[k]];
+    for (int c = 0; c < 3; ++c) ratios[c].push_back((bgr[2 - c] + 1.0) / (rgb[c] + 1.0));
+  }
+  if (ratios[0].empty()) return hidden;
+  std::array<double, 3> gain{};
+  for (int c = 0; c < 3; ++c) {
+    std::vector<double>& r = ratios[c];
+    std::nth_element(r.begin(), r.begin() + r.size() / 2, r.end());
+    gain[c] = r[r.size() / 2];
+  }
+  cv::Mat lab;
+  cv::cvtColor(reference, lab, cv::COLOR_BGR2Lab);
+  const int w = std::max(0, o.window_px);
+  for (size_t k = 0; k < indices.size(); ++k) {
+    if (pixel[k].x < 0) continue;
+    const std::array<uint8_t, 3>& rgb = colours[indices[k]];
+    cv::Mat3b point_bgr(1, 1);
+    for (int c = 0; c < 3; ++c)
+      point_bgr(0, 0)[2 - c] = cv::saturate_cast<uint8_t>(rgb[c] * gain[c]);
+    cv::Mat3b point_lab;
+    cv::cvtColor(point_bgr, point_lab, cv::COLOR_BGR2Lab);
+    const cv::Vec3d a = point_lab(0, 0);
+    double nearest = std::numeric_limits<double>::infinity();
+    for (int v = std::max(0, pixel[k].y - w); v <= std::min(lab.rows - 1, pixel[k].y + w); ++v)
+      for (int u = std::max(0, pixel[k].x - w); u <= std::min(lab.cols - 1, pixel[k].x + w); ++u)
+        nearest = std::min(nearest, cv::norm(a - cv::Vec3d(lab.at<cv::Vec3b>(v, u))));
+    hidden[k] = nearest > o.max_colour_distance;
+  }
+  return hidden;
+}
+
 Json DensifyOptions::ToJson() const {
   return {{"max_image_size", max_image_size},
           {"region_margin_px", region_margin_px},
@@ -625,7 +677,11 @@ Json DensifyOptions::ToJson() const {
             {"max_reprojection_px", outline.max_reprojection_px},
             {"continuity_radius_px", outline.continuity_radius_px},
             {"max_depth_jump", outline.max_depth_jump},
-            {"min_views", outline.min_views}}}};
+            {"min_views", outline.min_views}}},
+          {"hidden",
+           {{"enabled", hidden.enabled},
+            {"max_colour_distance", hidden.max_colour_distance},
+            {"window_px", hidden.window_px}}}};
 }
 
 DensifyInputs ReadInputs(const DensifyOptions& o) {
@@ -682,32 +738,52 @@ DensifyResult Run(const DensifyInputs& in, const DensifyOptions& o) {
   r.views.resize(num_views);
   for (int i = 0; i < num_views; ++i) r.views[i].image = in.cameras.views[i].image;
 
-  // Output cloud: sfm's points first, with their properties, then ours.
-  r.points.vertices = in.points.vertices;
-  r.points.colors = in.points.colors;
-  if (r.points.colors.size() != r.points.vertices.size())
-    r.points.colors.assign(r.points.vertices.size(), {200, 200, 200});
-  r.points.comments = {
-      "docunfold densify: sfm's points (source 0), then points triangulated from the texture "
-      "of the page (1) and from its outline (2), cameras of 10_sfm held fixed",
-      "frame: that of 10_sfm/cameras.json (camera of the reference view " +
-          in.cameras.reference + ")"};
+  // sfm's points of the region, less those the reference view shows in another colour.
+  const cv::Mat1b full_region = GrowRegion(in.region, o.region_margin_px);
+  const std::vector<int> in_region = PointsInRegion(in.points.vertices, ref_camera, full_region);
+  r.sfm_points_in_region = int(in_region.size());
+  std::vector<bool> keep(in.points.vertices.size(), true);
+  if (o.hidden.enabled) {
+    const std::vector<bool> hidden = HiddenInReference(
+        in.points.vertices, in.points.colors, in_region, ref_camera, in.reference, o.hidden);
+    for (size_t k = 0; k < in_region.size(); ++k)
+      if (hidden[k]) {
+        keep[in_region[k]] = false;
+        r.hidden.push_back(in.points.vertices[in_region[k]]);
+      }
+  }
+  std::vector<Eigen::Vector3d> page_points;
+  for (const int i : in_region)
+    if (keep[i]) page_points.push_back(in.points.vertices[i]);
+
+  // Output cloud: sfm's points first (those kept, in order, with their
+  // properties), then ours.
   r.sfm_points = int(in.points.vertices.size());
   auto sfm_property = [&](const char* name, double fallback) {
     const PlyProperty* p = in.points.FindProperty(name);
     return p ? p->values : std::vector<double>(in.points.vertices.size(), fallback);
   };
-  r.points.properties = {{"track_length", PlyScalar::kUint32, sfm_property("track_length", 2)},
-                         {"reprojection_error", PlyScalar::kFloat32,
-                          sfm_property("reprojection_error", 0)},
-                         {"source", PlyScalar::kUint8,
-                          std::vector<double>(in.points.vertices.size(), kSfm)}};
-
-  const cv::Mat1b full_region = GrowRegion(in.region, o.region_margin_px);
-  const std::vector<int> in_region = PointsInRegion(in.points.vertices, ref_camera, full_region);
-  r.sfm_points_in_region = int(in_region.size());
-  std::vector<Eigen::Vector3d> page_points;
-  for (const int i : in_region) page_points.push_back(in.points.vertices[i]);
+  const std::vector<double> track_length = sfm_property("track_length", 2);
+  const std::vector<double> reprojection_error = sfm_property("reprojection_error", 0);
+  const bool has_colours = in.points.colors.size() == in.points.vertices.size();
+  r.points.properties = {{"track_length", PlyScalar::kUint32, {}},
+                         {"reprojection_error", PlyScalar::kFloat32, {}},
+                         {"source", PlyScalar::kUint8, {}}};
+  for (size_t i = 0; i < in.points.vertices.size(); ++i) {
+    if (!keep[i]) continue;
+    AppendPoint(in.points.vertices[i],
+                has_colours ? in.points.colors[i] : std::array<uint8_t, 3>{200, 200, 200},
+                int(track_length[i]), reprojection_error[i], kSfm, &r.points);
+  }
+  const size_t first_new_point = r.points.vertices.size();
+  r.points.comments = {
+      "docunfold densify: sfm's points (source 0; those the reference view " +
+          in.cameras.reference +
+          " shows in another colour, behind the page, left out), then points triangulated "
+          "from the texture of the page (1) and from its outline (2), cameras of 10_sfm held "
+          "fixed",
+      "frame: that of 10_sfm/cameras.json (camera of the reference view " +
+          in.cameras.reference + ")"};
 
   // Working copies.
   auto t = Clock::now();
@@ -750,7 +826,7 @@ DensifyResult Run(const DensifyInputs& in, const DensifyOptions& o) {
       depths.push_back(xc.z());
     };
     for (const Eigen::Vector3d& X : page_points) add(X);
-    for (size_t i = in.points.vertices.size(); i < r.points.vertices.size(); ++i)
+    for (size_t i = first_new_point; i < r.points.vertices.size(); ++i)
       add(r.points.vertices[i]);
     if (in.boundary.RealSides() == 0)
       r.warnings.push_back("no real boundary side: no outline points");
@@ -789,14 +865,30 @@ void WriteOutputs(const DensifyInputs& in, const DensifyResult& r, const Densify
                  int(std::lround(radius_scale * (pass == 2 ? 3 : 2))), colours[pass], -1,
                  cv::LINE_AA);
     }
+  // Left out as hidden behind the page: red crosses.
+  const cv::Scalar hidden_colour(0, 0, 255);
+  const int arm = int(std::lround(4 * radius_scale));
+  for (const Eigen::Vector3d& X : r.hidden) {
+    const Eigen::Vector3d xc = ref.CamFromWorld(X);
+    if (!(xc.z() > 0)) continue;
+    const Eigen::Vector2d p = ref.ProjectCam(xc);
+    const cv::Point c(int(std::lround(p.x())), int(std::lround(p.y())));
+    cv::line(overlay, c - cv::Point(arm, arm), c + cv::Point(arm, arm), hidden_colour,
+             int(std::lround(radius_scale)), cv::LINE_AA);
+    cv::line(overlay, c - cv::Point(arm, -arm), c + cv::Point(arm, -arm), hidden_colour,
+             int(std::lround(radius_scale)), cv::LINE_AA);
+  }
   const double font = 0.8 * radius_scale;
   const int thick = int(std::lround(2 * radius_scale));
-  const std::string legend[3] = {"sfm " + std::to_string(r.sfm_points_in_region),
+  const int sfm_kept = r.sfm_points_in_region - int(r.hidden.size());
+  const std::string legend[4] = {"sfm " + std::to_string(sfm_kept),
                                  "texture " + std::to_string(r.texture_points),
-                                 "outline " + std::to_string(r.outline_points)};
-  for (int i = 0; i < 3; ++i)
+                                 "outline " + std::to_string(r.outline_points),
+                                 "hidden (left out) " + std::to_string(r.hidden.size())};
+  const cv::Scalar legend_colours[4] = {colours[0], colours[1], colours[2], hidden_colour};
+  for (int i = 0; i < 4; ++i)
     cv::putText(overlay, legend[i], cv::Point(int(20 * radius_scale), int((40 + 34 * i) * radius_scale)),
-                cv::FONT_HERSHEY_SIMPLEX, font, colours[i], thick, cv::LINE_AA);
+                cv::FONT_HERSHEY_SIMPLEX, font, legend_colours[i], thick, cv::LINE_AA);
   WriteImageAtomic(o.out_dir / "overlay.png", overlay, {cv::IMWRITE_PNG_COMPRESSION, 1});
 
   Json doc = MakeHeader("docunfold.points", 1, "densify", o.ToJson());
@@ -804,6 +896,7 @@ void WriteOutputs(const DensifyInputs& in, const DensifyResult& r, const Densify
   doc["working_scale"] = r.working_scale;
   doc["points"] = {{"sfm", r.sfm_points},
                    {"sfm_in_region", r.sfm_points_in_region},
+                   {"sfm_hidden", r.hidden.size()},
                    {"texture", r.texture_points},
                    {"outline", r.outline_points},
                    {"total", r.points.vertices.size()}};

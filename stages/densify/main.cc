@@ -11,7 +11,7 @@ int main(int argc, char** argv) {
                "optical flow, and the page's outline matched along epipolar lines. Writes "
                "points.ply (sfm's points first), points.json and overlay.png."};
   densify::DensifyOptions o;
-  bool no_texture = false, no_outline = false;
+  bool no_texture = false, no_outline = false, keep_hidden = false;
   app.add_option("--data", o.data_dir, "data set folder (its images/ are read)")->required();
   app.add_option("--sfm", o.sfm_dir, "sfm output: cameras.json, points.ply, reference.png")
       ->required();
@@ -46,16 +46,27 @@ int main(int argc, char** argv) {
                  "outline: other photos agree when their edge is within this distance")
       ->capture_default_str()->check(CLI::Range(0.1, 100.0));
 
+  app.add_flag("--keep-hidden", keep_hidden,
+               "keep sfm points of the document region that the reference view shows in "
+               "another colour (by default they are left out as behind the page)");
+  app.add_option("--hidden-colour-distance", o.hidden.max_colour_distance,
+                 "hidden: colour difference (CIE76, OpenCV 8-bit Lab) beyond which an sfm point "
+                 "is not what the reference view shows")
+      ->capture_default_str()->check(CLI::Range(0.0, 500.0));
+
   return RunStage("densify", app, argc, argv, [&] {
     o.texture.enabled = !no_texture;
     o.outline.enabled = !no_outline;
+    o.hidden.enabled = !keep_hidden;
     const densify::DensifyInputs in = densify::ReadInputs(o);
     const densify::DensifyResult r = densify::Run(in, o);
     densify::WriteOutputs(in, r, o);
     for (const std::string& w : r.warnings) Log("warning: " + w);
-    Log("wrote " + (o.out_dir / "points.ply").string() + ": " + std::to_string(r.sfm_points) +
-        " sfm + " + std::to_string(r.texture_points) + " texture + " +
-        std::to_string(r.outline_points) + " outline points, " +
+    Log("wrote " + (o.out_dir / "points.ply").string() + ": " +
+        std::to_string(r.sfm_points - int(r.hidden.size())) + " sfm (" +
+        std::to_string(r.hidden.size()) + " hidden behind the page left out) + " +
+        std::to_string(r.texture_points) + " texture + " + std::to_string(r.outline_points) +
+        " outline points, " +
         std::to_string(r.seconds_total).substr(0, 4) + " s");
   });
 }

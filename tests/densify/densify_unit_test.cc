@@ -2,6 +2,7 @@
 // with rows of "words" on a darker table, seen by four cameras.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <random>
 
@@ -44,6 +45,57 @@ TEST(Densify, ScaledCameraSeesTheResizedPixel) {
   // cv::resize's pixel centres: x' = (x + 0.5) s - 0.5.
   EXPECT_NEAR(small.x(), (full.x() + 0.5) * 0.5 - 0.5, 1e-9);
   EXPECT_NEAR(small.y(), (full.y() + 0.5) * 0.5 - 0.5, 1e-9);
+}
+
+// A white page with black text lines on a brown table, seen from above: page
+// points (white, or black on the text) are kept, table points that the other
+// photos saw behind a raised page (brown where the reference shows white) are
+// hidden, and all of it under a darker exposure of the other photos.
+TEST(Densify, PointsOfAnotherColourThanTheReferenceShowsAreHidden) {
+  const PinholeCamera camera = LookAt("ref", {0, 0, 0}, {0, 0, 1});
+  cv::Mat reference(600, 800, CV_8UC3, cv::Scalar(40, 90, 150));  // brown table (BGR)
+  cv::rectangle(reference, cv::Rect(200, 100, 400, 400), cv::Scalar(245, 245, 245), -1);
+  for (int y = 150; y < 450; y += 20)
+    cv::line(reference, {220, y}, {580, y}, cv::Scalar(20, 20, 20), 2);
+  std::vector<Eigen::Vector3d> points;
+  std::vector<std::array<uint8_t, 3>> colours;
+  std::vector<bool> expected;
+  const double exposure = 0.8;  // the photos COLMAP coloured the points from were darker
+  auto add = [&](int u, int v, const std::array<uint8_t, 3>& rgb, bool hidden) {
+    const Eigen::Vector3d ray = camera.K.inverse() * Eigen::Vector3d(u, v, 1);
+    points.push_back(ray * 1.2);
+    std::array<uint8_t, 3> seen;
+    for (int c = 0; c < 3; ++c) seen[c] = uint8_t(std::lround(rgb[c] * exposure));
+    colours.push_back(seen);
+    expected.push_back(hidden);
+  };
+  std::mt19937 rng(5);
+  std::uniform_int_distribution<int> col(210, 590), row(110, 490), gap(0, 14);
+  // Paper between the text lines (10 px from them).
+  for (int i = 0; i < 60; ++i) add(col(rng), 160 + 20 * gap(rng), {245, 245, 245}, false);
+  for (int y = 150; y < 450; y += 60) add(400, y + 1, {20, 20, 20}, false);       // on the text
+  for (int i = 0; i < 15; ++i) add(col(rng), row(rng), {150, 90, 40}, true);    // table behind
+  add(100, 300, {150, 90, 40}, false);  // table where the reference shows table
+  std::vector<int> indices(points.size());
+  for (size_t i = 0; i < indices.size(); ++i) indices[i] = int(i);
+  points.push_back({0, 0, -1});  // behind the camera: not judged
+  colours.push_back({150, 90, 40});
+  indices.push_back(int(points.size()) - 1);
+  expected.push_back(false);
+
+  const std::vector<bool> hidden = densify::HiddenInReference(
+      points, colours, indices, camera, reference, densify::HiddenOptions{});
+  ASSERT_EQ(hidden.size(), expected.size());
+  for (size_t i = 0; i < expected.size(); ++i) EXPECT_EQ(hidden[i], expected[i]) << i;
+
+  // Without colours, or with one colour for all, nothing is judged.
+  const std::vector<bool> none = densify::HiddenInReference(points, {}, indices, camera, reference,
+                                                            densify::HiddenOptions{});
+  EXPECT_EQ(std::count(none.begin(), none.end(), true), 0);
+  const std::vector<std::array<uint8_t, 3>> grey(points.size(), {128, 128, 128});
+  const std::vector<bool> same = densify::HiddenInReference(points, grey, indices, camera,
+                                                            reference, densify::HiddenOptions{});
+  EXPECT_EQ(std::count(same.begin(), same.end(), true), 0);
 }
 
 TEST(Densify, TriangulationIsExactWithoutNoise) {
