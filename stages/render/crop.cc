@@ -185,16 +185,18 @@ SideFit FitSideLine(int side, bool real,
   return fit;
 }
 
+double SlantOf(const SideFit& side, int index) {
+  const Eigen::Vector2d d = side.direction;
+  // A horizontal direction turned by a is (cos a, sin a); a vertical one
+  // is (-sin a, cos a).
+  return (index == 0 || index == 2) ? std::atan2(d.y(), d.x()) : std::atan2(-d.x(), d.y());
+}
+
 double TiltOfSides(const std::array<SideFit, 4>& sides) {
   double sum = 0, weight = 0;
   for (int i = 0; i < 4; ++i) {
     if (!sides[i].used) continue;
-    const Eigen::Vector2d d = sides[i].direction;
-    // A horizontal direction turned by a is (cos a, sin a); a vertical one
-    // is (-sin a, cos a).
-    const double angle = (i == 0 || i == 2) ? std::atan2(d.y(), d.x())
-                                            : std::atan2(-d.x(), d.y());
-    sum += angle * sides[i].mapped;
+    sum += SlantOf(sides[i], i) * sides[i].mapped;
     weight += sides[i].mapped;
   }
   return weight > 0 ? sum / weight : 0;
@@ -207,7 +209,7 @@ void RotateSide(SideFit* side, double angle) {
 }
 
 CropRect ChooseCrop(std::array<SideFit, 4>* sides_in,
-                    const Eigen::Vector4d& visible_box) {
+                    const Eigen::Vector4d& visible_box, double middle_max_slant) {
   std::array<SideFit, 4>& sides = *sides_in;
   const double cx = 0.5 * (visible_box[0] + visible_box[2]);
   const double cy = 0.5 * (visible_box[1] + visible_box[3]);
@@ -228,19 +230,27 @@ CropRect ChooseCrop(std::array<SideFit, 4>* sides_in,
   }
   CropRect crop{visible_box[0], visible_box[1], visible_box[2], visible_box[3],
                 ""};
+  std::array<bool, 4> middle{};
+  for (int i = 0; i < 4; ++i)
+    middle[i] = sides[i].used && std::abs(SlantOf(sides[i], i)) <= middle_max_slant;
   // Each line bounds the rectangle where it is tightest over the extent the
   // other sides leave; the lines are within 45 degrees of their axes, so a
   // few alternations settle on the inscribed rectangle.
   for (int iter = 0; iter < 8; ++iter) {
     CropRect next = crop;
+    const double mx = 0.5 * (crop.x0 + crop.x1), my = 0.5 * (crop.y0 + crop.y1);
     if (sides[0].used)
-      next.y0 = std::max(YAt(sides[0], crop.x0), YAt(sides[0], crop.x1));
+      next.y0 = middle[0] ? YAt(sides[0], mx)
+                          : std::max(YAt(sides[0], crop.x0), YAt(sides[0], crop.x1));
     if (sides[2].used)
-      next.y1 = std::min(YAt(sides[2], crop.x0), YAt(sides[2], crop.x1));
+      next.y1 = middle[2] ? YAt(sides[2], mx)
+                          : std::min(YAt(sides[2], crop.x0), YAt(sides[2], crop.x1));
     if (sides[3].used)
-      next.x0 = std::max(XAt(sides[3], crop.y0), XAt(sides[3], crop.y1));
+      next.x0 = middle[3] ? XAt(sides[3], my)
+                          : std::max(XAt(sides[3], crop.y0), XAt(sides[3], crop.y1));
     if (sides[1].used)
-      next.x1 = std::min(XAt(sides[1], crop.y0), XAt(sides[1], crop.y1));
+      next.x1 = middle[1] ? XAt(sides[1], my)
+                          : std::min(XAt(sides[1], crop.y0), XAt(sides[1], crop.y1));
     crop = next;
   }
   const int used =

@@ -56,7 +56,15 @@ struct CropRect {
 // the wrong order (top below bottom, left right of right) are dropped
 // (their `used` cleared, `note` set); a degenerate result falls back to the
 // visible box.
+// A used side whose line is within `middle_max_slant` (radians) of its axis
+// bounds the rectangle where it crosses the middle of the other axis' extent
+// instead: a slightly slanted line then cuts off as much page at one end as
+// it leaves table at the other. (Negative: every side inscribed.)
 CropRect ChooseCrop(std::array<SideFit, 4>* sides,
-                    const Eigen::Vector4d& visible_box);
+                    const Eigen::Vector4d& visible_box, double middle_max_slant = -1);
+
+// Angle (radians) of a side's line from its axis: from +x for top and
+// bottom, from +y for left and right, positive clockwise in image axes.
+double SlantOf(const SideFit& side, int index);
 
 }  // namespace docunfold::render

@@ -66,6 +66,14 @@ int main(int argc, char** argv) {
                  "lines: the direction most of optimize's lines (lines.json beside the "
                  "meshes) follow, else the sides; sides: the real boundary sides")
       ->capture_default_str()->check(CLI::IsMember({"lines", "sides"}));
+  app.add_option("--crop", o.crop_rule,
+                 "middle: through the lines of the real sides where they cross the middle of "
+                 "the page (those within --crop-middle-max-deg of their axis; the others "
+                 "inscribed); inscribed: the rectangle inside all the lines")
+      ->capture_default_str()->check(CLI::IsMember({"inscribed", "middle"}));
+  app.add_option("--crop-middle-max-deg", o.crop_middle_max_deg,
+                 "--crop middle: sides slanted more than this in M' are inscribed")
+      ->capture_default_str()->check(CLI::Range(0.0, 45.0));
   app.add_option("--max-deskew-deg", o.max_deskew_deg, "largest tilt corrected")
       ->capture_default_str();
   app.add_option("--side-snap", o.side_snap,

@@ -468,7 +468,9 @@ Json OptionsToJson(const RenderOptions& o) {
           {"max_deskew_deg", o.max_deskew_deg},
           {"deskew_by", o.deskew_by},
           {"sample_hidden", o.sample_hidden},
-          {"side_snap", o.side_snap}};
+          {"side_snap", o.side_snap},
+          {"crop_rule", o.crop_rule},
+          {"crop_middle_max_deg", o.crop_middle_max_deg}};
 }
 
 Json Vec2(const Eigen::Vector2d& v) { return Json::array({v.x(), v.y()}); }
@@ -603,7 +605,9 @@ RenderResult Run(const RenderOptions& options, const RenderInputs& in) {
   if (!(visible[2] > visible[0] && visible[3] > visible[1]))
     throw InputError(m3.string() +
                      ": the mesh covers no pixel of the reference image");
-  CropRect crop = ChooseCrop(&r.sides, visible);
+  CropRect crop = ChooseCrop(&r.sides, visible,
+                             options.crop_rule == "middle" ? options.crop_middle_max_deg * M_PI / 180
+                                                           : -1.0);
   for (int i = 0; i < 4; ++i)
     if (r.sides[i].real && !r.sides[i].used)
       Log(std::string(kSideNames[i]) +

@@ -232,8 +232,11 @@ TEST(RenderScene, CutOffPageIsCroppedByItsRealSidesAndWhatTheViewSees) {
   const cv::Vec3b paper = r.fill;
   EXPECT_GT(paper[0], 200);
   for (int y = 0; y < r.rectified.rows; y += 7)
-    for (int x = 0; x < r.rectified.cols; x += 7)
-      if (!r.page_mask(y, x)) ASSERT_EQ(r.rectified.at<cv::Vec3b>(y, x), paper);
+    for (int x = 0; x < r.rectified.cols; x += 7) {
+      if (!r.page_mask(y, x)) {
+        ASSERT_EQ(r.rectified.at<cv::Vec3b>(y, x), paper);
+      }
+    }
   // The seen part is still the texture (mostly the bent half, seen at a
   // slant and so blurred in the photo).
   Keep("cutoff", r.rectified_grid);
@@ -295,11 +298,18 @@ TEST(RenderScene, TiltedFlatMeshIsTurnedUpright) {
   EXPECT_NEAR(r.crop_y1 - r.crop_y0, s.page_h, 2 / r.pixels_per_unit);
   render::RenderOptions keep;
   keep.deskew = false;
+  keep.crop_rule = "inscribed";
   const render::RenderResult tilted = render::Run(keep, InputsOf(s));
   EXPECT_EQ(tilted.rotation_deg, 0);
   // Inscribed in the tilted page: smaller on both axes.
   EXPECT_LT(tilted.crop_x1 - tilted.crop_x0, s.page_w * 0.97);
   EXPECT_LT(tilted.crop_y1 - tilted.crop_y0, s.page_h * 0.97);
+  // Through the middle of the tilted sides: the page's size.
+  keep.crop_rule = "middle";
+  keep.crop_middle_max_deg = 5;
+  const render::RenderResult middle = render::Run(keep, InputsOf(s));
+  EXPECT_NEAR(middle.crop_x1 - middle.crop_x0, s.page_w, 0.01 * s.page_w);
+  EXPECT_NEAR(middle.crop_y1 - middle.crop_y0, s.page_h, 0.01 * s.page_h);
 }
 
 TEST(RenderInputs, InconsistentInputsAreRejected) {
@@ -376,6 +386,38 @@ TEST(RenderCrop, SideLinesIgnoreOutliersAndWrongOrderIsDropped) {
   EXPECT_NEAR(crop.y1, 1.2, 1e-9);
   // Weighted by the samples each line keeps (100 and 101).
   EXPECT_NEAR(render::TiltOfSides(good), std::atan(0.001) * 100 / 201, 1e-9);
+}
+
+TEST(RenderCrop, SlightlySlantedSidesBoundTheCropThroughTheirMiddle) {
+  // The unit square's sides in M'; the right one slanted by `deg` about its
+  // middle (0.5, 0.5).
+  auto sides_with_right_slant = [](double deg) {
+    const double t = std::tan(deg * M_PI / 180);
+    std::vector<Eigen::Vector2d> top, bottom, left, right;
+    for (int i = 0; i <= 100; ++i) {
+      const double u = i * 0.01;
+      top.emplace_back(u, 0);
+      bottom.emplace_back(u, 1);
+      left.emplace_back(0, u);
+      right.emplace_back(1 + (u - 0.5) * t, u);
+    }
+    std::array<render::SideFit, 4> sides;
+    sides[0] = render::FitSideLine(0, true, top, 101);
+    sides[1] = render::FitSideLine(1, true, right, 101);
+    sides[2] = render::FitSideLine(2, true, bottom, 101);
+    sides[3] = render::FitSideLine(3, true, left, 101);
+    return sides;
+  };
+  const Eigen::Vector4d box(-0.2, -0.2, 1.2, 1.2);
+  const double limit = 3 * M_PI / 180;
+  auto slight = sides_with_right_slant(2);
+  EXPECT_NEAR(render::SlantOf(slight[1], 1), -2 * M_PI / 180, 1e-9);
+  EXPECT_NEAR(render::ChooseCrop(&slight, box, limit).x1, 1.0, 1e-9);  // through the middle
+  slight = sides_with_right_slant(2);
+  const double inscribed = 1 - 0.5 * std::tan(2 * M_PI / 180);
+  EXPECT_NEAR(render::ChooseCrop(&slight, box).x1, inscribed, 1e-9);  // the default: inscribed
+  auto steep = sides_with_right_slant(5);  // beyond the limit: inscribed
+  EXPECT_NEAR(render::ChooseCrop(&steep, box, limit).x1, 1 - 0.5 * std::tan(5 * M_PI / 180), 1e-9);
 }
 
 }  // namespace
