@@ -752,9 +752,16 @@ DensifyResult Run(const DensifyInputs& in, const DensifyOptions& o) {
         r.hidden.push_back(in.points.vertices[in_region[k]]);
       }
   }
-  std::vector<Eigen::Vector3d> page_points;
-  for (const int i : in_region)
+  // The texture's prewarp (a homography, RANSAC) takes every point of the
+  // region, hidden ones included: they are its outliers anyway, and a
+  // different sample of points moved which texture points a curl kept
+  // (set06: 0.88 -> 0.54 MS-SSIM). Fitted points and the outline's depths
+  // take only the points the reference view sees.
+  std::vector<Eigen::Vector3d> region_points, page_points;
+  for (const int i : in_region) {
+    region_points.push_back(in.points.vertices[i]);
     if (keep[i]) page_points.push_back(in.points.vertices[i]);
+  }
 
   // Output cloud: sfm's points first (those kept, in order, with their
   // properties), then ours.
@@ -807,7 +814,7 @@ DensifyResult Run(const DensifyInputs& in, const DensifyOptions& o) {
 
   t = Clock::now();
   if (o.texture.enabled && !others.empty())
-    AddTexturePoints(ref, others, region, page_points, in.reference, o.texture, &r);
+    AddTexturePoints(ref, others, region, region_points, in.reference, o.texture, &r);
   r.seconds_texture = SecondsSince(t);
   Log(std::to_string(r.texture_points) + " texture points from " +
       std::to_string(r.texture_samples) + " textured samples, " +

@@ -67,9 +67,9 @@ int main(int argc, char** argv) {
                  "meshes) follow, else the sides; sides: the real boundary sides")
       ->capture_default_str()->check(CLI::IsMember({"lines", "sides"}));
   app.add_option("--crop", o.crop_rule,
-                 "middle: through the lines of the real sides where they cross the middle of "
-                 "the page (those within --crop-middle-max-deg of their axis; the others "
-                 "inscribed); inscribed: the rectangle inside all the lines")
+                 "inscribed: the rectangle inside the lines of the real sides; middle: "
+                 "through those within --crop-middle-max-deg of their axis where they cross "
+                 "the middle of the page (the others inscribed)")
       ->capture_default_str()->check(CLI::IsMember({"inscribed", "middle"}));
   app.add_option("--crop-middle-max-deg", o.crop_middle_max_deg,
                  "--crop middle: sides slanted more than this in M' are inscribed")

@@ -64,15 +64,15 @@ struct RenderOptions {
   bool deskew = true;
   double max_deskew_deg = 20;
   std::string deskew_by = "lines";
-  // The crop: through the "middle" of the lines of the real sides within
-  // crop_middle_max_deg of their axis, the others (and all with "inscribed")
-  // inscribed (see ChooseCrop). Inscribing a slanted line moves the crop
-  // into the page by half its run; through the middle, the page cut off at
-  // one end and the table left at the other even out. 12 benchmark sets,
-  // middle against inscribed: mean +0.013 MS-SSIM, LD -0.2 (r02 +0.095,
-  // set04 +0.078; six sets -0.001 ... -0.014); beyond 3 degrees (r03's
-  // bottom at 6.2, set07's top at 4.4) inscribed did better.
-  std::string crop_rule = "middle";
+  // The crop: inscribed in the lines of the real sides, or ("middle")
+  // through the middle of those within crop_middle_max_deg of their axis
+  // (see ChooseCrop). Inscribing a slanted line moves the crop into the page
+  // by half its run; through the middle, page cut off at one end and table
+  // left at the other even out. Measured, middle against inscribed on the 12
+  // benchmark sets: mean +0.013 MS-SSIM on one sfm run, -0.003 on another,
+  // with swings of +-0.2 on single sets (a table page's rows misalign when
+  // the crop's height is 1 % off): no better on average, so not the default.
+  std::string crop_rule = "inscribed";
   double crop_middle_max_deg = 3;
   int deskew_min_lines = 8;
   // Sample the reference image even where the page is hidden from the
