@@ -286,13 +286,13 @@ TEST_P(EndToEnd, MeshesAreCloseToTheTruthAndReadable) {
   std::printf("%s: M to the true surface %.3f %% (init) %.3f %% (final) of the diagonal; "
               "isometry error %.4f / %.4f\n",
               set_.c_str(), init_surface, final_surface, init_iso, final_iso);
-  // Targets (issue 5): 1 % and 0.005. Measured on the e2e run: surface
-  // 0.15-0.9 % on most sets but 2-5.6 % where the boundary corners are off
-  // (set02, set04, set07); asserted here are the bounds every set meets, and
-  // that optimize does not move M away from the truth (beyond run-to-run
-  // noise: set02, whose reference view hides part of the page, went from
-  // 3.93 % to 4.06 % in one run).
-  EXPECT_LE(final_surface, 8.0) << set_;
+  // Targets (issue 5): 1 % and 0.005. Measured in the benchmark of
+  // 2026-11-24 (densify leaving out the table points hidden behind the page):
+  // surface 0.05-0.45 % on ten sets, 0.8-1.6 % on set07 and set08 over
+  // several sfm runs (set02 was 2.1 % before, its raised flap bent by those
+  // points); asserted here are the bounds every set meets, and that optimize
+  // does not move M away from the truth (beyond run-to-run noise).
+  EXPECT_LE(final_surface, 3.0) << set_;
   EXPECT_LE(final_surface, 1.05 * init_surface + 0.1) << set_;
   EXPECT_LT(final_iso, 0.03) << set_;
   // Every PLY of the run opens in an independent reader.
