@@ -234,8 +234,9 @@ CropRect ChooseCrop(std::array<SideFit, 4>* sides_in,
   for (int i = 0; i < 4; ++i)
     middle[i] = sides[i].used && std::abs(SlantOf(sides[i], i)) <= middle_max_slant;
   // Each line bounds the rectangle where it is tightest over the extent the
-  // other sides leave; the lines are within 45 degrees of their axes, so a
-  // few alternations settle on the inscribed rectangle.
+  // other sides leave (or, for a `middle` side, where it crosses the middle
+  // of that extent); the lines are within 45 degrees of their axes, so a few
+  // alternations settle on the rectangle.
   for (int iter = 0; iter < 8; ++iter) {
     CropRect next = crop;
     const double mx = 0.5 * (crop.x0 + crop.x1), my = 0.5 * (crop.y0 + crop.y1);
