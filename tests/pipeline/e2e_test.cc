@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <fstream>
+#include <limits>
 #include <map>
 
 #include <Eigen/Geometry>
@@ -275,6 +276,34 @@ TEST_P(EndToEnd, FeatureSegmentsLieOnTrueLines) {
   if ((kind == "text" || kind == "table") && !cut_off) {
     EXPECT_GE(recall, 0.5) << set_;
   }
+}
+
+// densify leaves out sfm points that the reference view shows in another
+// colour: table seen behind a raised part of the page by the other photos.
+// Before that rule, 26 % of set02's sfm points in the page region were more
+// than 3 % of the diagonal off the true surface (its raised flap) and 11 % of
+// set04's; after it, at most 3.7 % on every set over two sfm runs.
+TEST_P(EndToEnd, SfmPointsKeptOnThePageLieOnTheTrueSurface) {
+  const PlyData points = ReadPly(work_ / "25_points/points.ply");
+  const PlyProperty* source = points.FindProperty("source");
+  ASSERT_NE(source, nullptr);
+  const cv::Mat1b region = ContourRegion(ReadBoundary(work_ / "20_boundary/boundary.json"), 0);
+  const std::vector<int> inside =
+      PointsInRegion(points.vertices, *sfm_.Find(sfm_.reference), region);
+  int sfm = 0, off = 0;
+  for (const int i : inside) {
+    if (source->values[i] != 0) continue;
+    const Eigen::Vector3d x = sim_.ToTrue(points.vertices[i]);
+    double nearest = std::numeric_limits<double>::infinity();
+    for (const Eigen::Vector3d& v : gt_.mesh.vertices)
+      nearest = std::min(nearest, (v - x).squaredNorm());
+    ++sfm;
+    off += std::sqrt(nearest) > 0.03 * gt_.Diagonal();
+  }
+  std::printf("%s: %d of %d sfm points on the page more than 3 %% of the diagonal off the true "
+              "surface\n", set_.c_str(), off, sfm);
+  ASSERT_GT(sfm, 0) << set_;
+  EXPECT_LE(off, 0.08 * sfm) << set_;
 }
 
 TEST_P(EndToEnd, MeshesAreCloseToTheTruthAndReadable) {
