@@ -111,6 +111,15 @@ Eigen::Vector3d JsonReader::Vector3(const std::string& pointer) const {
   return x;
 }
 
+Eigen::Vector2d JsonReader::Vector2(const std::string& pointer) const {
+  const Json& p = At(pointer);
+  if (!p.is_array() || p.size() != 2 || !p[0].is_number() || !p[1].is_number())
+    Fail(pointer, "expected [x, y]");
+  const Eigen::Vector2d v(p[0].get<double>(), p[1].get<double>());
+  if (!v.allFinite()) Fail(pointer, "not finite");
+  return v;
+}
+
 Json ToJson(const Eigen::Matrix3d& m) {
   Json a = Json::array();
   for (int i = 0; i < 3; ++i) a.push_back({m(i, 0), m(i, 1), m(i, 2)});

@@ -40,6 +40,8 @@ class JsonReader {
   std::string String(const std::string& pointer) const;
   Eigen::Matrix3d Matrix3(const std::string& pointer) const;
   Eigen::Vector3d Vector3(const std::string& pointer) const;
+  // [x, y], both finite numbers.
+  Eigen::Vector2d Vector2(const std::string& pointer) const;
   // Throws InputError for `pointer` with the given problem.
   [[noreturn]] void Fail(const std::string& pointer,
                          const std::string& problem) const;

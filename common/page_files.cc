@@ -12,15 +12,6 @@
 namespace docunfold {
 namespace {
 
-Eigen::Vector2d Point(const JsonReader& r, const std::string& pointer) {
-  const Json& p = r.At(pointer);
-  if (!p.is_array() || p.size() != 2 || !p[0].is_number() || !p[1].is_number())
-    r.Fail(pointer, "expected [x, y]");
-  const Eigen::Vector2d v(p[0].get<double>(), p[1].get<double>());
-  if (!v.allFinite()) r.Fail(pointer, "not finite");
-  return v;
-}
-
 std::vector<Eigen::Vector2d> Polyline(const JsonReader& r, const std::string& pointer,
                                       size_t min_points) {
   const Json& points = r.At(pointer);
@@ -28,7 +19,7 @@ std::vector<Eigen::Vector2d> Polyline(const JsonReader& r, const std::string& po
     r.Fail(pointer, "expected at least " + std::to_string(min_points) + " points");
   std::vector<Eigen::Vector2d> out;
   for (size_t k = 0; k < points.size(); ++k)
-    out.push_back(Point(r, pointer + "/" + std::to_string(k)));
+    out.push_back(r.Vector2(pointer + "/" + std::to_string(k)));
   return out;
 }
 
@@ -52,7 +43,7 @@ Boundary ReadBoundary(const fs::path& file) {
   b.contour = Polyline(r, "/contour", 3);
   const Json& corners = r.At("/corners");
   if (!corners.is_array() || corners.size() != 4) r.Fail("/corners", "expected 4 points");
-  for (int i = 0; i < 4; ++i) b.corners[i] = Point(r, "/corners/" + std::to_string(i));
+  for (int i = 0; i < 4; ++i) b.corners[i] = r.Vector2("/corners/" + std::to_string(i));
   for (int i = 0; i < 4; ++i) {
     const std::string p = std::string("/sides/") + kSideNames[i];
     const Json& real = r.At(p + "/real");
@@ -74,7 +65,7 @@ FeatureFile ReadFeatures(const fs::path& file) {
   if (r.Has("/width")) f.width = r.Integer("/width");
   if (r.Has("/height")) f.height = r.Integer("/height");
   if (r.Has("/text_down")) {
-    const Eigen::Vector2d d = Point(r, "/text_down");
+    const Eigen::Vector2d d = r.Vector2("/text_down");
     if (!(d.norm() > 0.5 && d.norm() < 2)) r.Fail("/text_down", "expected a unit vector");
     f.text_down = d.normalized();
   }

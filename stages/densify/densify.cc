@@ -634,16 +634,18 @@ std::vector<bool> HiddenInReference(const std::vector<Eigen::Vector3d>& points,
   }
   cv::Mat lab;
   cv::cvtColor(reference, lab, cv::COLOR_BGR2Lab);
+  // The points' colours at the reference's exposure, in Lab (one conversion).
+  cv::Mat3b point_lab(int(indices.size()), 1);
+  for (size_t k = 0; k < indices.size(); ++k) {
+    const std::array<uint8_t, 3>& rgb = colours[indices[k]];
+    for (int c = 0; c < 3; ++c)
+      point_lab(int(k), 0)[2 - c] = cv::saturate_cast<uint8_t>(rgb[c] * gain[c]);
+  }
+  cv::cvtColor(point_lab, point_lab, cv::COLOR_BGR2Lab);
   const int w = std::max(0, o.window_px);
   for (size_t k = 0; k < indices.size(); ++k) {
     if (pixel[k].x < 0) continue;
-    const std::array<uint8_t, 3>& rgb = colours[indices[k]];
-    cv::Mat3b point_bgr(1, 1);
-    for (int c = 0; c < 3; ++c)
-      point_bgr(0, 0)[2 - c] = cv::saturate_cast<uint8_t>(rgb[c] * gain[c]);
-    cv::Mat3b point_lab;
-    cv::cvtColor(point_bgr, point_lab, cv::COLOR_BGR2Lab);
-    const cv::Vec3d a = point_lab(0, 0);
+    const cv::Vec3d a = point_lab(int(k), 0);
     double nearest = std::numeric_limits<double>::infinity();
     for (int v = std::max(0, pixel[k].y - w); v <= std::min(lab.rows - 1, pixel[k].y + w); ++v)
       for (int u = std::max(0, pixel[k].x - w); u <= std::min(lab.cols - 1, pixel[k].x + w); ++u)

@@ -5,6 +5,7 @@
 
 #include "common/atomic_file.h"
 #include "common/errors.h"
+#include "common/json_io.h"
 #include "stages/render/render.h"
 
 namespace docunfold::render {
@@ -33,31 +34,20 @@ RenderInputs ReadRenderInputs(const fs::path& sfm_dir,
   // optimize's lines, for the deskew: each line's direction (its normal
   // turned, the same modulo 90 degrees) and its extent in M'.
   const fs::path lines_file = meshes_dir / "lines.json";
-  auto is_xy = [](const Json& v) {
-    return v.is_array() && v.size() == 2 && v[0].is_number() && v[1].is_number();
-  };
   if (fs::is_regular_file(lines_file, ec)) {
     const Json doc = ReadJsonFile(lines_file);
-    if (!doc.contains("lines") || !doc["lines"].is_array())
-      throw InputError(lines_file.string() + ":/lines: missing or not an array");
-    if (doc.contains("text_down_flat")) {
-      const Json& d = doc["text_down_flat"];
-      if (!is_xy(d))
-        throw InputError(lines_file.string() + ":/text_down_flat: expected [x, y]");
-      in.text_down = Eigen::Vector2d(d[0].get<double>(), d[1].get<double>());
-    }
+    const JsonReader r(doc, lines_file);
+    if (!r.At("/lines").is_array()) r.Fail("/lines", "expected an array");
+    if (r.Has("/text_down_flat")) in.text_down = r.Vector2("/text_down_flat");
     for (size_t i = 0; i < doc["lines"].size(); ++i) {
-      const Json& l = doc["lines"][i];
-      const std::string where = lines_file.string() + ":/lines/" + std::to_string(i);
-      if (!l.is_object() || !l.contains("normal") || !is_xy(l["normal"]) || !l.contains("flat") ||
-          !l["flat"].is_array())
-        throw InputError(where + ": needs normal [x, y] and flat [[x, y], ...]");
-      const Eigen::Vector2d n(l["normal"][0].get<double>(), l["normal"][1].get<double>());
+      const std::string where = "/lines/" + std::to_string(i);
+      const Eigen::Vector2d n = r.Vector2(where + "/normal");
       const Eigen::Vector2d along(-n.y(), n.x());
+      const Json& flat = r.At(where + "/flat");
+      if (!flat.is_array()) r.Fail(where + "/flat", "expected [[x, y], ...]");
       double lo = 1e300, hi = -1e300;
-      for (const Json& p : l["flat"]) {
-        if (!is_xy(p)) throw InputError(where + "/flat: points are [x, y]");
-        const double t = along.dot(Eigen::Vector2d(p[0].get<double>(), p[1].get<double>()));
+      for (size_t k = 0; k < flat.size(); ++k) {
+        const double t = along.dot(r.Vector2(where + "/flat/" + std::to_string(k)));
         lo = std::min(lo, t);
         hi = std::max(hi, t);
       }
