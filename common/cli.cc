@@ -114,4 +114,11 @@ void AddFairnessBoostOptions(CLI::App& app, double* unsupported_fairness,
       ->capture_default_str()->check(CLI::Range(0.0, 1.0));
 }
 
+void AddIsoEdgesOption(CLI::App& app, double* iso_edges) {
+  app.add_option("--iso-edges", *iso_edges,
+                 "weight of E_iso's edge-length rows next to the paper's diagonal rows "
+                 "(0 = diagonals only, as in the paper)")
+      ->capture_default_str()->check(CLI::Range(0.0, 100.0));
+}
+
 }  // namespace docunfold

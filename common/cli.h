@@ -36,6 +36,10 @@ void LimitOpenMpThreads(char** argv);
 void AddFairnessBoostOptions(CLI::App& app, double* unsupported_fairness,
                              double* support_radius);
 
+// --iso-edges, the same in every stage that runs the isometric solver
+// (isometry::SolveOptions::iso_edges documents it).
+void AddIsoEdgesOption(CLI::App& app, double* iso_edges);
+
 // One plain line on stderr: "<program>: <message>".
 void Log(const std::string& message);
 

@@ -29,7 +29,8 @@
 //    three subdivisions. An edge-length error of 0.5 % costs ~1e-4:
 //    isometry is much stiffer than the data term (paper does not stretch).
 //    kRaw is the paper's literal sum of squared c_iso (4th order in lengths;
-//    it weakens 4x per subdivision);
+//    it weakens 4x per subdivision). With iso_edges > 0 each quad adds
+//    |a|² - |a'|² of its four edges (same scale, times iso_edges / √2);
 //  - E_fair = Σ |v_i − 2 v_j + v_k|² along every grid row and column (raw,
 //    as in the paper; in model-size units, it weakens 4x per subdivision, as
 //    the paper intends for the tiny λ3 that must not smooth creases away);
@@ -123,6 +124,10 @@ struct SolveOptions {
   // iteration (progressive filtering). <= 0 keeps every point.
   double outlier_distance = 0.06;
   IsoNormalization iso_normalization = IsoNormalization::kStrain;
+  // Weight of E_iso's edge-length rows against the paper's three diagonal
+  // rows per quad (0 = the paper). The diagonals alone leave a quad of M free
+  // to twist out of its plane, which lengthens its edges.
+  double iso_edges = 0;
   // λ3 is multiplied by up to this where M has no inlier point within
   // support_radius (fraction of the model size, along M), reaching it at
   // twice that distance: blank paper then continues its panel's plane

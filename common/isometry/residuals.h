@@ -40,6 +40,7 @@ struct StepData {
   std::vector<Footpoint> footpoints;  // one per point
   std::vector<Marker> markers;        // rays in the normalised frame
   double iso_scale = 1;               // multiplies every c_iso (see IsoNormalization)
+  double iso_edge_weight = 0;         // edge rows' share of E_iso (SolveOptions::iso_edges)
   double beta_point = 1;
   double beta_normal = 0.1;
   int num_inliers = 0;
@@ -75,12 +76,17 @@ inline Triangle TriangleOf(const QuadGrid& grid, int t) {
   return t % 2 == 0 ? Triangle{c[0], c[1], c[2]} : Triangle{c[0], c[2], c[3]};
 }
 
-// --- E_iso: three rows per quad.
-inline int IsoRows(const State& s, double iso_scale, int q, Row* rows) {
+// Most rows one quad, point, triplet or marker contributes to any term.
+constexpr int kMaxRowsPerItem = 8;
+
+// --- E_iso: three rows per quad (the paper's c_iso), and with
+// iso_edge_weight > 0 four more, |a|² - |a'|² of each edge scaled by
+// iso_edge_weight / √2 (an inner edge is in two quads).
+inline int IsoRows(const State& s, const StepData& data, int q, Row* rows) {
   const auto c = s.grid.Quad(q);
   const Eigen::Vector3d d1 = s.v3[c[0]] - s.v3[c[2]], d2 = s.v3[c[1]] - s.v3[c[3]];
   const Eigen::Vector2d e1 = s.v2[c[0]] - s.v2[c[2]], e2 = s.v2[c[1]] - s.v2[c[3]];
-  const double k = iso_scale;
+  const double k = data.iso_scale;
   // c1 = |d1|² - |e1|²
   Row& r1 = rows[0];
   r1.Reset();
@@ -119,7 +125,22 @@ inline int IsoRows(const State& s, double iso_scale, int q, Row* rows) {
     Vec5& v3 = r3.Add(c[3]);
     v3 = -r3.d[1];
   }
-  return 3;
+  if (!(data.iso_edge_weight > 0)) return 3;
+  const double ke = k * data.iso_edge_weight * M_SQRT1_2;
+  for (int i = 0; i < 4; ++i) {
+    const int a = c[i], b = c[(i + 1) % 4];
+    const Eigen::Vector3d d = s.v3[a] - s.v3[b];
+    const Eigen::Vector2d e = s.v2[a] - s.v2[b];
+    Row& r = rows[3 + i];
+    r.Reset();
+    r.value = ke * (d.squaredNorm() - e.squaredNorm());
+    Vec5& da = r.Add(a);
+    da.head<3>() = 2 * ke * d;
+    da.tail<2>() = -2 * ke * e;
+    Vec5& db = r.Add(b);
+    db = -r.d[0];
+  }
+  return 7;
 }
 
 // --- E_dist: four rows per inlier (three point-to-point, one along N).
@@ -228,9 +249,9 @@ inline int RayRows(const State& s, const StepData& data, int m, Row* rows) {
 // Calls sink(term, row) for every row of every term (λ not applied).
 template <class Sink>
 void ForEachRow(const State& s, const StepData& data, Sink&& sink) {
-  Row rows[4];
+  Row rows[kMaxRowsPerItem];
   for (int q = 0; q < s.grid.NumQuads(); ++q) {
-    const int n = IsoRows(s, data.iso_scale, q, rows);
+    const int n = IsoRows(s, data, q, rows);
     for (int i = 0; i < n; ++i) sink(kIso, rows[i]);
   }
   for (int p = 0; p < int(data.points.size()); ++p) {

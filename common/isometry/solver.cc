@@ -57,9 +57,9 @@ TermValues EvaluateTerms(const State& s, const StepData& data, int threads) {
   const bool parallel = threads > 1 && quads > 2000;
 #pragma omp parallel num_threads(threads) if (parallel)
   {
-    Row rows[4];
+    Row rows[kMaxRowsPerItem];
 #pragma omp for schedule(static) reduction(+ : iso) nowait
-    for (int q = 0; q < quads; ++q) AddSquares(rows, IsoRows(s, data.iso_scale, q, rows), &iso);
+    for (int q = 0; q < quads; ++q) AddSquares(rows, IsoRows(s, data, q, rows), &iso);
 #pragma omp for schedule(static) reduction(+ : dist) nowait
     for (int p = 0; p < points; ++p) AddSquares(rows, DistRows(s, data, p, rows), &dist);
 #pragma omp for schedule(static) reduction(+ : fair3d, fair2d) nowait
@@ -193,6 +193,7 @@ Work Normalise(const Problem& p, const SolveOptions& o) {
   } else {
     w.data.iso_scale = 1;
   }
+  w.data.iso_edge_weight = o.iso_edges;
   w.weights = o.weights;
   return w;
 }
@@ -449,10 +450,10 @@ class GaussNewton {
         const int r0 = colour / 2, c0 = colour % 2;
 #pragma omp parallel for num_threads(threads_) schedule(static) reduction(+ : f) if (parallel)
         for (int r = r0; r < grid.ny - 1; r += 2) {
-          Row rows[3];
+          Row rows[internal::kMaxRowsPerItem];
           for (int c = c0; c < grid.nx - 1; c += 2) {
             const int q = r * (grid.nx - 1) + c;
-            const int m = internal::IsoRows(s, data.iso_scale, q, rows);
+            const int m = internal::IsoRows(s, data, q, rows);
             for (int i = 0; i < m; ++i) f += add(w.iso, rows[i]);
           }
         }

@@ -761,6 +761,7 @@ Json OptionsToJson(const Options& o) {
         {"support_radius", r.support_radius},
         {"iso_normalization",
          r.iso_normalization == isometry::IsoNormalization::kStrain ? "strain" : "raw"},
+        {"iso_edges", r.iso_edges},
         {"method", r.method == isometry::Method::kGaussNewton ? "gn" : "lbfgs"},
         {"max_outer_iterations", r.max_outer_iterations},
         {"relative_tolerance", r.relative_tolerance},

@@ -82,6 +82,7 @@ int main(int argc, char** argv) {
                  "strain: E_iso as mean squared strain (resolution independent); raw: the "
                  "paper's sum of squared c_iso")
       ->capture_default_str()->check(CLI::IsMember({"strain", "raw"}));
+  AddIsoEdgesOption(app, &o.refine.iso_edges);
   app.add_option("--method", method, "gn: Gauss-Newton/Levenberg-Marquardt; lbfgs: L-BFGS")
       ->capture_default_str()->check(CLI::IsMember({"gn", "lbfgs"}));
   app.add_option("--max-iterations", o.refine.max_outer_iterations,

@@ -53,6 +53,7 @@ int main(int argc, char** argv) {
                  "reference pixels")
       ->capture_default_str();
   AddFairnessBoostOptions(app, &o.unsupported_fairness, &o.support_radius);
+  AddIsoEdgesOption(app, &o.iso_edges);
   app.add_option("--solver", solver, "gn (Gauss-Newton/LM, sparse Cholesky) or lbfgs")
       ->capture_default_str();
   app.add_option("--linear-solver", linear,
@@ -125,6 +126,7 @@ int main(int argc, char** argv) {
                                {"region_margin_px", o.region_margin_px},
                                {"unsupported_fairness", o.unsupported_fairness},
                                {"support_radius", o.support_radius},
+                               {"iso_edges", o.iso_edges},
                                {"features", o.features},
                                {"boundary_only", o.boundary_only},
                                {"projection", o.project},

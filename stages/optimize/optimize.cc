@@ -117,6 +117,7 @@ OptimizeResult Run(const OptimizeInputs& in, const OptimizeOptions& o) {
     so.outlier_distance = o.outlier_distance;
     so.unsupported_fairness = o.unsupported_fairness;
     so.support_radius = o.support_radius;
+    so.iso_edges = o.iso_edges;
     so.relative_tolerance = o.relative_tolerance;
     so.max_outer_iterations = o.max_outer_iterations;
     so.method = o.method;

@@ -35,6 +35,7 @@ struct OptimizeOptions {
   // measured").
   double unsupported_fairness = 1;
   double support_radius = 0.03;       // fraction of the model size
+  double iso_edges = 0;               // isometry::SolveOptions::iso_edges
   isometry::Method method = isometry::Method::kGaussNewton;
   isometry::LinearSolver linear_solver = isometry::LinearSolver::kAuto;
   bool features = true;        // false: no feature lines at all (--no-features)

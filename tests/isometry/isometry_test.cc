@@ -93,6 +93,27 @@ std::vector<Row> RowsOf(const State& s, const StepData& d, int term) {
   return rows;
 }
 
+// The paper's c_iso compares a quad's diagonals only: a quad of M whose two
+// diagonals keep their vectors but are pushed apart out of the plane (a
+// twist) costs nothing, though each edge is longer. The edge rows see it.
+TEST(Isometry, EdgeRowsSeeATwistTheDiagonalsMiss) {
+  using isometry::internal::State;
+  using isometry::internal::StepData;
+  State s;
+  s.grid = {2, 2};
+  const double twist = 0.3;
+  for (int r = 0; r < 2; ++r)
+    for (int c = 0; c < 2; ++c) {
+      s.v2.emplace_back(c, r);
+      s.v3.emplace_back(c, r, (r + c) % 2 ? twist : 0.0);
+    }
+  StepData d;
+  EXPECT_NEAR(isometry::internal::EvaluateTerms(s, d).iso, 0, 1e-24);
+  d.iso_edge_weight = 1;
+  // Four edges of squared length 1 + twist² against 1, each row / √2.
+  EXPECT_NEAR(isometry::internal::EvaluateTerms(s, d).iso, 4 * 0.5 * std::pow(twist, 4), 1e-12);
+}
+
 TEST(Isometry, AnalyticJacobianMatchesFiniteDifferencesForEveryTerm) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> uni(-1, 1);
@@ -106,6 +127,7 @@ TEST(Isometry, AnalyticJacobianMatchesFiniteDifferencesForEveryTerm) {
   s.lines = {{0.3, 0.2}, {1.7, -0.1}};
   StepData d;
   d.iso_scale = 3.0;
+  d.iso_edge_weight = 0.7;
   d.beta_point = 1;
   d.beta_normal = 0.1;
   for (int i = 0; i < 6; ++i) {
