@@ -87,6 +87,11 @@ struct Marker {
   Eigen::Vector3d ray_origin = Eigen::Vector3d::Zero();     // world frame
   Eigen::Vector3d ray_direction = Eigen::Vector3d::UnitZ(); // unit, world frame
   int line = -1;  // index into Problem::lines; -1: only E_ray applies
+  // Non-zero (unit, orthogonal to the ray): E_ray keeps only the component
+  // of p - ray_origin along it, so the point is held to the plane through
+  // the ray normal to `across` and may slide within it (an outline: the
+  // plane through the camera centre and a tangent line of the silhouette).
+  Eigen::Vector3d across = Eigen::Vector3d::Zero();
 };
 
 struct Problem {

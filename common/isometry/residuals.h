@@ -228,22 +228,29 @@ inline void OrthogonalFrame(const Eigen::Vector3d& d, Eigen::Vector3d* e1, Eigen
   *e2 = d.cross(*e1).normalized();
 }
 
-// --- E_ray: two rows per marker (components of p - o orthogonal to the ray).
+// --- E_ray: two rows per marker (components of p - o orthogonal to the ray),
+// one (along Marker::across) for a marker held to a plane only.
 inline int RayRows(const State& s, const StepData& data, int m, Row* rows) {
   const Marker& mk = data.markers[m];
   const Triangle t = TriangleOf(s.grid, mk.where.triangle);
   const Eigen::Vector3d& w = mk.where.bary;
   const Eigen::Vector3d p = w[0] * s.v3[t[0]] + w[1] * s.v3[t[1]] + w[2] * s.v3[t[2]];
   Eigen::Vector3d e[2];
-  OrthogonalFrame(mk.ray_direction, &e[0], &e[1]);
+  const bool plane = mk.across.squaredNorm() > 0;
+  if (plane) {
+    e[0] = mk.across;
+  } else {
+    OrthogonalFrame(mk.ray_direction, &e[0], &e[1]);
+  }
   const double k = 1 / std::sqrt(double(data.markers.size()));
-  for (int j = 0; j < 2; ++j) {
+  const int n = plane ? 1 : 2;
+  for (int j = 0; j < n; ++j) {
     Row& r = rows[j];
     r.Reset();
     r.value = k * e[j].dot(p - mk.ray_origin);
     for (int i = 0; i < 3; ++i) r.Add(t[i]).head<3>() = k * w[i] * e[j];
   }
-  return 2;
+  return n;
 }
 
 // Calls sink(term, row) for every row of every term (λ not applied).

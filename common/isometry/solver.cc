@@ -137,7 +137,8 @@ void Validate(const Problem& p) {
     if (m.line >= int(p.lines.size()))
       throw std::invalid_argument("isometry: marker on line " + std::to_string(m.line) +
                                   " of " + std::to_string(p.lines.size()));
-    if (!m.ray_origin.allFinite() || !(m.ray_direction.norm() > 0) || !m.where.bary.allFinite())
+    if (!m.ray_origin.allFinite() || !(m.ray_direction.norm() > 0) || !m.where.bary.allFinite() ||
+        !m.across.allFinite())
       throw std::invalid_argument("isometry: marker with a bad ray or barycentrics");
   }
 }

@@ -93,6 +93,15 @@ struct Options {
     return o;
   }();
   bool upright = true;
+  // λ6 of E_ray on markers holding M's border vertices to the page outline
+  // in the reference image (they may slide along it); 0 = off.
+  double outline_hold = 0;
+  // Border vertices where M's normal is more than this off the viewing ray
+  // are not held (there the outline is likely a silhouette).
+  double outline_hold_max_angle_deg = 70;
+  // ... and those farther than this (fraction of the model size) from every
+  // point of the region.
+  double outline_hold_support = 0.1;
 };
 
 // boundary.json as init-mesh uses it (pixels of the reference image).

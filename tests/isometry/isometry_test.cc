@@ -147,6 +147,8 @@ TEST(Isometry, AnalyticJacobianMatchesFiniteDifferencesForEveryTerm) {
     m.ray_origin = Eigen::Vector3d(uni(rng), uni(rng), 0);
     m.ray_direction = Eigen::Vector3d(uni(rng), uni(rng), 1).normalized();
     m.line = i < 2 ? 0 : (i < 4 ? 1 : -1);
+    // The last is held to a plane through its ray only (one row).
+    if (i == 4) m.across = m.ray_direction.cross(Eigen::Vector3d(1, 0, 0)).normalized();
     d.markers.push_back(m);
   }
   const double h = 1e-6;
