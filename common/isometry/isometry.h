@@ -162,6 +162,9 @@ struct SolveOptions {
   // after max_outer_iterations (Q).
   int max_outer_iterations = 100;
   double relative_tolerance = 0.01;
+  // Also stop once F has risen from one outer iteration to the next this
+  // many times (it oscillates); 0 = never.
+  int max_rises = 0;
 
   // Lines are unknowns of F. They are solved for in closed form (total least
   // squares of their markers' p' = the exact minimiser of E_line for the

@@ -754,6 +754,7 @@ Result Solve(const Problem& problem, const SolveOptions& o) {
   report.num_points = int(problem.points.size());
 
   double f_previous = 0;
+  int rises = 0;
   for (int it = 0;; ++it) {
     IterationReport ir;
     ir.iteration = it;
@@ -799,9 +800,13 @@ Result Solve(const Problem& problem, const SolveOptions& o) {
 
     const bool converged =
         it > 0 && std::abs(ir.F - f_previous) <= o.relative_tolerance * std::abs(f_previous);
-    if (converged || it >= o.max_outer_iterations) {
-      report.converged = converged;
-      report.stop_reason = converged ? "converged" : "max_iterations";
+    // F measured after re-deciding footpoints and markers can oscillate
+    // without settling; then |ΔF/F| falls below ε only by chance.
+    if (it > 0 && ir.F > f_previous) ++rises;
+    const bool oscillating = o.max_rises > 0 && rises >= o.max_rises;
+    if (converged || oscillating || it >= o.max_outer_iterations) {
+      report.converged = converged || oscillating;
+      report.stop_reason = converged ? "converged" : oscillating ? "oscillating" : "max_iterations";
       ir.seconds = Since(start);
       report.iterations.push_back(ir);
       break;

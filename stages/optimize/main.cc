@@ -43,6 +43,13 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--tolerance", o.relative_tolerance, "inner loop stops when |ΔF/F| < this")
       ->capture_default_str();
+  app.add_option("--max-rises", o.max_rises,
+                 "inner loop also stops once F has risen from one outer iteration to the next this "
+                 "many times (footpoints and markers re-decided make it oscillate); 0 = off")
+      ->capture_default_str()->check(CLI::Range(0, 100000));
+  app.add_option("--rises-from-round", o.rises_from_round,
+                 "--max-rises applies from this round on (the first rounds are cheap)")
+      ->capture_default_str()->check(CLI::Range(0, 100000));
   app.add_option("--max-iterations", o.max_outer_iterations, "outer iterations per round at most")
       ->capture_default_str();
   app.add_option("--outlier-distance", o.outlier_distance,
@@ -122,6 +129,8 @@ int main(int argc, char** argv) {
                                {"feature_growth", o.feature_weight_growth},
                                {"tolerance", o.relative_tolerance},
                                {"max_iterations", o.max_outer_iterations},
+                               {"max_rises", o.max_rises},
+                               {"rises_from_round", o.rises_from_round},
                                {"outlier_distance", o.outlier_distance},
                                {"region_margin_px", o.region_margin_px},
                                {"unsupported_fairness", o.unsupported_fairness},

@@ -23,6 +23,14 @@ struct OptimizeOptions {
   double feature_weight_growth = 4;   // λ5 and λ6 are multiplied by this per subdivision
   double relative_tolerance = 0.01;   // inner loop stops when |ΔF/F| < this (ε)
   int max_outer_iterations = 100;     // ... or after this many outer iterations (Q)
+  // ... or once F rose from one outer iteration to the next this often (0 =
+  // off), in round rises_from_round and later. With markers re-decided every
+  // iteration F can oscillate without settling in the fine rounds, where an
+  // iteration costs ~0.4 s: set04 took 21 iterations in its last round (12 s
+  // in all) and 4.5 s in all from another start. The first rounds are cheap
+  // and may need many iterations (set02's first: 35, after a rise at the 4th).
+  int max_rises = 3;
+  int rises_from_round = 2;
   double outlier_distance = 0.06;     // φ, fraction of the model size
   // Only points projecting into the document region of the reference view
   // (boundary contour grown by this many pixels) are fitted, as in

@@ -495,6 +495,36 @@ TEST(Isometry, CallbackSeesEveryOuterIteration) {
   EXPECT_EQ(calls, int(r.report.iterations.size()));
 }
 
+// A marker whose ray the callback moves away on every other iteration makes
+// F rise and fall: with max_rises the solve stops at the given rise.
+TEST(Isometry, StopsWhenFOscillates) {
+  Problem p;
+  const MeshPair truth = CurledSheet(6, 5, 0.5, 0.4, 0.4);
+  p.meshes = truth;
+  p.points = SampleSurface(truth, 300, 0.0, 0.0, 2).points;
+  isometry::Marker m;
+  m.where = {7, Eigen::Vector3d(0.3, 0.3, 0.4)};
+  m.ray_direction = Eigen::Vector3d::UnitZ();
+  p.markers = {m};
+  SolveOptions o;
+  o.relative_tolerance = 1e-12;
+  o.max_outer_iterations = 40;
+  o.max_rises = 2;
+  o.on_outer_iteration = [&](const isometry::OuterIterationContext& c) {
+    const Eigen::Vector3d at = PointOnMesh3d(*c.meshes, (*c.markers)[0].where);
+    (*c.markers)[0].ray_origin = at + Eigen::Vector3d(c.iteration % 2 ? 0.05 : 0.0, 0, 0);
+  };
+  const auto r = isometry::Solve(p, o);
+  const auto& it = r.report.iterations;
+  EXPECT_EQ(r.report.stop_reason, "oscillating");
+  int rises = 0;
+  for (size_t i = 1; i < it.size(); ++i) rises += it[i].F > it[i - 1].F;
+  EXPECT_EQ(rises, 2);
+  EXPECT_GT(it.back().F, it[it.size() - 2].F);
+  o.max_rises = 0;
+  EXPECT_EQ(isometry::Solve(p, o).report.iterations.size(), 41u);
+}
+
 TEST(Isometry, RejectsInconsistentProblems) {
   Problem p;
   p.meshes = CurledSheet(4, 3, 0.5, 0.4, 0.4);
