@@ -81,13 +81,16 @@ Boundary ParseBoundary(const Json& doc) {
 // ---------------------------------------------------------------------------
 // 2D k-d tree over projected points.
 
-struct PixelCloud {
-  const std::vector<Eigen::Vector2d>* pts;
+// nanoflann's view of a vector of D-dimensional points.
+template <int D>
+struct VectorCloud {
+  const std::vector<Eigen::Matrix<double, D, 1>>* pts;
   size_t kdtree_get_point_count() const { return pts->size(); }
   double kdtree_get_pt(size_t i, size_t d) const { return (*pts)[i][int(d)]; }
   template <class B>
   bool kdtree_get_bbox(B&) const { return false; }
 };
+using PixelCloud = VectorCloud<2>;
 using PixelTree = nanoflann::KDTreeSingleIndexAdaptor<
     nanoflann::L2_Simple_Adaptor<double, PixelCloud>, PixelCloud, 2, uint32_t>;
 
@@ -109,13 +112,7 @@ class NearestPoint {
   }
 
  private:
-  struct Cloud {
-    const std::vector<Eigen::Vector3d>* pts;
-    size_t kdtree_get_point_count() const { return pts->size(); }
-    double kdtree_get_pt(size_t i, size_t d) const { return (*pts)[i][int(d)]; }
-    template <class B>
-    bool kdtree_get_bbox(B&) const { return false; }
-  };
+  using Cloud = VectorCloud<3>;
   Cloud cloud_;
   nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, Cloud>, Cloud, 3,
                                       uint32_t>
@@ -573,6 +570,10 @@ std::vector<isometry::Marker> OutlineMarkers(const MeshPair& m, const PinholeCam
   const size_t n = contour.size();
   if (n < 3 || g.nx < 2 || g.ny < 2) return markers;
   const Eigen::Vector3d centre = cam.Center();
+  // The image border where the page is cut off is no edge of it.
+  auto on_frame = [&](const Eigen::Vector2d& p) {
+    return p.x() < 2 || p.y() < 2 || p.x() > cam.width - 3 || p.y() > cam.height - 3;
+  };
   for (int r = 0; r < g.ny; ++r)
     for (int c = 0; c < g.nx; ++c) {
       if (r != 0 && r != g.ny - 1 && c != 0 && c != g.nx - 1) continue;
@@ -598,10 +599,6 @@ std::vector<isometry::Marker> OutlineMarkers(const MeshPair& m, const PinholeCam
       bool cut = false;
       for (size_t i = 0; i < n; ++i) {
         const Eigen::Vector2d a = contour[i], b = contour[(i + 1) % n];
-        // The image border where the page is cut off is no edge of it.
-        auto on_frame = [&](const Eigen::Vector2d& p) {
-          return p.x() < 2 || p.y() < 2 || p.x() > cam.width - 3 || p.y() > cam.height - 3;
-        };
         const Eigen::Vector2d d = b - a;
         const double len2 = d.squaredNorm();
         if (!(len2 > 0)) continue;
@@ -867,7 +864,8 @@ Json OptionsToJson(const Options& o) {
       {"min_covered_ninths", o.min_covered_ninths},
       {"upright", o.upright},
       {"refine",
-       {{"lambda", {r.weights.iso, r.weights.dist, r.weights.fair3d, r.weights.fair2d, 0.0, o.outline_hold}},
+       {{"lambda",
+         {r.weights.iso, r.weights.dist, r.weights.fair3d, r.weights.fair2d, 0.0, o.outline_hold}},
         {"beta", {r.beta_point, r.beta_normal}},
         {"outlier_distance", r.outlier_distance},
         {"unsupported_fairness", r.unsupported_fairness},
