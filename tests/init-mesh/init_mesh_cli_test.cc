@@ -110,7 +110,7 @@ TEST(InitMeshCli, OutlineHoldKeepsTheBorderOnTheOutline) {
   const double size = isometry::ModelSize(truth);
   EXPECT_LT(SurfaceDistance(ReadMeshPair(held / "40_init"), truth).mean, 0.002 * size);
   const Json init = ReadJsonFile(held / "40_init/init.json");
-  EXPECT_EQ(init.at("producer").at("options").at("outline_hold").get<double>(), 1.0);
+  EXPECT_EQ(init.at("producer").at("options").at("refine").at("outline_hold").get<double>(), 1.0);
 }
 
 TEST(InitMeshCli, MissingOrCorruptFilesAreBadInput) {
