@@ -322,11 +322,11 @@ TEST_P(EndToEnd, MeshesAreCloseToTheTruthAndReadable) {
   // points); asserted here are the bounds every set meets, and that optimize
   // does not move M away from the truth (beyond run-to-run noise). Since
   // init-mesh compares edge lengths too, its isometry error is 0.01-0.31 %
-  // on every set over two sfm runs and 0.54 % on set07 in a third (it was
-  // 5.7 % there).
+  // on every set over four sfm runs but set07's, 0.17-0.80 % (it was 5.5-5.7
+  // % there with the paper's diagonals alone).
   EXPECT_LE(final_surface, 3.0) << set_;
   EXPECT_LE(final_surface, 1.05 * init_surface + 0.1) << set_;
-  EXPECT_LT(init_iso, 0.01) << set_;
+  EXPECT_LT(init_iso, 0.02) << set_;
   EXPECT_LT(final_iso, 0.03) << set_;
   // Every PLY of the run opens in an independent reader.
   for (const char* f : {"40_init/mesh3d.ply", "40_init/mesh2d.ply", "50_optimize/mesh3d.ply",
