@@ -165,6 +165,9 @@ struct SolveOptions {
   // Also stop once F has risen from one outer iteration to the next this
   // many times (it oscillates); 0 = never.
   int max_rises = 0;
+  // Gauss-Newton: |ΔF/F| < ε does not count while the Levenberg-Marquardt
+  // damping μ is above this (0 = always counts).
+  double converged_max_damping = 0;
 
   // Lines are unknowns of F. They are solved for in closed form (total least
   // squares of their markers' p' = the exact minimiser of E_line for the

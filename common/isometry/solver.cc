@@ -798,8 +798,11 @@ Result Solve(const Problem& problem, const SolveOptions& o) {
     ir.lines = int(w.state.lines.size());
     ir.footpoint_seconds = Since(t0);
 
-    const bool converged =
-        it > 0 && std::abs(ir.F - f_previous) <= o.relative_tolerance * std::abs(f_previous);
+    // A step Levenberg-Marquardt damped hard lowers F little without F being
+    // near a minimum: that is no convergence (optionally).
+    const bool damped = gn && o.converged_max_damping > 0 && gn->damping() > o.converged_max_damping;
+    const bool converged = it > 0 && !damped &&
+                           std::abs(ir.F - f_previous) <= o.relative_tolerance * std::abs(f_previous);
     // F measured after re-deciding footpoints and markers can oscillate
     // without settling; then |ΔF/F| falls below ε only by chance.
     if (it > 0 && ir.F > f_previous) ++rises;

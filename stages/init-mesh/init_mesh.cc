@@ -879,6 +879,7 @@ Json OptionsToJson(const Options& o) {
         {"method", r.method == isometry::Method::kGaussNewton ? "gn" : "lbfgs"},
         {"max_outer_iterations", r.max_outer_iterations},
         {"relative_tolerance", r.relative_tolerance},
+        {"converged_max_damping", r.converged_max_damping},
         {"threads", r.num_threads}}}};
 }
 

@@ -100,6 +100,11 @@ int main(int argc, char** argv) {
   app.add_option("--max-iterations", o.refine.max_outer_iterations,
                  "outer iterations of the refinement (Q)")
       ->capture_default_str()->check(CLI::Range(0, 100000));
+  app.add_option("--converged-max-damping", o.refine.converged_max_damping,
+                 "|dF/F| below --tolerance does not stop the refinement while the "
+                 "Levenberg-Marquardt damping is above this (its steps are then short, not "
+                 "converged); 0 = it always stops")
+      ->capture_default_str()->check(CLI::Range(0.0, 1e6));
   app.add_option("--tolerance", o.refine.relative_tolerance,
                  "stop when |dF/F| between outer iterations is below this (epsilon)")
       ->capture_default_str()->check(CLI::Range(0.0, 1.0));
