@@ -36,14 +36,6 @@ int main(int argc, char** argv) {
                  "pixel distance unit of the depth weights 1/(1+r^2); 0 = median spacing of "
                  "the projected points, 1 = plain pixels as in the paper")
       ->capture_default_str()->check(CLI::Range(0.0, 1e6));
-  app.add_option("--outline-hold-max-angle", o.outline_hold_max_angle_deg,
-                 "border vertices where M is seen more than this far off its normal (degrees) are "
-                 "not held: the outline there is likely a silhouette")
-      ->capture_default_str()->check(CLI::Range(0.0, 90.0));
-  app.add_option("--outline-hold-support", o.outline_hold_support,
-                 "border vertices farther than this from every point (fraction of the model "
-                 "size) are not held: M's shape there is a guess")
-      ->capture_default_str()->check(CLI::Range(0.0, 10.0));
   app.add_option("--depth-model", o.depth_model,
                  "planar: fit 1/depth as an affine function of the pixel to the nearest "
                  "--planar-k points (continues each panel's plane over blank paper); average: "
@@ -95,6 +87,14 @@ int main(int argc, char** argv) {
                  "weight of the term holding M's border to the page outline in the reference "
                  "image (sliding along it); 0 = off")
       ->capture_default_str()->check(CLI::Range(0.0, 1e6));
+  app.add_option("--outline-hold-max-angle", o.outline_hold_max_angle_deg,
+                 "border vertices where M is seen more than this far off its normal (degrees) are "
+                 "not held: the outline there is likely a silhouette")
+      ->capture_default_str()->check(CLI::Range(0.0, 90.0));
+  app.add_option("--outline-hold-support", o.outline_hold_support,
+                 "border vertices farther than this from every point (fraction of the model "
+                 "size) are not held: M's shape there is a guess")
+      ->capture_default_str()->check(CLI::Range(0.0, 10.0));
   app.add_option("--method", method, "gn: Gauss-Newton/Levenberg-Marquardt; lbfgs: L-BFGS")
       ->capture_default_str()->check(CLI::IsMember({"gn", "lbfgs"}));
   app.add_option("--max-iterations", o.refine.max_outer_iterations,
