@@ -132,8 +132,10 @@ $(SFM_OUT) &: $(BIN)/sfm $(WORK)/.flags/sfm $(IMAGES) | check-data
 
 BOUNDARY_OUT := $(addprefix $(WORK)/20_boundary/,boundary.json mask.png overlay.png)
 boundary: check-data $(BOUNDARY_OUT)
-$(BOUNDARY_OUT) &: $(BIN)/segment-boundary $(WORK)/.flags/boundary $(WORK)/10_sfm/reference.png
-	$(call timed,segment-boundary) $(BIN)/segment-boundary --image $(WORK)/10_sfm/reference.png --out $(WORK)/20_boundary $(BOUNDARY_FLAGS)
+# The other views' pages too (20_boundary/views/): render looks there past a
+# side the reference image cuts off.
+$(BOUNDARY_OUT) &: $(BIN)/segment-boundary $(WORK)/.flags/boundary $(WORK)/10_sfm/reference.png $(WORK)/10_sfm/cameras.json
+	$(call timed,segment-boundary) $(BIN)/segment-boundary --image $(WORK)/10_sfm/reference.png --out $(WORK)/20_boundary --views $(DATA_DIR)/images --cameras $(WORK)/10_sfm/cameras.json $(BOUNDARY_FLAGS)
 
 POINTS_OUT := $(addprefix $(WORK)/25_points/,points.ply points.json overlay.png)
 points: check-data boundary $(POINTS_OUT)
@@ -174,7 +176,7 @@ MESH_STAGE := $(if $(wildcard $(ROOT)/stages/optimize),50_optimize,40_init)
 RENDER_OUT := $(addprefix $(WORK)/60_render/,rectified.png rectified_grid.png)
 render: check-data $(if $(wildcard $(ROOT)/stages/optimize),optimize,init) $(RENDER_OUT)
 $(RENDER_OUT) &: $(BIN)/render $(WORK)/.flags/render $(WORK)/$(MESH_STAGE)/mesh3d.ply $(WORK)/$(MESH_STAGE)/mesh2d.ply $(SFM_IN) $(BOUNDARY_IN)
-	$(call timed,render) $(BIN)/render --sfm $(WORK)/10_sfm --boundary $(WORK)/20_boundary --meshes $(WORK)/$(MESH_STAGE) --out $(WORK)/60_render $(RENDER_FLAGS)
+	$(call timed,render) $(BIN)/render --sfm $(WORK)/10_sfm --boundary $(WORK)/20_boundary --meshes $(WORK)/$(MESH_STAGE) --out $(WORK)/60_render --images $(DATA_DIR)/images $(RENDER_FLAGS)
 
 EVAL_OUT := $(WORK)/70_eval/metrics.json
 evaluate: check-data render $(EVAL_OUT)

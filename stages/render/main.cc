@@ -84,13 +84,30 @@ int main(int argc, char** argv) {
   app.add_flag(
       "--sample-hidden", o.sample_hidden,
       "sample the reference image also where it does not see the page");
+  bool no_extend = false, no_texture_cut = false;
+  std::string images;
+  app.add_option("--images", images,
+                 "the photos (<data>/images): the page found past a cut side is textured "
+                 "from the other views that see it (without: the fill colour)");
+  app.add_flag("--no-texture-cut-sides", no_texture_cut,
+               "fill the page found past a cut side instead of texturing it");
+  app.add_flag("--no-extend-cut-sides", no_extend,
+               "stop the crop where the reference image cuts the page off (by default the "
+               "page edge past it is looked for in the other views' page masks, "
+               "<boundary>/views/*/mask.png)");
+  app.add_option("--max-extension", o.cut_sides.max_extension,
+                 "how far past a cut side the page edge is looked for, as a fraction of "
+                 "what the reference view shows along that axis")
+      ->capture_default_str()->check(CLI::Range(0.0, 10.0));
   return RunStage("render", app, argc, argv, [&] {
     const auto start = std::chrono::steady_clock::now();
     o.antialias = !no_antialias;
     o.deskew = !no_deskew;
     o.orient = !no_orient;
+    o.extend_cut_sides = !no_extend;
+    o.texture_cut_sides = !no_texture_cut;
     const render::RenderInputs in =
-        render::ReadRenderInputs(sfm, boundary, meshes);
+        render::ReadRenderInputs(sfm, boundary, meshes, images);
     const double read_s = SecondsSince(start);
     render::RenderResult result = render::Run(o, in);
     result.report["timing_s"]["read"] = read_s;

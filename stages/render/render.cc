@@ -9,8 +9,10 @@
 #include <cstdio>
 #include <limits>
 #include <opencv2/core/utility.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "common/atomic_file.h"
 #include "common/cli.h"
 #include "common/errors.h"
 #include "common/raster.h"
@@ -26,6 +28,7 @@ using Clock = std::chrono::steady_clock;
 constexpr uchar kOutside = 0;  // not on M'
 constexpr uchar kPage = 1;     // sampled from the reference image
 constexpr uchar kHidden = 2;   // on M', but the reference view does not see it
+constexpr uchar kOtherView = 4;  // past a cut side, from another view's photo
 constexpr uchar kHiddenSampled =
     3;  // the same, sampled anyway (--sample-hidden)
 
@@ -470,7 +473,10 @@ Json OptionsToJson(const RenderOptions& o) {
           {"sample_hidden", o.sample_hidden},
           {"side_snap", o.side_snap},
           {"crop_rule", o.crop_rule},
-          {"crop_middle_max_deg", o.crop_middle_max_deg}};
+          {"crop_middle_max_deg", o.crop_middle_max_deg},
+          {"extend_cut_sides", o.extend_cut_sides},
+          {"texture_cut_sides", o.texture_cut_sides},
+          {"max_extension", o.cut_sides.max_extension}};
 }
 
 Json Vec2(const Eigen::Vector2d& v) { return Json::array({v.x(), v.y()}); }
@@ -483,6 +489,9 @@ Json MakeReport(const RenderOptions& options, const RenderInputs& in,
                    {"reference", in.reference_file.string()},
                    {"boundary", in.boundary.file.string()},
                    {"grid", {in.meshes.grid.nx, in.meshes.grid.ny}}};
+  Json view_masks = Json::array();
+  for (const ViewMask& v : in.views) view_masks.push_back(v.file.string());
+  doc["inputs"]["view_masks"] = view_masks;
   doc["width"] = r.rectified.cols;
   doc["height"] = r.rectified.rows;
   doc["pixels_per_unit"] = r.pixels_per_unit;
@@ -509,6 +518,20 @@ Json MakeReport(const RenderOptions& options, const RenderInputs& in,
       j["rms"] = s.rms;
     }
     if (!s.note.empty()) j["note"] = s.note;
+    if (!s.real && options.extend_cut_sides) {
+      const CutSideEdge& e = r.cut_edges[i];
+      Json c = {{"measured", e.measured},
+                {"edge_seen", e.edge_seen},
+                {"crossings", e.crossings},
+                {"columns_seen", e.columns_seen},
+                {"views", e.views}};
+      if (e.measured) {
+        c["bound"] = e.bound;
+        c["extension"] = e.extension;
+      }
+      if (!e.note.empty()) c["note"] = e.note;
+      j["page_edge_in_other_views"] = c;
+    }
     sides[kSideNames[i]] = j;
   }
   doc["sides"] = sides;
@@ -516,6 +539,17 @@ Json MakeReport(const RenderOptions& options, const RenderInputs& in,
   doc["page_fraction"] = r.page_fraction;
   doc["hidden_fraction"] = r.hidden_fraction;
   doc["minified_fraction"] = r.minified_fraction;
+  doc["other_view_fraction"] = r.other_view_fraction;
+  Json regs = Json::array();
+  for (const ViewRegistration& g : r.registrations)
+    regs.push_back({{"view", in.views[g.view].camera.image},
+                    {"affine", {{g.affine(0, 0), g.affine(0, 1), g.affine(0, 2)},
+                                {g.affine(1, 0), g.affine(1, 1), g.affine(1, 2)}}},
+                    {"inliers", g.inliers},
+                    {"moved", g.moved},
+                    {"agreement", g.agreement},
+                    {"used", g.used}});
+  doc["other_views"] = regs;
   doc["grid_line_step"] = r.grid_line_step;
   Json timing = Json::object();
   double total = 0;
@@ -600,11 +634,37 @@ RenderResult Run(const RenderOptions& options, const RenderInputs& in) {
   for (auto& q : flat) q = rotation * q;
   for (auto& s : r.sides)
     if (s.used) RotateSide(&s, angle);
-  const Eigen::Vector4d visible =
+  Eigen::Vector4d visible =
       VisibleBox(lookup.raster(), pm.triangles, flat);
   if (!(visible[2] > visible[0] && visible[3] > visible[1]))
     throw InputError(m3.string() +
                      ": the mesh covers no pixel of the reference image");
+  if (options.extend_cut_sides) {
+    std::array<bool, 4> cut;
+    for (int i = 0; i < 4; ++i) cut[i] = !in.boundary.sides[i].real;
+    r.cut_edges =
+        FindCutSideEdges(in.meshes, flat, visible, cut, in.views, in.lens, options.cut_sides);
+    for (int i = 0; i < 4; ++i) {
+      if (!cut[i]) continue;
+      const CutSideEdge& e = r.cut_edges[i];
+      if (!e.measured) {
+        Log(std::string(kSideNames[i]) + " side cut off by the reference image: " + e.note);
+        continue;
+      }
+      // The box stands in for the sides the crop has no line for.
+      visible[i == 0 ? 1 : i == 1 ? 2 : i == 2 ? 3 : 0] = e.bound;
+      const double axis_extent = i % 2 == 0 ? visible[3] - visible[1] : visible[2] - visible[0];
+      const std::string share =
+          std::to_string(int(std::lround(100 * e.extension / axis_extent))) + " % of the page";
+      Log(std::string(kSideNames[i]) + " side cut off by the reference image: " +
+          (e.edge_seen ? "the other views see the page edge " + share + " past it (" +
+                             std::to_string(e.crossings) + " crossings in " +
+                             std::to_string(e.views) + " views)"
+                       : "the other views see page up to " + share +
+                             " past it, but not its edge (" + std::to_string(e.columns_seen) +
+                             " columns)"));
+    }
+  }
   CropRect crop = ChooseCrop(&r.sides, visible,
                              options.crop_rule == "middle" ? options.crop_middle_max_deg * M_PI / 180
                                                            : -1.0);
@@ -647,8 +707,35 @@ RenderResult Run(const RenderOptions& options, const RenderInputs& in) {
                    size.scale, &image, &state);
   timer.Mark("sample");
 
+  // The page past the sides the reference image cuts off, from the photos
+  // that see it.
+  std::vector<const ExtensionStrip*> strips;
+  for (const CutSideEdge& e : r.cut_edges)
+    if (!e.strip.flat.empty()) strips.push_back(&e.strip);
+  if (!strips.empty() && options.texture_cut_sides) {
+    std::vector<cv::Mat> photos(in.views.size());
+    for (size_t v = 0; v < in.views.size(); ++v) {
+      const ViewMask& view = in.views[v];
+      if (view.photo.empty()) continue;
+      photos[v] = ReadImage(view.photo, cv::IMREAD_COLOR);
+      if (photos[v].cols != view.camera.width || photos[v].rows != view.camera.height)
+        throw InputError(view.photo.string() + ": " + std::to_string(photos[v].cols) + "x" +
+                         std::to_string(photos[v].rows) + ", but " + in.cameras_file.string() +
+                         " says " + std::to_string(view.camera.width) + "x" +
+                         std::to_string(view.camera.height));
+    }
+    const cv::Mat3b reference_render = image.clone();
+    const cv::Mat1b textured = TextureStrips(
+        strips, in.views, photos, in.lens, r.crop_x0, r.crop_y0, size.scale, options.antialias,
+        reference_render, state == kPage, state == kOutside, &image, &r.registrations);
+    state.setTo(kOtherView, textured);
+    r.other_view_fraction = cv::countNonZero(textured) / (double(size.width) * size.height);
+    timer.Mark("other_views");
+  }
+
   r.fill = paper_fill ? MedianColour(image, state) : fixed_fill;
-  const cv::Mat1b unfilled = (state != kPage) & (state != kHiddenSampled);
+  const cv::Mat1b unfilled =
+      (state != kPage) & (state != kHiddenSampled) & (state != kOtherView);
   image.setTo(cv::Scalar(r.fill[0], r.fill[1], r.fill[2]), unfilled);
   const double n = double(size.width) * size.height;
   r.page_fraction = stats.page / n;

@@ -20,6 +20,7 @@
 #include "common/grid_mesh.h"
 #include "common/json_io.h"
 #include "common/page_files.h"
+#include "stages/render/cut_sides.h"
 
 namespace docunfold::render {
 
@@ -92,6 +93,15 @@ struct RenderOptions {
   // tell a page's top from its sides, so without this the page may come out
   // on its side or upside down.
   bool orient = true;
+  // Where a side of the page is cut off by the reference image's border,
+  // look for the page edge past it in the other views' page masks
+  // (cut_sides.h) and extend the crop to it; the part no photo textures
+  // gets the fill colour. Off: the crop stops where the reference view does.
+  bool extend_cut_sides = true;
+  // Texture the page found past cut sides from the other photos that see
+  // it (RenderInputs::views[].photo); off: the fill colour.
+  bool texture_cut_sides = true;
+  CutSideOptions cut_sides;
   cv::Scalar grid_color = cv::Scalar(40, 40, 230);
   double grid_min_spacing_px = 12;
 };
@@ -107,6 +117,10 @@ struct RenderInputs {
   // The reader's down in M' (lines.json text_down_flat), when known: which
   // way up the page is when Tesseract cannot read its print.
   std::optional<Eigen::Vector2d> text_down;
+  // Page masks of the other views (20_boundary/views/<name>/mask.png, when
+  // segment-boundary was given --views) and their lens distortion.
+  std::vector<ViewMask> views;
+  RadialDistortion lens;
   // Where each input came from, for error messages and the report.
   fs::path cameras_file, reference_file, meshes_dir;
 };
@@ -139,10 +153,13 @@ struct RenderResult {
       size_rule;  // "reference-density", "width", "height", "dpi", "scale"
   bool capped = false;  // the default size was reduced to max_pixels
   std::array<SideFit, 4> sides;
+  std::array<CutSideEdge, 4> cut_edges;  // the page edge past cut sides
+  std::vector<ViewRegistration> registrations;  // of the views textured from
   cv::Vec3b fill;
   double page_fraction = 0;      // output pixels showing the page
   double hidden_fraction = 0;    // output pixels on M' but not seen
   double minified_fraction = 0;  // output pixels that needed pre-filtering
+  double other_view_fraction = 0;  // output pixels from another view's photo
   int grid_line_step = 1;
   // Clockwise quarter turns applied to the images after rendering (the crop
   // and pixels_per_unit above refer to the unturned image).
@@ -153,9 +170,11 @@ struct RenderResult {
 
 // Reads and validates everything render needs; InputError naming the file
 // and the problem otherwise.
+// `images_dir` (optional): the photos, for the page past cut sides.
 RenderInputs ReadRenderInputs(const fs::path& sfm_dir,
                               const fs::path& boundary_dir,
-                              const fs::path& meshes_dir);
+                              const fs::path& meshes_dir,
+                              const fs::path& images_dir = {});
 
 // Renders the rectified page. Throws InputError for inconsistent inputs
 // (image sizes, mesh behind the camera or out of view) and UsageError for

@@ -5,6 +5,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "common/atomic_file.h"
+#include "common/camera.h"
 #include "common/cli.h"
 #include "stages/segment-boundary/segment_boundary.h"
 
@@ -55,6 +56,16 @@ int main(int argc, char** argv) {
                  "geometry")
       ->capture_default_str()->check(CLI::IsMember({"auto", "text", "geometry"}));
   app.add_flag("--verbose", opt.verbose, "log each step and its time");
+  fs::path views_dir, cameras_path;
+  auto* views_opt = app.add_option(
+      "--views", views_dir,
+      "folder of the photos (e.g. <data>/images): also find the page in every other view "
+      "that --cameras registers, into <out>/views/<photo name>/ (render looks there past "
+      "the border of a reference image that cuts the page off)");
+  auto* cameras_opt =
+      app.add_option("--cameras", cameras_path, "sfm's cameras.json (with --views)");
+  views_opt->needs(cameras_opt);
+  cameras_opt->needs(views_opt);
 
   return RunStage("segment-boundary", app, argc, argv, [&] {
     const auto start = std::chrono::steady_clock::now();
@@ -71,6 +82,43 @@ int main(int argc, char** argv) {
     if (opt.verbose)
       Log("page found in " + std::to_string(SecondsSince(start)) + " s; orientation by " +
           result.orientation.method);
+    // The other views, all found before anything is written: a view without
+    // a page is logged and left out (render uses whichever views it finds);
+    // a photo that is missing or not the size cameras.json says fails.
+    struct ViewOutput {
+      fs::path dir;
+      cv::Mat1b mask;
+      cv::Mat overlay;
+      Json doc;
+    };
+    std::vector<ViewOutput> view_outputs;
+    int views = 0;
+    if (!views_dir.empty()) {
+      const CameraSet cameras = ReadCameras(cameras_path);
+      for (const PinholeCamera& view : cameras.views) {
+        if (view.image == cameras.reference) continue;
+        ++views;
+        const fs::path photo = views_dir / view.image;
+        const cv::Mat view_image = ReadImage(photo, 1 /*cv::IMREAD_COLOR*/);
+        if (view_image.cols != view.width || view_image.rows != view.height)
+          throw InputError(photo.string() + ": " + std::to_string(view_image.cols) + "x" +
+                           std::to_string(view_image.rows) + ", but " + cameras_path.string() +
+                           " says " + std::to_string(view.width) + "x" +
+                           std::to_string(view.height));
+        boundary::BoundaryResult view_result;
+        try {
+          view_result = boundary::SegmentBoundary(view_image, opt);
+        } catch (const InputError& e) {
+          Log(photo.string() + ": " + e.what() + "; view left out");
+          continue;
+        }
+        view_outputs.push_back({out_dir / "views" / fs::path(view.image).stem(),
+                                view_result.mask,
+                                boundary::DrawBoundaryOverlay(view_image, view_result, 800),
+                                boundary::BoundaryToJson(view_result, view.image,
+                                                         view_image.cols, view_image.rows, opt)});
+      }
+    }
     EnsureDirectory(out_dir);
     const Json doc = boundary::BoundaryToJson(result, image_path.filename().string(),
                                               image.cols, image.rows, opt);
@@ -81,6 +129,18 @@ int main(int argc, char** argv) {
     WriteImageAtomic(out_dir / "overlay.png", boundary::DrawBoundaryOverlay(image, result),
                      png_fast);
     WriteJsonAtomic(out_dir / "boundary.json", doc);
+    // Views of an earlier run would no longer match this boundary.
+    std::error_code ec;
+    fs::remove_all(out_dir / "views", ec);
+    for (const ViewOutput& v : view_outputs) {
+      EnsureDirectory(v.dir);
+      WriteImageAtomic(v.dir / "mask.png", v.mask, png_fast);
+      WriteImageAtomic(v.dir / "overlay.png", v.overlay, png_fast);
+      WriteJsonAtomic(v.dir / "boundary.json", v.doc);
+    }
+    if (!views_dir.empty())
+      Log("page found in " + std::to_string(view_outputs.size()) + " of " +
+          std::to_string(views) + " other views");
     int real = 0;
     for (const auto& s : result.sides) real += s.real;
     Log("page covers " + std::to_string(int(std::lround(result.area_fraction * 100))) +

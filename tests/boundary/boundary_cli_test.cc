@@ -96,5 +96,59 @@ TEST(SegmentBoundaryCli, HelpAndBadFlags) {
             2);
 }
 
+// cameras.json naming `images` (800x600 each) with the first as reference.
+fs::path WriteCameras(const TempDir& dir, const std::vector<std::string>& images, int width) {
+  std::string views;
+  for (const auto& name : images) {
+    if (!views.empty()) views += ",";
+    views += "{\"image\":\"" + name + "\",\"width\":" + std::to_string(width) +
+             ",\"height\":600,\"K\":[[700,0,400],[0,700,300],[0,0,1]],"
+             "\"R\":[[1,0,0],[0,1,0],[0,0,1]],\"t\":[0,0,0]}";
+  }
+  const fs::path path = dir / "cameras.json";
+  std::ofstream(path) << "{\"format\":\"docunfold.cameras\",\"version\":1,\"reference\":\"" +
+                             images[0] + "\",\"views\":[" + views + "]}";
+  return path;
+}
+
+TEST(SegmentBoundaryCli, OtherViewsGetTheirOwnPageMasks) {
+  TempDir dir;
+  WriteScene(dir, true);
+  WriteScene(dir, false);
+  fs::copy_file(dir / "page.png", dir / "again.png");
+  const fs::path cameras = WriteCameras(dir, {"page.png", "again.png", "table.png"}, 800);
+  const std::string base = Binary() + " --image " + Quote((dir / "page.png").string()) +
+                           " --out " + Quote((dir / "out").string());
+  const CommandResult r = RunCommand(base + " --views " + Quote(dir.path().string()) +
+                                     " --cameras " + Quote(cameras.string()));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  // The reference's own outputs as always; a view without a page is left out.
+  EXPECT_TRUE(fs::is_regular_file(dir / "out" / "mask.png"));
+  EXPECT_FALSE(fs::exists(dir / "out" / "views" / "page"));
+  const cv::Mat mask = cv::imread((dir / "out" / "views" / "again" / "mask.png").string(),
+                                  cv::IMREAD_UNCHANGED);
+  ASSERT_FALSE(mask.empty());
+  EXPECT_EQ(mask.size(), cv::Size(800, 600));
+  EXPECT_GT(cv::countNonZero(mask), 0.15 * mask.total());
+  EXPECT_TRUE(fs::is_regular_file(dir / "out" / "views" / "again" / "boundary.json"));
+  EXPECT_FALSE(fs::exists(dir / "out" / "views" / "table"));
+  EXPECT_NE(r.output.find("table.png"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("page found in 1 of 2 other views"), std::string::npos) << r.output;
+
+  // --views needs --cameras; a photo that is not the size cameras.json says
+  // is bad input, named.
+  EXPECT_EQ(RunCommand(base + " --views " + Quote(dir.path().string())).exit_code, 2);
+  const fs::path wrong = WriteCameras(dir, {"page.png", "again.png"}, 640);
+  const CommandResult bad = RunCommand(base + " --views " + Quote(dir.path().string()) +
+                                       " --cameras " + Quote(wrong.string()));
+  EXPECT_EQ(bad.exit_code, 3) << bad.output;
+  EXPECT_NE(bad.output.find("again.png"), std::string::npos) << bad.output;
+  // ... and writes nothing: the earlier run's files are still there.
+  EXPECT_TRUE(fs::is_regular_file(dir / "out" / "views" / "again" / "mask.png"));
+  // Without --views, the views of an earlier run go (they belong to it).
+  ASSERT_EQ(RunCommand(base).exit_code, 0);
+  EXPECT_FALSE(fs::exists(dir / "out" / "views"));
+}
+
 }  // namespace
 }  // namespace docunfold::testing

@@ -67,9 +67,10 @@ TEST_P(RenderTruth, TrueMeshesReproduceFlatPng) {
     EXPECT_EQ(r.sides[i].used, r.sides[i].real)
         << kSideNames[i] << " " << r.sides[i].note;
     // A real side bounds the crop where the page edge is (to a pixel).
-    if (r.sides[i].used)
+    if (r.sides[i].used) {
       EXPECT_LT(std::abs(crop_edge[i] - true_edge[i]), 1.5 / r.pixels_per_unit)
           << kSideNames[i];
+    }
   }
   const double aspect = double(r.rectified.cols) / r.rectified.rows;
   if (real == 4) {

@@ -9,6 +9,7 @@
 #include "common/atomic_file.h"
 #include "common/errors.h"
 #include "stages/render/crop.h"
+#include "stages/render/cut_sides.h"
 #include "stages/render/render.h"
 #include "tests/render/render_fixtures.h"
 #include "tests/support/test_support.h"
@@ -418,6 +419,141 @@ TEST(RenderCrop, SlightlySlantedSidesBoundTheCropThroughTheirMiddle) {
   EXPECT_NEAR(render::ChooseCrop(&slight, box).x1, inscribed, 1e-9);  // the default: inscribed
   auto steep = sides_with_right_slant(5);  // beyond the limit: inscribed
   EXPECT_NEAR(render::ChooseCrop(&steep, box, limit).x1, 1 - 0.5 * std::tan(5 * M_PI / 180), 1e-9);
+}
+
+// The columns of a scene's grid that the reference view sees whole: M and M'
+// as the pipeline has them when the image cuts the page off on the left.
+MeshPair SeenColumns(const SyntheticScene& s) {
+  const QuadGrid& g = s.meshes.grid;
+  int first = 0;
+  for (int c = 0; c < g.nx; ++c) {
+    bool inside = true;
+    for (int r = 0; r < g.ny && inside; ++r)
+      inside = s.camera.Project(s.meshes.mesh3d[g.Index(r, c)]).x() >= 0;
+    if (inside) {
+      first = c;
+      break;
+    }
+  }
+  MeshPair m;
+  m.grid = {g.nx - first, g.ny};
+  for (int r = 0; r < g.ny; ++r)
+    for (int c = first; c < g.nx; ++c) {
+      m.mesh3d.push_back(s.meshes.mesh3d[g.Index(r, c)]);
+      m.mesh2d.push_back(s.meshes.mesh2d[g.Index(r, c)]);
+    }
+  return m;
+}
+
+// Another view of the same page: `other` is the scene made with the page
+// moved (the same tilt), i.e. the camera moved the other way. Its page mask
+// is where its raster shows the page.
+render::ViewMask OtherView(const SyntheticScene& reference_scene, const SceneOptions& reference,
+                           const SyntheticScene& other, const SceneOptions& other_options) {
+  render::ViewMask view;
+  view.camera = other.camera;
+  view.camera.image = "view_01.png";
+  view.camera.t = other_options.page_origin - reference.page_origin;
+  const RasterResult raster =
+      RasterizeMesh(other.camera, other.meshes.mesh3d, other.meshes.grid.Triangles());
+  view.mask = raster.face >= 0;
+  (void)reference_scene;
+  return view;
+}
+
+Eigen::Vector4d BoxOf(const std::vector<Eigen::Vector2d>& flat) {
+  Eigen::Vector2d lo = flat[0], hi = flat[0];
+  for (const auto& q : flat) {
+    lo = lo.cwiseMin(q);
+    hi = hi.cwiseMax(q);
+  }
+  return {lo.x(), lo.y(), hi.x(), hi.y()};
+}
+
+TEST(RenderCutSides, AnotherViewFindsThePageEdgePastTheReferenceImage) {
+  SceneOptions o;
+  o.page_origin = {-0.6, -0.3, 1.0};  // the left part runs off the image
+  o.radius = 0;
+  const SyntheticScene s = MakeScene(o);
+  ASSERT_FALSE(s.real[3]);
+  const MeshPair seen = SeenColumns(s);
+  const Eigen::Vector4d box = BoxOf(seen.mesh2d);
+  ASSERT_GT(box[0], 0.1 * o.page_w);  // a good part of the page is cut off
+  SceneOptions far = o;
+  far.page_origin = {-0.25, -0.3, 1.6};  // seen whole from farther back
+  const SyntheticScene s2 = MakeScene(far);
+  ASSERT_TRUE(s2.real[0] && s2.real[1] && s2.real[2] && s2.real[3]);
+  const std::vector<render::ViewMask> views = {OtherView(s, o, s2, far)};
+  const std::array<bool, 4> cut = {false, false, false, true};
+
+  const auto edges = render::FindCutSideEdges(seen, seen.mesh2d, box, cut, views, {});
+  const render::CutSideEdge& left = edges[3];
+  ASSERT_TRUE(left.measured) << left.note;
+  EXPECT_TRUE(left.edge_seen);
+  EXPECT_NEAR(left.bound, 0.0, 0.005 * o.page_w);  // the true left edge: x = 0
+  EXPECT_NEAR(left.extension, box[0], 0.005 * o.page_w);
+  EXPECT_GT(left.crossings, seen.grid.ny / 2);
+  EXPECT_EQ(left.strip.cols, seen.grid.ny);
+  EXPECT_FALSE(edges[0].measured || edges[1].measured || edges[2].measured);
+
+  // A view whose own frame cuts the page before its edge: the page reaches
+  // at least as far as it sees, and no farther is claimed.
+  SyntheticScene s3 = s2;
+  s3.camera.K(0, 2) -= 240;  // the page's left edge now lies off this photo
+  const std::vector<render::ViewMask> short_views = {OtherView(s, o, s3, far)};
+  ASSERT_LT(s3.camera.Project(s3.meshes.mesh3d[0]).x(), 0);
+  const auto short_edges =
+      render::FindCutSideEdges(seen, seen.mesh2d, box, cut, short_views, {});
+  ASSERT_TRUE(short_edges[3].measured) << short_edges[3].note;
+  EXPECT_FALSE(short_edges[3].edge_seen);
+  EXPECT_GT(short_edges[3].bound, 0.0);
+  EXPECT_LT(short_edges[3].bound, box[0] - 0.05 * o.page_w);
+
+  // No other view: nothing measured, and why.
+  const auto none = render::FindCutSideEdges(seen, seen.mesh2d, box, cut, {}, {});
+  EXPECT_FALSE(none[3].measured);
+  EXPECT_FALSE(none[3].note.empty());
+}
+
+TEST(RenderCutSides, ThePagePastTheReferenceImageIsTexturedFromAnotherView) {
+  TempDir dir;
+  SceneOptions o;
+  o.page_origin = {-0.6, -0.3, 1.0};
+  o.radius = 0;
+  SyntheticScene s = MakeScene(o);
+  const SyntheticScene full = s;
+  s.meshes = SeenColumns(s);
+  SceneOptions far = o;
+  far.page_origin = {-0.25, -0.3, 1.6};
+  const SyntheticScene s2 = MakeScene(far);
+  render::RenderInputs in = InputsOf(s);
+  in.views = {OtherView(s, o, s2, far)};
+  in.views[0].photo = dir / "view_01.png";
+  WriteImageAtomic(in.views[0].photo, s2.photo);
+
+  render::RenderOptions without;
+  without.extend_cut_sides = false;
+  const render::RenderResult before = render::Run(without, in);
+  const render::RenderResult r = render::Run({}, in);
+  Keep("cut-sides", r.rectified);
+  const double px = 1 / r.pixels_per_unit;
+  EXPECT_GT(before.crop_x0, 0.1 * o.page_w);
+  EXPECT_NEAR(r.crop_x0, 0.0, 0.005 * o.page_w + px);  // out to the true edge
+  EXPECT_NEAR(r.crop_x1, before.crop_x1, px);
+  EXPECT_GT(r.other_view_fraction, 0.1);
+  ASSERT_EQ(r.registrations.size(), 1u);
+  // The part from the other view shows the page's texture where it belongs.
+  const int x_end = int((before.crop_x0 - r.crop_x0) * r.pixels_per_unit) - 4;
+  ASSERT_GT(x_end, 40);
+  cv::Mat1b mask = Inner(r.page_mask, 3);
+  mask.colRange(x_end, mask.cols).setTo(0);
+  const SyntheticScene& truth = full;
+  const cv::Mat1f a = Detail(ExpectedImage(truth, r)), b = Detail(r.rectified);
+  EXPECT_GT(Correlation(a, b, mask), 0.6);
+  const TileOffsets off = FindTileOffsets(a, b, mask, 32, 8);
+  ASSERT_GT(off.tiles, 3);
+  EXPECT_GE(off.matched, off.tiles - 1);
+  EXPECT_LT(off.median, 1.5);
 }
 
 }  // namespace

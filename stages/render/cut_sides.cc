@@ -1,0 +1,454 @@
+#include "stages/render/cut_sides.h"
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/features2d.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "common/raster.h"
+#include "stages/render/texture_sampler.h"
+
+namespace docunfold::render {
+
+bool ProjectDistorted(const PinholeCamera& camera, const RadialDistortion& lens,
+                      const Eigen::Vector3d& x_world, Eigen::Vector2d* pixel) {
+  const Eigen::Vector3d x = camera.CamFromWorld(x_world);
+  if (!(x.z() > 0)) return false;
+  const double u = x.x() / x.z(), v = x.y() / x.z();
+  const double r2 = u * u + v * v;
+  const double f = 1 + lens.k1 * r2 + lens.k2 * r2 * r2;
+  const Eigen::Vector3d p = camera.K * Eigen::Vector3d(u * f, v * f, 1);
+  *pixel = p.head<2>() / p.z();
+  return std::isfinite(pixel->x()) && std::isfinite(pixel->y());
+}
+
+namespace {
+
+// Outward normal of side i of M' (y down): top, right, bottom, left.
+Eigen::Vector2d Outward(int side) {
+  static const Eigen::Vector2d n[4] = {{0, -1}, {1, 0}, {0, 1}, {-1, 0}};
+  return n[side];
+}
+
+// The grid's border b (0 first row, 1 last column, 2 last row, 3 first
+// column): its vertices in order and, for each, the vertex `depth` steps
+// inwards.
+struct Border {
+  std::vector<int> vertex;
+  std::vector<int> inner;
+};
+
+Border GridBorder(const QuadGrid& g, int b, int depth) {
+  Border border;
+  const bool along_row = b == 0 || b == 2;
+  const int n = along_row ? g.nx : g.ny;
+  for (int k = 0; k < n; ++k) {
+    switch (b) {
+      case 0: border.vertex.push_back(g.Index(0, k)); border.inner.push_back(g.Index(depth, k)); break;
+      case 1: border.vertex.push_back(g.Index(k, g.nx - 1)); border.inner.push_back(g.Index(k, g.nx - 1 - depth)); break;
+      case 2: border.vertex.push_back(g.Index(g.ny - 1, k)); border.inner.push_back(g.Index(g.ny - 1 - depth, k)); break;
+      default: border.vertex.push_back(g.Index(k, 0)); border.inner.push_back(g.Index(k, depth)); break;
+    }
+  }
+  return border;
+}
+
+double Quantile(std::vector<double> v, double q) {
+  const size_t k = std::min(v.size() - 1, size_t(q * (v.size() - 1) + 0.5));
+  std::nth_element(v.begin(), v.begin() + k, v.end());
+  return v[k];
+}
+
+double Median(std::vector<double> v) { return Quantile(std::move(v), 0.5); }
+
+}  // namespace
+
+std::array<CutSideEdge, 4> FindCutSideEdges(const MeshPair& meshes,
+                                            const std::vector<Eigen::Vector2d>& flat,
+                                            const Eigen::Vector4d& visible_box,
+                                            const std::array<bool, 4>& cut,
+                                            const std::vector<ViewMask>& views,
+                                            const RadialDistortion& lens,
+                                            const CutSideOptions& options) {
+  std::array<CutSideEdge, 4> edges;
+  const QuadGrid& g = meshes.grid;
+  if (g.nx < 3 || g.ny < 3) return edges;
+  for (int side = 0; side < 4; ++side) {
+    CutSideEdge& edge = edges[side];
+    if (!cut[side]) continue;
+    if (views.empty()) {
+      edge.note = "no other view's page mask";
+      continue;
+    }
+    const Eigen::Vector2d n = Outward(side);
+    const bool vertical_axis = side == 0 || side == 2;  // the bound is a y
+    const double extent = vertical_axis ? visible_box[3] - visible_box[1]
+                                        : visible_box[2] - visible_box[0];
+    // The grid border lying farthest out on this side of M'.
+    int best = 0;
+    double best_out = -1e300;
+    for (int b = 0; b < 4; ++b) {
+      const Border border = GridBorder(g, b, 0);
+      double sum = 0;
+      for (int v : border.vertex) sum += n.dot(flat[v]);
+      if (sum / border.vertex.size() > best_out) {
+        best_out = sum / border.vertex.size();
+        best = b;
+      }
+    }
+    const int rows_inward = (best == 0 || best == 2) ? g.ny - 1 : g.nx - 1;
+    const int depth = std::clamp(int(std::lround(options.base_fraction * rows_inward)), 1,
+                                 rows_inward);
+    const Border border = GridBorder(g, best, depth);
+    constexpr int kStepsPerExtent = 400;
+    std::vector<double> crossings;
+    std::vector<double> seen_page;  // per column: the farthest page seen
+    // Per border column: the continuation's direction (per step of t).
+    std::vector<Eigen::Vector3d> dir3(border.vertex.size(), Eigen::Vector3d::Zero());
+    std::vector<Eigen::Vector2d> dir2(border.vertex.size(), Eigen::Vector2d::Zero());
+    std::vector<char> view_crossed(views.size(), 0);
+    for (size_t k = 0; k < border.vertex.size(); ++k) {
+      const int vb = border.vertex[k], vi = border.inner[k];
+      const Eigen::Vector3d d3 = (meshes.mesh3d[vb] - meshes.mesh3d[vi]) / depth;
+      const Eigen::Vector2d d2 = (flat[vb] - flat[vi]) / depth;
+      const double speed = n.dot(d2);  // outward M' distance per step of t
+      if (!(speed > 0)) continue;
+      dir3[k] = d3;
+      dir2[k] = d2;
+      const double dt = extent / (kStepsPerExtent * speed);
+      const int steps = int(std::ceil(options.max_extension * kStepsPerExtent));
+      double column_seen = std::nan("");  // farthest page any view sees here
+      for (size_t v = 0; v < views.size(); ++v) {
+        const ViewMask& view = views[v];
+        const double m = options.frame_margin *
+                         std::hypot(view.camera.width, view.camera.height);
+        // -1 unseen (behind the camera or off the photo), 0 table, 1 page.
+        auto state_at = [&](int j, Eigen::Vector2d* px) {
+          if (!ProjectDistorted(view.camera, lens, meshes.mesh3d[vb] + j * dt * d3, px) ||
+              !(px->x() >= m && px->y() >= m && px->x() <= view.camera.width - 1 - m &&
+                px->y() <= view.camera.height - 1 - m))
+            return -1;
+          return view.mask(int(std::lround(px->y())), int(std::lround(px->x()))) ? 1 : 0;
+        };
+        // Out from the border for as long as the view sees page there.
+        Eigen::Vector2d px;
+        if (state_at(0, &px) != 1) continue;
+        int last_page = 0;
+        for (int j = 1; j <= steps; ++j) {
+          const int state = state_at(j, &px);
+          if (state == 1) {
+            last_page = j;
+            continue;
+          }
+          if (state == -1) break;  // off the photo: page at least to last_page
+          // Table from here on for confirm_px in the photo: a notch in the
+          // mask or a dark print blob is not the page edge.
+          int l = j + 1, ahead = 0;
+          Eigen::Vector2d px_ahead = px;
+          for (; l <= steps && (px_ahead - px).norm() < options.confirm_px; ++l)
+            if ((ahead = state_at(l, &px_ahead)) != 0) break;
+          if (ahead == 0 && (px_ahead - px).norm() >= options.confirm_px) {
+            const Eigen::Vector2d q = flat[vb] + (j - 0.5) * dt * d2;
+            crossings.push_back(vertical_axis ? q.y() : q.x());
+            view_crossed[v] = 1;
+            last_page = 0;  // the edge says more than a lower bound
+            break;
+          }
+          if (ahead != 1) break;
+          last_page = j = l;
+        }
+        if (last_page > 0) {
+          const Eigen::Vector2d q = flat[vb] + last_page * dt * d2;
+          const double c = vertical_axis ? q.y() : q.x();
+          column_seen = std::isnan(column_seen) ? c
+                        : side == 0 || side == 3 ? std::min(column_seen, c)
+                                                 : std::max(column_seen, c);
+        }
+      }
+      if (!std::isnan(column_seen)) seen_page.push_back(column_seen);
+    }
+    edge.crossings = int(crossings.size());
+    edge.columns_seen = int(seen_page.size());
+    edge.views = int(std::count(view_crossed.begin(), view_crossed.end(), 1));
+    if (edge.crossings >= options.min_crossings) {
+      edge.bound = Median(crossings);
+      edge.edge_seen = true;
+    } else if (edge.columns_seen >= options.min_crossings) {
+      // No photo sees the edge itself; the page reaches at least as far as
+      // the photos see it (a high quantile over the columns: the page is a
+      // rectangle, so page seen past any column is page past the side).
+      edge.bound = Quantile(seen_page, side == 0 || side == 3 ? 1 - options.seen_quantile
+                                                              : options.seen_quantile);
+    } else {
+      edge.note = "the other views see neither the page edge nor page past this side (" +
+                  std::to_string(edge.crossings) + " crossings, " +
+                  std::to_string(edge.columns_seen) + " columns seen; " +
+                  std::to_string(options.min_crossings) + " needed)";
+      continue;
+    }
+    const double visible_bound = side == 0   ? visible_box[1]
+                                 : side == 1 ? visible_box[2]
+                                 : side == 2 ? visible_box[3]
+                                             : visible_box[0];
+    const double sign = (side == 0 || side == 3) ? -1 : 1;
+    edge.extension = sign * (edge.bound - visible_bound);
+    if (edge.extension < 0) {
+      edge.bound = visible_bound;
+      edge.extension = 0;
+    }
+    edge.measured = true;
+    if (edge.extension > 0) {
+      // Each column continues until it reaches the bound's line in M'.
+      ExtensionStrip& strip = edge.strip;
+      strip.cols = int(border.vertex.size());
+      const int band = std::max(0, options.band_rows);
+      strip.rows = band + std::max(2, options.strip_rows);
+      strip.band_rows = band;
+      strip.mesh3d.resize(size_t(strip.cols) * strip.rows);
+      strip.flat.resize(strip.mesh3d.size());
+      const double target = (side == 0 || side == 3) ? -edge.bound : edge.bound;
+      for (int k = 0; k < strip.cols; ++k) {
+        const int vb = border.vertex[k];
+        const double speed = n.dot(dir2[k]);
+        const double t_end = speed > 0 ? std::max(0.0, (target - n.dot(flat[vb])) / speed) : 0;
+        for (int j = 0; j < strip.rows; ++j) {
+          // Band rows run back over the mesh, towards the inner vertex.
+          const double t = j < band ? -double(depth) * (band - j) / band
+                                    : t_end * (j - band) / (strip.rows - band - 1);
+          strip.mesh3d[size_t(j) * strip.cols + k] = meshes.mesh3d[vb] + t * dir3[k];
+          strip.flat[size_t(j) * strip.cols + k] = flat[vb] + t * dir2[k];
+        }
+      }
+    }
+  }
+  return edges;
+}
+
+namespace {
+
+// Least agreement (Agreement()) with the reference for a view to be used.
+constexpr double kMinAgreement = 0.3;
+
+struct StripMesh {
+  std::vector<Eigen::Vector3d> screen, world;
+  std::vector<Triangle> triangles;
+};
+
+StripMesh JoinStrips(const std::vector<const ExtensionStrip*>& strips, double x0, double y0,
+                     double scale) {
+  StripMesh m;
+  for (const ExtensionStrip* strip : strips) {
+    const int base = int(m.screen.size());
+    for (size_t i = 0; i < strip->flat.size(); ++i) {
+      m.screen.emplace_back((strip->flat[i].x() - x0) * scale - 0.5,
+                            (strip->flat[i].y() - y0) * scale - 0.5, 1.0);
+      m.world.push_back(strip->mesh3d[i]);
+    }
+    for (int j = 0; j + 1 < strip->rows; ++j)
+      for (int k = 0; k + 1 < strip->cols; ++k) {
+        const int a = base + j * strip->cols + k, b = a + 1, c = a + strip->cols + 1,
+                  d = a + strip->cols;
+        m.triangles.push_back({a, b, c});
+        m.triangles.push_back({a, c, d});
+      }
+  }
+  return m;
+}
+
+// One view's rendering of the strips: colour, and per pixel the view's
+// pixels per output pixel (0 where the view does not show the strip).
+struct ViewRendering {
+  cv::Mat3b colour;
+  cv::Mat1f density;
+};
+
+ViewRendering RenderStripsFromView(const StripMesh& m, const ViewMask& view,
+                                   const RadialDistortion& lens, const TextureSampler& sampler,
+                                   const Eigen::Vector2d& shift, int width, int height,
+                                   bool antialias) {
+  std::vector<Eigen::Vector3d> screen = m.screen;
+  for (auto& p : screen) p.head<2>() += shift;
+  const RasterResult raster = Rasterize(screen, m.triangles, width, height);
+  // Per triangle: all corners on the view's page mask, and the affine map
+  // output pixel -> view pixel (the footprint).
+  std::vector<char> usable(m.triangles.size(), 0);
+  std::vector<Eigen::Matrix2d> jacobian(m.triangles.size());
+  for (size_t f = 0; f < m.triangles.size(); ++f) {
+    const Triangle& t = m.triangles[f];
+    Eigen::Matrix2d S;
+    S << (screen[t[1]] - screen[t[0]]).head<2>(), (screen[t[2]] - screen[t[0]]).head<2>();
+    if (!(std::abs(S.determinant()) > 1e-9)) continue;
+    Eigen::Vector2d px[3];
+    bool ok = true;
+    for (int c = 0; c < 3 && ok; ++c)
+      ok = ProjectDistorted(view.camera, lens, m.world[t[c]], &px[c]) && px[c].x() >= 0 &&
+           px[c].y() >= 0 && px[c].x() <= view.camera.width - 1 &&
+           px[c].y() <= view.camera.height - 1 &&
+           view.mask(int(std::lround(px[c].y())), int(std::lround(px[c].x())));
+    if (!ok) continue;
+    Eigen::Matrix2d P;
+    P << px[1] - px[0], px[2] - px[0];
+    usable[f] = 1;
+    jacobian[f] = P * S.inverse();
+  }
+  ViewRendering out{cv::Mat3b(height, width, cv::Vec3b(0, 0, 0)),
+                    cv::Mat1f(height, width, 0.0f)};
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      const int f = raster.face(y, x);
+      if (f < 0 || !usable[f]) continue;
+      const Triangle& t = m.triangles[f];
+      const cv::Vec2f b = raster.bary(y, x);
+      const Eigen::Vector3d p =
+          (1 - b[0] - b[1]) * m.world[t[0]] + b[0] * m.world[t[1]] + b[1] * m.world[t[2]];
+      Eigen::Vector2d px;
+      if (!ProjectDistorted(view.camera, lens, p, &px)) continue;
+      const Eigen::Matrix2d& J = jacobian[f];
+      const float Jf[4] = {float(J(0, 0)), float(J(0, 1)), float(J(1, 0)), float(J(1, 1))};
+      float colour[3];
+      sampler.Sample(float(px.x()), float(px.y()), Jf, antialias, colour);
+      out.colour(y, x) = cv::Vec3b(cv::saturate_cast<uchar>(colour[0]),
+                                   cv::saturate_cast<uchar>(colour[1]),
+                                   cv::saturate_cast<uchar>(colour[2]));
+      out.density(y, x) = float(std::sqrt(std::abs(J.determinant())));
+    }
+  }
+  return out;
+}
+
+// The affine map (output pixels) that moves `view` onto `reference` where
+// both show the page: SIFT matches between the two renderings, RANSAC.
+// Identity when fewer than `min_inliers` matches agree.
+cv::Matx23d Register(const cv::Mat3b& reference, const cv::Mat1b& reference_valid,
+                     const ViewRendering& view, int min_inliers, int* inliers) {
+  *inliers = 0;
+  const cv::Matx23d identity(1, 0, 0, 0, 1, 0);
+  cv::Mat grey_ref, grey_view;
+  cv::cvtColor(reference, grey_ref, cv::COLOR_BGR2GRAY);
+  cv::cvtColor(view.colour, grey_view, cv::COLOR_BGR2GRAY);
+  cv::Mat1b view_valid = view.density > 0;
+  // Keypoints away from the renderings' own borders.
+  cv::Mat1b ref_mask, view_mask;
+  cv::erode(reference_valid, ref_mask, cv::Mat(), cv::Point(-1, -1), 4);
+  cv::erode(view_valid, view_mask, cv::Mat(), cv::Point(-1, -1), 4);
+  // Only near the overlap: the reference far from the strips says nothing.
+  cv::Mat1b near_view;
+  cv::dilate(view_valid, near_view, cv::Mat(), cv::Point(-1, -1), 40);
+  ref_mask &= near_view;
+  if (cv::countNonZero(ref_mask) < 100 || cv::countNonZero(view_mask) < 100) return identity;
+  const cv::Ptr<cv::SIFT> sift = cv::SIFT::create(4000);
+  std::vector<cv::KeyPoint> kr, kv;
+  cv::Mat dr, dv;
+  sift->detectAndCompute(grey_ref, ref_mask, kr, dr);
+  sift->detectAndCompute(grey_view, view_mask, kv, dv);
+  if (kr.size() < size_t(min_inliers) || kv.size() < size_t(min_inliers)) return identity;
+  cv::BFMatcher matcher(cv::NORM_L2);
+  std::vector<std::vector<cv::DMatch>> knn;
+  matcher.knnMatch(dv, dr, knn, 2);
+  std::vector<cv::Point2f> from, to;
+  for (const auto& m : knn)
+    if (m.size() == 2 && m[0].distance < 0.8f * m[1].distance) {
+      from.push_back(kv[m[0].queryIdx].pt);
+      to.push_back(kr[m[0].trainIdx].pt);
+    }
+  if (from.size() < size_t(min_inliers)) return identity;
+  std::vector<uchar> keep;
+  const cv::Mat A = cv::estimateAffine2D(from, to, keep, cv::RANSAC, 3.0);
+  *inliers = cv::countNonZero(keep);
+  if (A.empty() || *inliers < min_inliers) return identity;
+  return cv::Matx23d(A);
+}
+
+// `view` moved by the affine map A (output pixels).
+ViewRendering Warp(const ViewRendering& view, const cv::Matx23d& A) {
+  ViewRendering out;
+  cv::warpAffine(view.colour, out.colour, A, view.colour.size(), cv::INTER_LINEAR);
+  cv::warpAffine(view.density, out.density, A, view.density.size(), cv::INTER_NEAREST);
+  // Bilinear colour at the rendering's edge mixes in the empty black.
+  cv::Mat1b inside = out.density > 0;
+  cv::erode(inside, inside, cv::Mat());
+  out.density.setTo(0, ~inside);
+  return out;
+}
+
+// How well `view` matches the reference where both show the page: the
+// correlation of their fine detail (grey minus its blur), -1..1; 0 when they
+// overlap in fewer than 500 pixels.
+double Agreement(const cv::Mat3b& reference, const cv::Mat1b& reference_valid,
+                 const ViewRendering& view) {
+  cv::Mat1b both = reference_valid & (view.density > 0);
+  cv::erode(both, both, cv::Mat(), cv::Point(-1, -1), 3);
+  if (cv::countNonZero(both) < 500) return 0;
+  auto detail = [](const cv::Mat3b& image) {
+    cv::Mat grey;
+    cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
+    cv::Mat1f f, low;
+    grey.convertTo(f, CV_32F);
+    cv::GaussianBlur(f, low, cv::Size(0, 0), 3);
+    return cv::Mat1f(f - low);
+  };
+  const cv::Mat1f a = detail(reference), b = detail(view.colour);
+  cv::Scalar ma, sa, mb, sb;
+  cv::meanStdDev(a, ma, sa, both);
+  cv::meanStdDev(b, mb, sb, both);
+  const cv::Mat1f prod = (a - ma[0]).mul(b - mb[0]);
+  return cv::mean(prod, both)[0] / (sa[0] * sb[0] + 1e-9);
+}
+
+}  // namespace
+
+cv::Mat1b TextureStrips(const std::vector<const ExtensionStrip*>& strips,
+                        const std::vector<ViewMask>& views, const std::vector<cv::Mat>& photos,
+                        const RadialDistortion& lens, double x0, double y0, double scale,
+                        bool antialias, const cv::Mat3b& reference_render,
+                        const cv::Mat1b& reference_valid, const cv::Mat1b& todo,
+                        cv::Mat3b* image, std::vector<ViewRegistration>* registrations) {
+  const int W = image->cols, H = image->rows;
+  cv::Mat1b done(H, W, uchar(0));
+  const StripMesh m = JoinStrips(strips, x0, y0, scale);
+  if (m.triangles.empty()) return done;
+  cv::Mat1f best(H, W, 0.0f);
+  for (size_t v = 0; v < views.size(); ++v) {
+    if (photos[v].empty()) continue;
+    const TextureSampler sampler(photos[v]);
+    ViewRendering r = RenderStripsFromView(m, views[v], lens, sampler, Eigen::Vector2d::Zero(),
+                                           W, H, antialias);
+    if (cv::countNonZero(r.density > 0) == 0) continue;
+    // The other view sees M where it is least sure (the page's cut edge in
+    // the reference view); move its texture onto the reference's where the
+    // two overlap (the strips' band rows run back over M).
+    ViewRegistration reg;
+    reg.view = int(v);
+    reg.agreement = Agreement(reference_render, reference_valid, r);
+    const cv::Matx23d A = Register(reference_render, reference_valid, r, 15, &reg.inliers);
+    if (reg.inliers >= 15) {
+      ViewRendering moved = Warp(r, A);
+      const double agreement = Agreement(reference_render, reference_valid, moved);
+      if (agreement > reg.agreement) {
+        reg.affine = A;
+        reg.agreement = agreement;
+        reg.moved = true;
+        r = moved;
+      }
+    }
+    // A view that does not match the reference where they overlap would
+    // repeat or misplace what the reference shows.
+    reg.used = reg.agreement >= kMinAgreement;
+    if (registrations) registrations->push_back(reg);
+    if (!reg.used) continue;
+    for (int y = 0; y < H; ++y)
+      for (int x = 0; x < W; ++x) {
+        const float d = r.density(y, x);
+        if (!todo(y, x) || !(d > best(y, x))) continue;
+        best(y, x) = d;
+        (*image)(y, x) = r.colour(y, x);
+        done(y, x) = 255;
+      }
+  }
+  return done;
+}
+
+}  // namespace docunfold::render

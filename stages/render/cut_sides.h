@@ -1,0 +1,144 @@
+// Where the page ends past the border of a reference image that cuts it
+// off. The reference view alone cannot tell: its mesh stops at the image
+// border. The other photos often see further: the surface is continued past
+// the mesh border (straight on, in M and M' alike), projected into each
+// other view, and the page edge is where it leaves that view's page mask.
+#pragma once
+
+#include <array>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include "common/camera.h"
+#include "common/grid_mesh.h"
+
+namespace docunfold::render {
+
+namespace fs = std::filesystem;
+
+// Radial lens distortion of the original photos (COLMAP's SIMPLE_RADIAL and
+// RADIAL: x_distorted = x (1 + k1 r^2 + k2 r^4) in normalised coordinates).
+// The reference image is undistorted; the other views are not.
+struct RadialDistortion {
+  double k1 = 0;
+  double k2 = 0;
+};
+
+// Pixel of a world point in an original (distorted) photo; false when it lies
+// behind the camera.
+bool ProjectDistorted(const PinholeCamera& camera, const RadialDistortion& lens,
+                      const Eigen::Vector3d& x_world, Eigen::Vector2d* pixel);
+
+// The page region found in another view (20_boundary/views/<name>/mask.png).
+struct ViewMask {
+  PinholeCamera camera;
+  cv::Mat1b mask;  // non-zero = page, camera.width x camera.height
+  fs::path file;
+  fs::path photo;  // the view's photo (empty: not known, not textured from)
+};
+
+struct CutSideOptions {
+  // How far past the mesh border the surface is continued, as a fraction of
+  // the visible part's extent along that axis (1: the page may be up to
+  // twice what the reference view shows of it).
+  double max_extension = 1.0;
+  // The continuation is the straight line through each border vertex and
+  // the vertex this fraction of the grid's rows (columns) inwards: far
+  // enough to average out the last rows' noise, near enough to stay on the
+  // panel next to the border.
+  double base_fraction = 0.1;
+  // Photo pixels this close to a photo's own border tell nothing: the page
+  // may be cut off there too, and a mask is least sure at the image border.
+  // Fraction of the photo's diagonal (0.01: 20 px at 1600x1200).
+  double frame_margin = 0.01;
+  // A crossing counts when the continued surface stays on the table for
+  // this many photo pixels past it (a notch in the mask is not the edge).
+  double confirm_px = 12;
+  // Where no view sees the edge: the quantile, over the border's columns, of
+  // how far past the side the views see page (0.9: the far end, less the
+  // odd column where a mask or the continued surface runs wide).
+  double seen_quantile = 0.9;
+  // Fewest crossings of the page edge (border columns times views) that
+  // place it.
+  int min_crossings = 8;
+  // Rows of the extension strip handed to render (its texture).
+  int strip_rows = 32;
+  // Rows of the strip that run back over the mesh, as far as the inner
+  // vertex of base_fraction.
+  int band_rows = 8;
+};
+
+// How another view's texture was moved onto the reference's.
+struct ViewRegistration {
+  int view = -1;
+  cv::Matx23d affine = cv::Matx23d(1, 0, 0, 0, 1, 0);  // output pixels
+  int inliers = 0;         // SIFT matches that agree on it
+  bool moved = false;      // the map was applied (it improved the agreement)
+  double agreement = 0;    // correlation of fine detail with the reference
+  bool used = false;       // agreement high enough for the view to be used
+};
+
+// The surface continued past a cut side up to its page edge, as a grid of
+// `cols` x `rows` vertices: column k runs out from the mesh border's vertex
+// k, row 0 lies on the border. Row-major like QuadGrid.
+struct ExtensionStrip {
+  int cols = 0;
+  int rows = 0;
+  std::vector<Eigen::Vector3d> mesh3d;  // M continued (world frame)
+  std::vector<Eigen::Vector2d> flat;    // M' continued (turned as `flat`)
+  // The first rows run back over the mesh (to register the other views'
+  // texture with the reference's); row band_rows lies on the border.
+  int band_rows = 0;
+};
+
+struct CutSideEdge {
+  bool measured = false;
+  // The page edge's coordinate in M' as render turns it (y for top and
+  // bottom, x for left and right), and how far it lies past the visible box.
+  double bound = 0;
+  double extension = 0;
+  // True: the bound is where the other views see the page edge (median of
+  // the crossings); false: no view sees the edge, and the bound is how far
+  // they see page (median over the border's columns of the farthest).
+  bool edge_seen = false;
+  int crossings = 0;     // border columns (in all views) that saw the edge
+  int columns_seen = 0;  // border columns some view sees page past
+  int views = 0;         // views with at least one crossing
+  std::string note;   // why it was not measured
+  ExtensionStrip strip;  // when measured and extension > 0
+};
+
+// For each side i (0 top, 1 right, 2 bottom, 3 left of M' turned as
+// `flat`) with cut[i] set: the page edge past that side of the mesh, seen in
+// `views`. `flat` is M' after render's deskew turn, `visible_box` (x0 y0 x1
+// y1) the box of the part of it the reference view sees.
+std::array<CutSideEdge, 4> FindCutSideEdges(const MeshPair& meshes,
+                                            const std::vector<Eigen::Vector2d>& flat,
+                                            const Eigen::Vector4d& visible_box,
+                                            const std::array<bool, 4>& cut,
+                                            const std::vector<ViewMask>& views,
+                                            const RadialDistortion& lens,
+                                            const CutSideOptions& options = {});
+
+// Textures the extension strips from the other views' photos. For every
+// pixel of `image` (output pixel (x, y) is the point (x0 + (x + 0.5) /
+// scale, y0 + (y + 0.5) / scale) of M') where `todo` is set and a strip
+// lies, the colour of the view that resolves it best among those whose page
+// mask holds the whole strip triangle. Each view's rendering is first
+// moved onto `reference_render` where the two overlap (`reference_valid`;
+// the strips' band rows) when SIFT matches agree on an affine map that
+// improves their agreement; a view whose detail then still does not
+// correlate with the reference's there is not used. `photos[v]` belongs to `views[v]` (empty: not
+// used). Returns the pixels textured (255).
+cv::Mat1b TextureStrips(const std::vector<const ExtensionStrip*>& strips,
+                        const std::vector<ViewMask>& views, const std::vector<cv::Mat>& photos,
+                        const RadialDistortion& lens, double x0, double y0, double scale,
+                        bool antialias, const cv::Mat3b& reference_render,
+                        const cv::Mat1b& reference_valid, const cv::Mat1b& todo,
+                        cv::Mat3b* image, std::vector<ViewRegistration>* registrations);
+
+}  // namespace docunfold::render
