@@ -339,11 +339,14 @@ cv::Matx23d Register(const cv::Mat3b& reference, const cv::Mat1b& reference_vali
   cv::dilate(view_valid, near_view, cv::Mat(), cv::Point(-1, -1), 40);
   ref_mask &= near_view;
   if (cv::countNonZero(ref_mask) < 100 || cv::countNonZero(view_mask) < 100) return identity;
+  // SIFT on the box of the view's rendering and its surroundings only (its
+  // pyramid over the whole output would cost most of render's time).
+  const cv::Rect box = cv::boundingRect(near_view);
   const cv::Ptr<cv::SIFT> sift = cv::SIFT::create(4000);
   std::vector<cv::KeyPoint> kr, kv;
   cv::Mat dr, dv;
-  sift->detectAndCompute(grey_ref, ref_mask, kr, dr);
-  sift->detectAndCompute(grey_view, view_mask, kv, dv);
+  sift->detectAndCompute(grey_ref(box), ref_mask(box), kr, dr);
+  sift->detectAndCompute(grey_view(box), view_mask(box), kv, dv);
   if (kr.size() < size_t(min_inliers) || kv.size() < size_t(min_inliers)) return identity;
   cv::BFMatcher matcher(cv::NORM_L2);
   std::vector<std::vector<cv::DMatch>> knn;
@@ -351,8 +354,8 @@ cv::Matx23d Register(const cv::Mat3b& reference, const cv::Mat1b& reference_vali
   std::vector<cv::Point2f> from, to;
   for (const auto& m : knn)
     if (m.size() == 2 && m[0].distance < 0.8f * m[1].distance) {
-      from.push_back(kv[m[0].queryIdx].pt);
-      to.push_back(kr[m[0].trainIdx].pt);
+      from.push_back(kv[m[0].queryIdx].pt + cv::Point2f(box.tl()));
+      to.push_back(kr[m[0].trainIdx].pt + cv::Point2f(box.tl()));
     }
   if (from.size() < size_t(min_inliers)) return identity;
   std::vector<uchar> keep;

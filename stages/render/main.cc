@@ -84,6 +84,11 @@ int main(int argc, char** argv) {
   app.add_flag(
       "--sample-hidden", o.sample_hidden,
       "sample the reference image also where it does not see the page");
+  app.add_option("--scattered-sides", o.scattered_sides,
+                 "a real side whose samples scatter about their line in M' bounds the crop "
+                 "by their median (median) or not at all (box: the part of M' the reference "
+                 "view sees)")
+      ->capture_default_str()->check(CLI::IsMember({"median", "box"}));
   bool no_extend = false, no_texture_cut = false;
   std::string images;
   app.add_option("--images", images,

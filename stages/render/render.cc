@@ -476,6 +476,7 @@ Json OptionsToJson(const RenderOptions& o) {
           {"crop_middle_max_deg", o.crop_middle_max_deg},
           {"extend_cut_sides", o.extend_cut_sides},
           {"texture_cut_sides", o.texture_cut_sides},
+          {"scattered_sides", o.scattered_sides},
           {"max_extension", o.cut_sides.max_extension}};
 }
 
@@ -518,6 +519,7 @@ Json MakeReport(const RenderOptions& options, const RenderInputs& in,
       j["rms"] = s.rms;
     }
     if (!s.note.empty()) j["note"] = s.note;
+    if (s.scattered) j["median_bound"] = s.median_bound;
     if (!s.real && options.extend_cut_sides) {
       const CutSideEdge& e = r.cut_edges[i];
       Json c = {{"measured", e.measured},
@@ -603,6 +605,7 @@ RenderResult Run(const RenderOptions& options, const RenderInputs& in) {
     // edge seen on M (the boundary runs over a fold, or M is far off there).
     if (r.sides[i].used && r.sides[i].rms > kMaxSideRms * flat_diagonal) {
       r.sides[i].used = false;
+      r.sides[i].scattered = true;
       r.sides[i].note = "samples scatter about their line (rms " +
                         std::to_string(r.sides[i].rms / flat_diagonal) +
                         " of M' diagonal)";
@@ -664,6 +667,17 @@ RenderResult Run(const RenderOptions& options, const RenderInputs& in) {
                              " past it, but not its edge (" + std::to_string(e.columns_seen) +
                              " columns)"));
     }
+  }
+  for (int i = 0; i < 4; ++i) {
+    if (!r.sides[i].scattered) continue;
+    std::vector<double> across;
+    for (const auto& p : side_points[i]) {
+      const Eigen::Vector2d q = rotation * p;
+      across.push_back(i % 2 == 0 ? q.y() : q.x());
+    }
+    r.sides[i].median_bound = Median(across);
+    if (options.scattered_sides == "median")
+      visible[i == 0 ? 1 : i == 1 ? 2 : i == 2 ? 3 : 0] = r.sides[i].median_bound;
   }
   CropRect crop = ChooseCrop(&r.sides, visible,
                              options.crop_rule == "middle" ? options.crop_middle_max_deg * M_PI / 180

@@ -98,6 +98,10 @@ struct RenderOptions {
   // (cut_sides.h) and extend the crop to it; the part no photo textures
   // gets the fill colour. Off: the crop stops where the reference view does.
   bool extend_cut_sides = true;
+  // A real side whose samples scatter about their line (a fold on the
+  // outline, M far off there) bounds the crop by the median of its samples
+  // ("median") or not at all ("box": the part of M' the reference sees).
+  std::string scattered_sides = "median";
   // Texture the page found past cut sides from the other photos that see
   // it (RenderInputs::views[].photo); off: the fill colour.
   bool texture_cut_sides = true;
@@ -135,6 +139,11 @@ struct SideFit {
   Eigen::Vector2d direction = Eigen::Vector2d::UnitX();  // unit
   double rms = 0;    // residual of the fit, M' units
   std::string note;  // why a real side was not used
+  // A real side whose samples scatter about their line: the median of their
+  // coordinate across it (y for top and bottom, x for left and right, M'
+  // after the deskew turn), which then bounds the crop (scattered_sides).
+  bool scattered = false;
+  double median_bound = 0;
 };
 
 struct RenderResult {

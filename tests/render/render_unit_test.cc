@@ -288,6 +288,38 @@ TEST(RenderScene, PartsTheReferenceViewCannotSeeAreFilled) {
   EXPECT_GT(cv::countNonZero(all.page_mask), cv::countNonZero(r.page_mask));
 }
 
+// A real side whose samples scatter about their line (a fold on the outline,
+// or M far off there) is not fitted, but the median of its samples still
+// bounds the crop; the mesh may run past the page there.
+TEST(RenderScene, ScatteredSideBoundsTheCropByItsMedian) {
+  SceneOptions o;
+  o.radius = 0;
+  SyntheticScene s = MakeScene(o);
+  // The outline says the page's left edge is at x = 0.05 of M' (the mesh
+  // runs 0.05 past it), ragged by +-10 pixels.
+  const double edge = 0.05;
+  const Eigen::Matrix3d tilt =
+      Eigen::AngleAxisd(o.tilt_deg * M_PI / 180, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  s.sides[3].clear();
+  for (int k = 0; k <= 60; ++k) {
+    const Eigen::Vector3d p = o.page_origin + tilt * Eigen::Vector3d(edge, o.page_h * k / 60, 0);
+    s.sides[3].push_back(s.camera.Project(p) + Eigen::Vector2d(k % 2 ? 10 : -10, 0));
+  }
+  s.sides[0].front() = s.camera.Project(o.page_origin + tilt * Eigen::Vector3d(edge, 0, 0));
+  s.sides[2].front() =
+      s.camera.Project(o.page_origin + tilt * Eigen::Vector3d(edge, o.page_h, 0));
+  const render::RenderResult r = render::Run({}, InputsOf(s));
+  ASSERT_TRUE(r.sides[3].scattered) << r.sides[3].note;
+  EXPECT_FALSE(r.sides[3].used);
+  const double px = 1 / r.pixels_per_unit;
+  EXPECT_NEAR(r.crop_x0, edge, 2 * px);
+  EXPECT_NEAR(r.crop_x1, o.page_w, px);
+  render::RenderOptions box;
+  box.scattered_sides = "box";
+  const render::RenderResult b = render::Run(box, InputsOf(s));
+  EXPECT_NEAR(b.crop_x0, 0.0, px);  // the mesh's border
+}
+
 TEST(RenderScene, TiltedFlatMeshIsTurnedUpright) {
   SyntheticScene s = MakeScene({});
   const double angle = 3 * M_PI / 180;
