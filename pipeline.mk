@@ -175,8 +175,8 @@ $(OPTIMIZE_OUT) &: $(BIN)/optimize $(WORK)/.flags/optimize $(INIT_OUT) $(SFM_IN)
 MESH_STAGE := $(if $(wildcard $(ROOT)/stages/optimize),50_optimize,40_init)
 RENDER_OUT := $(addprefix $(WORK)/60_render/,rectified.png rectified_grid.png)
 render: check-data $(if $(wildcard $(ROOT)/stages/optimize),optimize,init) $(RENDER_OUT)
-$(RENDER_OUT) &: $(BIN)/render $(WORK)/.flags/render $(WORK)/$(MESH_STAGE)/mesh3d.ply $(WORK)/$(MESH_STAGE)/mesh2d.ply $(SFM_IN) $(BOUNDARY_IN)
-	$(call timed,render) $(BIN)/render --sfm $(WORK)/10_sfm --boundary $(WORK)/20_boundary --meshes $(WORK)/$(MESH_STAGE) --out $(WORK)/60_render --images $(DATA_DIR)/images $(RENDER_FLAGS)
+$(RENDER_OUT) &: $(BIN)/render $(WORK)/.flags/render $(WORK)/$(MESH_STAGE)/mesh3d.ply $(WORK)/$(MESH_STAGE)/mesh2d.ply $(SFM_IN) $(BOUNDARY_IN) $(WORK)/30_features/features.json
+	$(call timed,render) $(BIN)/render --sfm $(WORK)/10_sfm --boundary $(WORK)/20_boundary --meshes $(WORK)/$(MESH_STAGE) --out $(WORK)/60_render --images $(DATA_DIR)/images --features $(WORK)/30_features/features.json $(RENDER_FLAGS)
 
 EVAL_OUT := $(WORK)/70_eval/metrics.json
 evaluate: check-data render $(EVAL_OUT)

@@ -149,7 +149,8 @@ make_row_docunfold-init() {
   [[ -d $work/50_optimize ]] || { reason="same as docunfold (no optimize)"; return 1; }
   mesh_dir=$work/40_init
   timed docunfold-init "$bin/render" --sfm "$work/10_sfm" --boundary "$work/20_boundary" \
-    --meshes "$work/40_init" --out "$work/60_render_init" --images "$data/images" || return
+    --meshes "$work/40_init" --out "$work/60_render_init" --images "$data/images" \
+    --features "$work/30_features/features.json" || return
   image=$work/60_render_init/rectified.png
 }
 # The point cloud pipeline.mk gave init-mesh and optimize (densify's when it ran).
@@ -166,7 +167,8 @@ optimize_variant() {  # optimize_variant <row> <suffix> <optimize flag>
     --features "$work/30_features/features.json" --init "$work/40_init" \
     $(points_args) --out "$mesh_dir" "$flag" || return
   timed "$row" "$bin/render" --sfm "$work/10_sfm" --boundary "$work/20_boundary" \
-    --meshes "$mesh_dir" --out "$work/60_render_$suffix" --images "$data/images" || return
+    --meshes "$mesh_dir" --out "$work/60_render_$suffix" --images "$data/images" \
+    --features "$work/30_features/features.json" || return
   image=$work/60_render_$suffix/rectified.png
 }
 make_row_docunfold-nofeatures() { optimize_variant docunfold-nofeatures nofeatures --no-features; }

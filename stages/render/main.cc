@@ -90,7 +90,11 @@ int main(int argc, char** argv) {
                  "view sees)")
       ->capture_default_str()->check(CLI::IsMember({"median", "box"}));
   bool no_extend = false, no_texture_cut = false;
-  std::string images;
+  std::string images, features;
+  app.add_option("--features", features,
+                 "features.json (30_features/): when Tesseract cannot tell which way up the "
+                 "page is and the meshes have no lines.json beside them (init-mesh's), the "
+                 "side the text's baselines lie on decides");
   app.add_option("--images", images,
                  "the photos (<data>/images): the page found past a cut side is textured "
                  "from the other views that see it (without: the fill colour)");
@@ -112,7 +116,7 @@ int main(int argc, char** argv) {
     o.extend_cut_sides = !no_extend;
     o.texture_cut_sides = !no_texture_cut;
     const render::RenderInputs in =
-        render::ReadRenderInputs(sfm, boundary, meshes, images);
+        render::ReadRenderInputs(sfm, boundary, meshes, images, features);
     const double read_s = SecondsSince(start);
     render::RenderResult result = render::Run(o, in);
     result.report["timing_s"]["read"] = read_s;

@@ -564,6 +564,30 @@ Json MakeReport(const RenderOptions& options, const RenderInputs& in,
   return doc;
 }
 
+
+// The reader's down `down_image` (reference pixels) carried into M': the
+// least-squares affine map pixel -> M' over the text segments' points that
+// lie on M. nullopt when fewer than 10 do.
+std::optional<Eigen::Vector2d> DownInFlat(const RenderInputs& in, const PixelToSurface& lookup,
+                                          const Eigen::Vector2d& down_image) {
+  Eigen::Matrix3d ata = Eigen::Matrix3d::Zero();
+  Eigen::Matrix<double, 3, 2> atb = Eigen::Matrix<double, 3, 2>::Zero();
+  int n = 0;
+  for (const Eigen::Vector2d& p : in.text_points) {
+    const auto sp = lookup.Lookup(p);
+    if (!sp) continue;
+    const Eigen::Vector3d a(p.x(), p.y(), 1);
+    ata += a * a.transpose();
+    atb += a * PointOnMesh2d(in.meshes, *sp).transpose();
+    ++n;
+  }
+  if (n < 10 || !(std::abs(ata.determinant()) > 1e-12)) return std::nullopt;
+  const Eigen::Matrix<double, 3, 2> x = ata.ldlt().solve(atb);
+  const Eigen::Vector2d down = x.topRows<2>().transpose() * down_image;
+  if (!(down.norm() > 0)) return std::nullopt;
+  return down.normalized();
+}
+
 }  // namespace
 
 RenderResult Run(const RenderOptions& options, const RenderInputs& in) {
@@ -764,17 +788,25 @@ RenderResult Run(const RenderOptions& options, const RenderInputs& in) {
   Json orientation = {{"checked", options.orient}};
   if (options.orient) {
     Orientation o = FindOrientation(r.rectified);
-    if (!o.decided && in.text_down) {
+    // The reader's down in M': lines.json's, else features.json's carried
+    // into M' here; (0, 0) when neither is known.
+    Eigen::Vector2d down = in.text_down.value_or(Eigen::Vector2d::Zero());
+    std::string down_from = "lines.json";
+    if (!in.text_down && in.text_down_image) {
+      down = DownInFlat(in, lookup, *in.text_down_image).value_or(Eigen::Vector2d::Zero());
+      down_from = "features.json";
+    }
+    if (!o.decided && down.norm() > 0) {
       // Print too small to read: the side the baselines lie on (found by
-      // detect-features, carried into M' by optimize) says which way is
-      // down. Output y is M' turned by `angle`; turn so that down is +y.
-      const Eigen::Vector2d d = Eigen::Rotation2Dd(angle) * *in.text_down;
+      // detect-features, carried into M' by optimize or here) says which way
+      // is down. Output y is M' turned by `angle`; turn so that down is +y.
+      const Eigen::Vector2d d = Eigen::Rotation2Dd(angle) * down;
       // Clockwise quarter turns map the image's down (0, 1) to: 0 -> (0, 1),
       // 1 -> (-1, 0), 2 -> (0, -1), 3 -> (1, 0); pick the one taking d there.
       const int turns = std::abs(d.y()) >= std::abs(d.x()) ? (d.y() > 0 ? 0 : 2)
                                                            : (d.x() > 0 ? 1 : 3);
       o.quarter_turns = turns;
-      o.note += "; turned by the side the text's baselines lie on (lines.json)";
+      o.note += "; turned by the side the text's baselines lie on (" + down_from + ")";
       orientation["by"] = "baselines";
     }
     orientation["readable_words"] = o.words;

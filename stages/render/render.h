@@ -121,6 +121,11 @@ struct RenderInputs {
   // The reader's down in M' (lines.json text_down_flat), when known: which
   // way up the page is when Tesseract cannot read its print.
   std::optional<Eigen::Vector2d> text_down;
+  // Without lines.json (init-mesh's meshes): the reader's down in the
+  // reference image (features.json text_down) and the points of the text
+  // segments, which carry it into M'.
+  std::optional<Eigen::Vector2d> text_down_image;
+  std::vector<Eigen::Vector2d> text_points;
   // Page masks of the other views (20_boundary/views/<name>/mask.png, when
   // segment-boundary was given --views) and their lens distortion.
   std::vector<ViewMask> views;
@@ -180,10 +185,13 @@ struct RenderResult {
 // Reads and validates everything render needs; InputError naming the file
 // and the problem otherwise.
 // `images_dir` (optional): the photos, for the page past cut sides.
+// `features_file` (optional): features.json, for which way up the page is
+// when Tesseract cannot tell and there is no lines.json beside the meshes.
 RenderInputs ReadRenderInputs(const fs::path& sfm_dir,
                               const fs::path& boundary_dir,
                               const fs::path& meshes_dir,
-                              const fs::path& images_dir = {});
+                              const fs::path& images_dir = {},
+                              const fs::path& features_file = {});
 
 // Renders the rectified page. Throws InputError for inconsistent inputs
 // (image sizes, mesh behind the camera or out of view) and UsageError for

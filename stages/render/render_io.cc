@@ -13,7 +13,8 @@ namespace docunfold::render {
 RenderInputs ReadRenderInputs(const fs::path& sfm_dir,
                               const fs::path& boundary_dir,
                               const fs::path& meshes_dir,
-                              const fs::path& images_dir) {
+                              const fs::path& images_dir,
+                              const fs::path& features_file) {
   RenderInputs in;
   in.cameras_file = sfm_dir / "cameras.json";
   in.reference_file = sfm_dir / "reference.png";
@@ -88,6 +89,16 @@ RenderInputs ReadRenderInputs(const fs::path& sfm_dir,
       }
       if (hi > lo && std::isfinite(hi - lo))
         in.lines.push_back({std::atan2(n.y(), n.x()) * 180 / M_PI, hi - lo});
+    }
+  }
+  if (!features_file.empty() && !in.text_down) {
+    const FeatureFile features = ReadFeatures(features_file);
+    if (features.text_down) {
+      in.text_down_image = features.text_down;
+      for (const FeatureSegment& segment : features.segments)
+        if (segment.kind == "text")
+          in.text_points.insert(in.text_points.end(), segment.points.begin(),
+                                segment.points.end());
     }
   }
   return in;

@@ -164,6 +164,29 @@ TEST_F(RenderCli, DeskewFollowsTheLinesOfLinesJson) {
     EXPECT_EQ(o["quarter_turns_clockwise"], turns) << o.dump();
     EXPECT_EQ(o["by"], "baselines") << o.dump();
   }
+  // Without lines.json (init-mesh's meshes), features.json's down in the
+  // reference image, carried into M' through the text segments, does it.
+  fs::remove(work / "40_init/lines.json");
+  for (const auto& [down, turns] : std::vector<std::pair<double, int>>{{1, 1}, {-1, 3}}) {
+    Json segments = Json::array();
+    for (int y = 200; y <= 300; y += 10)
+      segments.push_back({{"kind", "text"}, {"points", {{260, y}, {320, y}, {380, y}}}});
+    const fs::path features = work / ("features" + std::to_string(turns) + ".json");
+    WriteJsonAtomic(features, {{"format", "docunfold.features"},
+                               {"version", 1},
+                               {"segments", segments},
+                               {"text_down", {down, 0.0}}});
+    const std::string name = "features" + std::to_string(turns);
+    ASSERT_EQ(Render(work, dir_ / name, "--width 100 --features " + Quote(features.string()))
+                  .exit_code,
+              0);
+    const Json o = ReadJsonFile(dir_ / name / "render.json")["orientation"];
+    EXPECT_EQ(o["quarter_turns_clockwise"], turns) << o.dump();
+    EXPECT_NE(o.value("note", "").find("features.json"), std::string::npos) << o.dump();
+  }
+  ExpectFailure(Render(work, dir_ / "nofeatures", "--features " +
+                                                    Quote((work / "none.json").string())),
+                3, "none.json", dir_ / "nofeatures");
   WriteTextAtomic(work / "40_init/lines.json", "{\"lines\": [{\"normal\": [0, 1]}]}");
   ExpectFailure(Render(work, dir_ / "broken"), 3, "lines.json:/lines/0", dir_ / "broken");
   WriteTextAtomic(work / "40_init/lines.json",
