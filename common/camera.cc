@@ -1,5 +1,7 @@
 #include "common/camera.h"
 
+#include <cmath>
+
 #include "common/errors.h"
 
 namespace docunfold {
@@ -42,6 +44,34 @@ CameraSet ReadCameras(const fs::path& path) {
   if (!set.reference.empty() && !set.Find(set.reference))
     r.Fail("/reference", "names no view in /views");
   return set;
+}
+
+std::array<double, 4> ReadDistortion(const JsonReader& r, const std::string& view_pointer) {
+  std::array<double, 4> d{};
+  const std::string pointer = view_pointer + "/distortion";
+  if (!r.Has(pointer)) return d;
+  if (r.String(pointer + "/model") != "opencv")
+    r.Fail(pointer + "/model", "only the \"opencv\" model (k1 k2 p1 p2) is understood");
+  const Json& c = r.At(pointer + "/coefficients");
+  if (!c.is_array() || c.size() != 4) r.Fail(pointer + "/coefficients", "expected 4 numbers");
+  for (int i = 0; i < 4; ++i) d[i] = r.Number(pointer + "/coefficients/" + std::to_string(i));
+  return d;
+}
+
+std::optional<Eigen::Vector2d> ProjectDistorted(const PinholeCamera& camera,
+                                                const std::array<double, 4>& d,
+                                                const Eigen::Vector3d& x_world) {
+  const Eigen::Vector3d x = camera.CamFromWorld(x_world);
+  if (!(x.z() > 0)) return std::nullopt;
+  const double u = x.x() / x.z(), v = x.y() / x.z();
+  const double r2 = u * u + v * v;
+  const double radial = 1 + d[0] * r2 + d[1] * r2 * r2;
+  const double ud = u * radial + 2 * d[2] * u * v + d[3] * (r2 + 2 * u * u);
+  const double vd = v * radial + d[2] * (r2 + 2 * v * v) + 2 * d[3] * u * v;
+  const Eigen::Vector3d p = camera.K * Eigen::Vector3d(ud, vd, 1);
+  const Eigen::Vector2d pixel = p.head<2>() / p.z();
+  if (!std::isfinite(pixel.x()) || !std::isfinite(pixel.y())) return std::nullopt;
+  return pixel;
 }
 
 Json CameraToJson(const PinholeCamera& c) {

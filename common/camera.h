@@ -2,6 +2,7 @@
 // at integer coordinates) and the cameras.json files that hold sets of them.
 #pragma once
 
+#include <array>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -53,6 +54,18 @@ struct CameraSet {
 
 // Reads either format; validates shapes and finiteness (throws InputError).
 CameraSet ReadCameras(const fs::path& path);
+
+// The lens distortion of a view's photo as sfm's cameras.json gives it
+// ("distortion": {"model": "opencv", "coefficients": [k1, k2, p1, p2]} under
+// `view_pointer`, e.g. "/views/2"); zeros when absent (an undistorted image,
+// like reference.png). InputError for another model or a malformed entry.
+std::array<double, 4> ReadDistortion(const JsonReader& r, const std::string& view_pointer);
+
+// Pixel of a world point in a photo with OpenCV's distortion (k1 k2 p1 p2);
+// nullopt behind the camera.
+std::optional<Eigen::Vector2d> ProjectDistorted(const PinholeCamera& camera,
+                                                const std::array<double, 4>& distortion,
+                                                const Eigen::Vector3d& x_world);
 
 // JSON for one camera: {"image","width","height","K","R","t"}.
 Json CameraToJson(const PinholeCamera& camera);

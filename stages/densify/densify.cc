@@ -557,17 +557,6 @@ void AddOutlinePoints(const View& ref, const std::vector<View>& others, int num_
   }
 }
 
-std::array<double, 4> ReadDistortion(const JsonReader& r, const std::string& view) {
-  std::array<double, 4> d{};
-  const std::string pointer = view + "/distortion";
-  if (!r.Has(pointer)) return d;
-  if (r.String(pointer + "/model") != "opencv")
-    r.Fail(pointer + "/model", "only the \"opencv\" model (k1 k2 p1 p2) is understood");
-  const Json& c = r.At(pointer + "/coefficients");
-  if (!c.is_array() || c.size() != 4) r.Fail(pointer + "/coefficients", "expected 4 numbers");
-  for (int i = 0; i < 4; ++i) d[i] = r.Number(pointer + "/coefficients/" + std::to_string(i));
-  return d;
-}
 
 }  // namespace
 

@@ -13,18 +13,6 @@
 
 namespace docunfold::render {
 
-bool ProjectDistorted(const PinholeCamera& camera, const RadialDistortion& lens,
-                      const Eigen::Vector3d& x_world, Eigen::Vector2d* pixel) {
-  const Eigen::Vector3d x = camera.CamFromWorld(x_world);
-  if (!(x.z() > 0)) return false;
-  const double u = x.x() / x.z(), v = x.y() / x.z();
-  const double r2 = u * u + v * v;
-  const double f = 1 + lens.k1 * r2 + lens.k2 * r2 * r2;
-  const Eigen::Vector3d p = camera.K * Eigen::Vector3d(u * f, v * f, 1);
-  *pixel = p.head<2>() / p.z();
-  return std::isfinite(pixel->x()) && std::isfinite(pixel->y());
-}
-
 namespace {
 
 // Outward normal of side i of M' (y down): top, right, bottom, left.
@@ -71,7 +59,6 @@ std::array<CutSideEdge, 4> FindCutSideEdges(const MeshPair& meshes,
                                             const Eigen::Vector4d& visible_box,
                                             const std::array<bool, 4>& cut,
                                             const std::vector<ViewMask>& views,
-                                            const RadialDistortion& lens,
                                             const CutSideOptions& options) {
   std::array<CutSideEdge, 4> edges;
   const QuadGrid& g = meshes.grid;
@@ -127,8 +114,11 @@ std::array<CutSideEdge, 4> FindCutSideEdges(const MeshPair& meshes,
                          std::hypot(view.camera.width, view.camera.height);
         // -1 unseen (behind the camera or off the photo), 0 table, 1 page.
         auto state_at = [&](int j, Eigen::Vector2d* px) {
-          if (!ProjectDistorted(view.camera, lens, meshes.mesh3d[vb] + j * dt * d3, px) ||
-              !(px->x() >= m && px->y() >= m && px->x() <= view.camera.width - 1 - m &&
+          const auto projected =
+              ProjectDistorted(view.camera, view.distortion, meshes.mesh3d[vb] + j * dt * d3);
+          if (!projected) return -1;
+          *px = *projected;
+          if (!(px->x() >= m && px->y() >= m && px->x() <= view.camera.width - 1 - m &&
                 px->y() <= view.camera.height - 1 - m))
             return -1;
           return view.mask(int(std::lround(px->y())), int(std::lround(px->x()))) ? 1 : 0;
@@ -266,11 +256,9 @@ struct ViewRendering {
 };
 
 ViewRendering RenderStripsFromView(const StripMesh& m, const ViewMask& view,
-                                   const RadialDistortion& lens, const TextureSampler& sampler,
-                                   const Eigen::Vector2d& shift, int width, int height,
+                                   const TextureSampler& sampler, int width, int height,
                                    bool antialias) {
-  std::vector<Eigen::Vector3d> screen = m.screen;
-  for (auto& p : screen) p.head<2>() += shift;
+  const std::vector<Eigen::Vector3d>& screen = m.screen;
   const RasterResult raster = Rasterize(screen, m.triangles, width, height);
   // Per triangle: all corners on the view's page mask, and the affine map
   // output pixel -> view pixel (the footprint).
@@ -283,11 +271,13 @@ ViewRendering RenderStripsFromView(const StripMesh& m, const ViewMask& view,
     if (!(std::abs(S.determinant()) > 1e-9)) continue;
     Eigen::Vector2d px[3];
     bool ok = true;
-    for (int c = 0; c < 3 && ok; ++c)
-      ok = ProjectDistorted(view.camera, lens, m.world[t[c]], &px[c]) && px[c].x() >= 0 &&
-           px[c].y() >= 0 && px[c].x() <= view.camera.width - 1 &&
-           px[c].y() <= view.camera.height - 1 &&
+    for (int c = 0; c < 3 && ok; ++c) {
+      const auto projected = ProjectDistorted(view.camera, view.distortion, m.world[t[c]]);
+      if (projected) px[c] = *projected;
+      ok = projected && px[c].x() >= 0 && px[c].y() >= 0 &&
+           px[c].x() <= view.camera.width - 1 && px[c].y() <= view.camera.height - 1 &&
            view.mask(int(std::lround(px[c].y())), int(std::lround(px[c].x())));
+    }
     if (!ok) continue;
     Eigen::Matrix2d P;
     P << px[1] - px[0], px[2] - px[0];
@@ -304,8 +294,9 @@ ViewRendering RenderStripsFromView(const StripMesh& m, const ViewMask& view,
       const cv::Vec2f b = raster.bary(y, x);
       const Eigen::Vector3d p =
           (1 - b[0] - b[1]) * m.world[t[0]] + b[0] * m.world[t[1]] + b[1] * m.world[t[2]];
-      Eigen::Vector2d px;
-      if (!ProjectDistorted(view.camera, lens, p, &px)) continue;
+      const auto projected = ProjectDistorted(view.camera, view.distortion, p);
+      if (!projected) continue;
+      const Eigen::Vector2d px = *projected;
       const Eigen::Matrix2d& J = jacobian[f];
       const float Jf[4] = {float(J(0, 0)), float(J(0, 1)), float(J(1, 0)), float(J(1, 1))};
       float colour[3];
@@ -405,7 +396,7 @@ double Agreement(const cv::Mat3b& reference, const cv::Mat1b& reference_valid,
 
 cv::Mat1b TextureStrips(const std::vector<const ExtensionStrip*>& strips,
                         const std::vector<ViewMask>& views, const std::vector<cv::Mat>& photos,
-                        const RadialDistortion& lens, double x0, double y0, double scale,
+                        double x0, double y0, double scale,
                         bool antialias, const cv::Mat3b& reference_render,
                         const cv::Mat1b& reference_valid, const cv::Mat1b& todo,
                         cv::Mat3b* image, std::vector<ViewRegistration>* registrations) {
@@ -417,8 +408,7 @@ cv::Mat1b TextureStrips(const std::vector<const ExtensionStrip*>& strips,
   for (size_t v = 0; v < views.size(); ++v) {
     if (photos[v].empty()) continue;
     const TextureSampler sampler(photos[v]);
-    ViewRendering r = RenderStripsFromView(m, views[v], lens, sampler, Eigen::Vector2d::Zero(),
-                                           W, H, antialias);
+    ViewRendering r = RenderStripsFromView(m, views[v], sampler, W, H, antialias);
     if (cv::countNonZero(r.density > 0) == 0) continue;
     // The other view sees M where it is least sure (the page's cut edge in
     // the reference view); move its texture onto the reference's where the

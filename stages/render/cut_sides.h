@@ -20,25 +20,15 @@ namespace docunfold::render {
 
 namespace fs = std::filesystem;
 
-// Radial lens distortion of the original photos (COLMAP's SIMPLE_RADIAL and
-// RADIAL: x_distorted = x (1 + k1 r^2 + k2 r^4) in normalised coordinates).
-// The reference image is undistorted; the other views are not.
-struct RadialDistortion {
-  double k1 = 0;
-  double k2 = 0;
-};
-
-// Pixel of a world point in an original (distorted) photo; false when it lies
-// behind the camera.
-bool ProjectDistorted(const PinholeCamera& camera, const RadialDistortion& lens,
-                      const Eigen::Vector3d& x_world, Eigen::Vector2d* pixel);
-
 // The page region found in another view (20_boundary/views/<name>/mask.png).
 struct ViewMask {
   PinholeCamera camera;
   cv::Mat1b mask;  // non-zero = page, camera.width x camera.height
   fs::path file;
   fs::path photo;  // the view's photo (empty: not known, not textured from)
+  // The photo's lens distortion (OpenCV k1 k2 p1 p2; cameras.json): the
+  // masks and photos are of the original, not undistorted, images.
+  std::array<double, 4> distortion{};
 };
 
 struct CutSideOptions {
@@ -121,7 +111,6 @@ std::array<CutSideEdge, 4> FindCutSideEdges(const MeshPair& meshes,
                                             const Eigen::Vector4d& visible_box,
                                             const std::array<bool, 4>& cut,
                                             const std::vector<ViewMask>& views,
-                                            const RadialDistortion& lens,
                                             const CutSideOptions& options = {});
 
 // Textures the extension strips from the other views' photos. For every
@@ -136,7 +125,7 @@ std::array<CutSideEdge, 4> FindCutSideEdges(const MeshPair& meshes,
 // used). Returns the pixels textured (255).
 cv::Mat1b TextureStrips(const std::vector<const ExtensionStrip*>& strips,
                         const std::vector<ViewMask>& views, const std::vector<cv::Mat>& photos,
-                        const RadialDistortion& lens, double x0, double y0, double scale,
+                        double x0, double y0, double scale,
                         bool antialias, const cv::Mat3b& reference_render,
                         const cv::Mat1b& reference_valid, const cv::Mat1b& todo,
                         cv::Mat3b* image, std::vector<ViewRegistration>* registrations);

@@ -670,7 +670,7 @@ RenderResult Run(const RenderOptions& options, const RenderInputs& in) {
     std::array<bool, 4> cut;
     for (int i = 0; i < 4; ++i) cut[i] = !in.boundary.sides[i].real;
     r.cut_edges =
-        FindCutSideEdges(in.meshes, flat, visible, cut, in.views, in.lens, options.cut_sides);
+        FindCutSideEdges(in.meshes, flat, visible, cut, in.views, options.cut_sides);
     for (int i = 0; i < 4; ++i) {
       if (!cut[i]) continue;
       const CutSideEdge& e = r.cut_edges[i];
@@ -764,7 +764,7 @@ RenderResult Run(const RenderOptions& options, const RenderInputs& in) {
     }
     const cv::Mat3b reference_render = image.clone();
     const cv::Mat1b textured = TextureStrips(
-        strips, in.views, photos, in.lens, r.crop_x0, r.crop_y0, size.scale, options.antialias,
+        strips, in.views, photos, r.crop_x0, r.crop_y0, size.scale, options.antialias,
         reference_render, state == kPage, state == kOutside, &image, &r.registrations);
     state.setTo(kOtherView, textured);
     r.other_view_fraction = cv::countNonZero(textured) / (double(size.width) * size.height);

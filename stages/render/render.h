@@ -127,9 +127,8 @@ struct RenderInputs {
   std::optional<Eigen::Vector2d> text_down_image;
   std::vector<Eigen::Vector2d> text_points;
   // Page masks of the other views (20_boundary/views/<name>/mask.png, when
-  // segment-boundary was given --views) and their lens distortion.
+  // segment-boundary was given --views), with their cameras and photos.
   std::vector<ViewMask> views;
-  RadialDistortion lens;
   // Where each input came from, for error messages and the report.
   fs::path cameras_file, reference_file, meshes_dir;
 };

@@ -28,9 +28,12 @@ RenderInputs ReadRenderInputs(const fs::path& sfm_dir,
   in.camera = *cameras.Find(cameras.reference);
   in.reference = ReadImage(in.reference_file, cv::IMREAD_COLOR);
   in.boundary = ReadBoundary(boundary_dir / "boundary.json");
-  // The other views' page masks, where segment-boundary found them; their
-  // photos are not undistorted, so the lens model comes along.
-  for (const PinholeCamera& view : cameras.views) {
+  // The other views' page masks, where segment-boundary found them, with
+  // the distortion of their (original, not undistorted) photos.
+  const Json cameras_doc = ReadJsonFile(in.cameras_file);
+  const JsonReader cameras_reader(cameras_doc, in.cameras_file);
+  for (size_t i = 0; i < cameras.views.size(); ++i) {
+    const PinholeCamera& view = cameras.views[i];
     if (view.image == cameras.reference) continue;
     const fs::path mask_file =
         boundary_dir / "views" / fs::path(view.image).stem() / "mask.png";
@@ -43,24 +46,9 @@ RenderInputs ReadRenderInputs(const fs::path& sfm_dir,
         throw InputError(photo.string() + ": no such file (a view in " +
                          in.cameras_file.string() + ")");
     }
-    in.views.push_back(
-        {view, ReadDocumentMask(mask_file, view.width, view.height), mask_file, photo});
-  }
-  {
-    const Json doc = ReadJsonFile(in.cameras_file);
-    const JsonReader r(doc, in.cameras_file);
-    if (r.Has("/colmap/camera_model") && r.Has("/colmap/params")) {
-      const std::string model = r.String("/colmap/camera_model");
-      const Json& params = r.At("/colmap/params");
-      // COLMAP's parameter order: f, cx, cy, k (SIMPLE_RADIAL);
-      // f, cx, cy, k1, k2 (RADIAL).
-      if (model == "SIMPLE_RADIAL" && params.size() == 4) {
-        in.lens.k1 = r.Number("/colmap/params/3");
-      } else if (model == "RADIAL" && params.size() == 5) {
-        in.lens.k1 = r.Number("/colmap/params/3");
-        in.lens.k2 = r.Number("/colmap/params/4");
-      }
-    }
+    in.views.push_back({view, ReadDocumentMask(mask_file, view.width, view.height), mask_file,
+                        photo,
+                        ReadDistortion(cameras_reader, "/views/" + std::to_string(i))});
   }
   std::error_code ec;
   if (!fs::is_directory(meshes_dir, ec))
