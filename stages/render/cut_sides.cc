@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
-
 #include <opencv2/calib3d.hpp>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
@@ -35,10 +34,22 @@ Border GridBorder(const QuadGrid& g, int b, int depth) {
   const int n = along_row ? g.nx : g.ny;
   for (int k = 0; k < n; ++k) {
     switch (b) {
-      case 0: border.vertex.push_back(g.Index(0, k)); border.inner.push_back(g.Index(depth, k)); break;
-      case 1: border.vertex.push_back(g.Index(k, g.nx - 1)); border.inner.push_back(g.Index(k, g.nx - 1 - depth)); break;
-      case 2: border.vertex.push_back(g.Index(g.ny - 1, k)); border.inner.push_back(g.Index(g.ny - 1 - depth, k)); break;
-      default: border.vertex.push_back(g.Index(k, 0)); border.inner.push_back(g.Index(k, depth)); break;
+      case 0:
+        border.vertex.push_back(g.Index(0, k));
+        border.inner.push_back(g.Index(depth, k));
+        break;
+      case 1:
+        border.vertex.push_back(g.Index(k, g.nx - 1));
+        border.inner.push_back(g.Index(k, g.nx - 1 - depth));
+        break;
+      case 2:
+        border.vertex.push_back(g.Index(g.ny - 1, k));
+        border.inner.push_back(g.Index(g.ny - 1 - depth, k));
+        break;
+      default:
+        border.vertex.push_back(g.Index(k, 0));
+        border.inner.push_back(g.Index(k, depth));
+        break;
     }
   }
   return border;
@@ -54,12 +65,10 @@ double Median(std::vector<double> v) { return Quantile(std::move(v), 0.5); }
 
 }  // namespace
 
-std::array<CutSideEdge, 4> FindCutSideEdges(const MeshPair& meshes,
-                                            const std::vector<Eigen::Vector2d>& flat,
-                                            const Eigen::Vector4d& visible_box,
-                                            const std::array<bool, 4>& cut,
-                                            const std::vector<ViewMask>& views,
-                                            const CutSideOptions& options) {
+std::array<CutSideEdge, 4> FindCutSideEdges(
+    const MeshPair& meshes, const std::vector<Eigen::Vector2d>& flat,
+    const Eigen::Vector4d& visible_box, const std::array<bool, 4>& cut,
+    const std::vector<ViewMask>& views, const CutSideOptions& options) {
   std::array<CutSideEdge, 4> edges;
   const QuadGrid& g = meshes.grid;
   if (g.nx < 3 || g.ny < 3) return edges;
@@ -87,19 +96,22 @@ std::array<CutSideEdge, 4> FindCutSideEdges(const MeshPair& meshes,
       }
     }
     const int rows_inward = (best == 0 || best == 2) ? g.ny - 1 : g.nx - 1;
-    const int depth = std::clamp(int(std::lround(options.base_fraction * rows_inward)), 1,
-                                 rows_inward);
+    const int depth = std::clamp(
+        int(std::lround(options.base_fraction * rows_inward)), 1, rows_inward);
     const Border border = GridBorder(g, best, depth);
     constexpr int kStepsPerExtent = 400;
     std::vector<double> crossings;
     std::vector<double> seen_page;  // per column: the farthest page seen
     // Per border column: the continuation's direction (per step of t).
-    std::vector<Eigen::Vector3d> dir3(border.vertex.size(), Eigen::Vector3d::Zero());
-    std::vector<Eigen::Vector2d> dir2(border.vertex.size(), Eigen::Vector2d::Zero());
+    std::vector<Eigen::Vector3d> dir3(border.vertex.size(),
+                                      Eigen::Vector3d::Zero());
+    std::vector<Eigen::Vector2d> dir2(border.vertex.size(),
+                                      Eigen::Vector2d::Zero());
     std::vector<char> view_crossed(views.size(), 0);
     for (size_t k = 0; k < border.vertex.size(); ++k) {
       const int vb = border.vertex[k], vi = border.inner[k];
-      const Eigen::Vector3d d3 = (meshes.mesh3d[vb] - meshes.mesh3d[vi]) / depth;
+      const Eigen::Vector3d d3 =
+          (meshes.mesh3d[vb] - meshes.mesh3d[vi]) / depth;
       const Eigen::Vector2d d2 = (flat[vb] - flat[vi]) / depth;
       const double speed = n.dot(d2);  // outward M' distance per step of t
       if (!(speed > 0)) continue;
@@ -114,14 +126,17 @@ std::array<CutSideEdge, 4> FindCutSideEdges(const MeshPair& meshes,
                          std::hypot(view.camera.width, view.camera.height);
         // -1 unseen (behind the camera or off the photo), 0 table, 1 page.
         auto state_at = [&](int j, Eigen::Vector2d* px) {
-          const auto projected =
-              ProjectDistorted(view.camera, view.distortion, meshes.mesh3d[vb] + j * dt * d3);
+          const auto projected = ProjectDistorted(
+              view.camera, view.distortion, meshes.mesh3d[vb] + j * dt * d3);
           if (!projected) return -1;
           *px = *projected;
-          if (!(px->x() >= m && px->y() >= m && px->x() <= view.camera.width - 1 - m &&
+          if (!(px->x() >= m && px->y() >= m &&
+                px->x() <= view.camera.width - 1 - m &&
                 px->y() <= view.camera.height - 1 - m))
             return -1;
-          return view.mask(int(std::lround(px->y())), int(std::lround(px->x()))) ? 1 : 0;
+          return view.mask(int(std::lround(px->y())), int(std::lround(px->x())))
+                     ? 1
+                     : 0;
         };
         // Out from the border for as long as the view sees page there.
         Eigen::Vector2d px;
@@ -153,7 +168,7 @@ std::array<CutSideEdge, 4> FindCutSideEdges(const MeshPair& meshes,
         if (last_page > 0) {
           const Eigen::Vector2d q = flat[vb] + last_page * dt * d2;
           const double c = vertical_axis ? q.y() : q.x();
-          column_seen = std::isnan(column_seen) ? c
+          column_seen = std::isnan(column_seen)  ? c
                         : side == 0 || side == 3 ? std::min(column_seen, c)
                                                  : std::max(column_seen, c);
         }
@@ -170,13 +185,16 @@ std::array<CutSideEdge, 4> FindCutSideEdges(const MeshPair& meshes,
       // No photo sees the edge itself; the page reaches at least as far as
       // the photos see it (a high quantile over the columns: the page is a
       // rectangle, so page seen past any column is page past the side).
-      edge.bound = Quantile(seen_page, side == 0 || side == 3 ? 1 - options.seen_quantile
-                                                              : options.seen_quantile);
+      edge.bound =
+          Quantile(seen_page, side == 0 || side == 3 ? 1 - options.seen_quantile
+                                                     : options.seen_quantile);
     } else {
-      edge.note = "the other views see neither the page edge nor page past this side (" +
-                  std::to_string(edge.crossings) + " crossings, " +
-                  std::to_string(edge.columns_seen) + " columns seen; " +
-                  std::to_string(options.min_crossings) + " needed)";
+      edge.note =
+          "the other views see neither the page edge nor page past this side "
+          "(" +
+          std::to_string(edge.crossings) + " crossings, " +
+          std::to_string(edge.columns_seen) + " columns seen; " +
+          std::to_string(options.min_crossings) + " needed)";
       continue;
     }
     const double visible_bound = side == 0   ? visible_box[1]
@@ -203,12 +221,15 @@ std::array<CutSideEdge, 4> FindCutSideEdges(const MeshPair& meshes,
       for (int k = 0; k < strip.cols; ++k) {
         const int vb = border.vertex[k];
         const double speed = n.dot(dir2[k]);
-        const double t_end = speed > 0 ? std::max(0.0, (target - n.dot(flat[vb])) / speed) : 0;
+        const double t_end =
+            speed > 0 ? std::max(0.0, (target - n.dot(flat[vb])) / speed) : 0;
         for (int j = 0; j < strip.rows; ++j) {
           // Band rows run back over the mesh, towards the inner vertex.
-          const double t = j < band ? -double(depth) * (band - j) / band
-                                    : t_end * (j - band) / (strip.rows - band - 1);
-          strip.mesh3d[size_t(j) * strip.cols + k] = meshes.mesh3d[vb] + t * dir3[k];
+          const double t = j < band
+                               ? -double(depth) * (band - j) / band
+                               : t_end * (j - band) / (strip.rows - band - 1);
+          strip.mesh3d[size_t(j) * strip.cols + k] =
+              meshes.mesh3d[vb] + t * dir3[k];
           strip.flat[size_t(j) * strip.cols + k] = flat[vb] + t * dir2[k];
         }
       }
@@ -227,8 +248,8 @@ struct StripMesh {
   std::vector<Triangle> triangles;
 };
 
-StripMesh JoinStrips(const std::vector<const ExtensionStrip*>& strips, double x0, double y0,
-                     double scale) {
+StripMesh JoinStrips(const std::vector<const ExtensionStrip*>& strips,
+                     double x0, double y0, double scale) {
   StripMesh m;
   for (const ExtensionStrip* strip : strips) {
     const int base = int(m.screen.size());
@@ -239,8 +260,8 @@ StripMesh JoinStrips(const std::vector<const ExtensionStrip*>& strips, double x0
     }
     for (int j = 0; j + 1 < strip->rows; ++j)
       for (int k = 0; k + 1 < strip->cols; ++k) {
-        const int a = base + j * strip->cols + k, b = a + 1, c = a + strip->cols + 1,
-                  d = a + strip->cols;
+        const int a = base + j * strip->cols + k, b = a + 1,
+                  c = a + strip->cols + 1, d = a + strip->cols;
         m.triangles.push_back({a, b, c});
         m.triangles.push_back({a, c, d});
       }
@@ -256,8 +277,8 @@ struct ViewRendering {
 };
 
 ViewRendering RenderStripsFromView(const StripMesh& m, const ViewMask& view,
-                                   const TextureSampler& sampler, int width, int height,
-                                   bool antialias) {
+                                   const TextureSampler& sampler, int width,
+                                   int height, bool antialias) {
   const std::vector<Eigen::Vector3d>& screen = m.screen;
   const RasterResult raster = Rasterize(screen, m.triangles, width, height);
   // Per triangle: all corners on the view's page mask, and the affine map
@@ -267,15 +288,18 @@ ViewRendering RenderStripsFromView(const StripMesh& m, const ViewMask& view,
   for (size_t f = 0; f < m.triangles.size(); ++f) {
     const Triangle& t = m.triangles[f];
     Eigen::Matrix2d S;
-    S << (screen[t[1]] - screen[t[0]]).head<2>(), (screen[t[2]] - screen[t[0]]).head<2>();
+    S << (screen[t[1]] - screen[t[0]]).head<2>(),
+        (screen[t[2]] - screen[t[0]]).head<2>();
     if (!(std::abs(S.determinant()) > 1e-9)) continue;
     Eigen::Vector2d px[3];
     bool ok = true;
     for (int c = 0; c < 3 && ok; ++c) {
-      const auto projected = ProjectDistorted(view.camera, view.distortion, m.world[t[c]]);
+      const auto projected =
+          ProjectDistorted(view.camera, view.distortion, m.world[t[c]]);
       if (projected) px[c] = *projected;
       ok = projected && px[c].x() >= 0 && px[c].y() >= 0 &&
-           px[c].x() <= view.camera.width - 1 && px[c].y() <= view.camera.height - 1 &&
+           px[c].x() <= view.camera.width - 1 &&
+           px[c].y() <= view.camera.height - 1 &&
            view.mask(int(std::lround(px[c].y())), int(std::lround(px[c].x())));
     }
     if (!ok) continue;
@@ -292,13 +316,14 @@ ViewRendering RenderStripsFromView(const StripMesh& m, const ViewMask& view,
       if (f < 0 || !usable[f]) continue;
       const Triangle& t = m.triangles[f];
       const cv::Vec2f b = raster.bary(y, x);
-      const Eigen::Vector3d p =
-          (1 - b[0] - b[1]) * m.world[t[0]] + b[0] * m.world[t[1]] + b[1] * m.world[t[2]];
+      const Eigen::Vector3d p = (1 - b[0] - b[1]) * m.world[t[0]] +
+                                b[0] * m.world[t[1]] + b[1] * m.world[t[2]];
       const auto projected = ProjectDistorted(view.camera, view.distortion, p);
       if (!projected) continue;
       const Eigen::Vector2d px = *projected;
       const Eigen::Matrix2d& J = jacobian[f];
-      const float Jf[4] = {float(J(0, 0)), float(J(0, 1)), float(J(1, 0)), float(J(1, 1))};
+      const float Jf[4] = {float(J(0, 0)), float(J(0, 1)), float(J(1, 0)),
+                           float(J(1, 1))};
       float colour[3];
       sampler.Sample(float(px.x()), float(px.y()), Jf, antialias, colour);
       out.colour(y, x) = cv::Vec3b(cv::saturate_cast<uchar>(colour[0]),
@@ -313,7 +338,8 @@ ViewRendering RenderStripsFromView(const StripMesh& m, const ViewMask& view,
 // The affine map (output pixels) that moves `view` onto `reference` where
 // both show the page: SIFT matches between the two renderings, RANSAC.
 // Identity when fewer than `min_inliers` matches agree.
-cv::Matx23d Register(const cv::Mat3b& reference, const cv::Mat1b& reference_valid,
+cv::Matx23d Register(const cv::Mat3b& reference,
+                     const cv::Mat1b& reference_valid,
                      const ViewRendering& view, int min_inliers, int* inliers) {
   *inliers = 0;
   const cv::Matx23d identity(1, 0, 0, 0, 1, 0);
@@ -329,7 +355,8 @@ cv::Matx23d Register(const cv::Mat3b& reference, const cv::Mat1b& reference_vali
   cv::Mat1b near_view;
   cv::dilate(view_valid, near_view, cv::Mat(), cv::Point(-1, -1), 40);
   ref_mask &= near_view;
-  if (cv::countNonZero(ref_mask) < 100 || cv::countNonZero(view_mask) < 100) return identity;
+  if (cv::countNonZero(ref_mask) < 100 || cv::countNonZero(view_mask) < 100)
+    return identity;
   // SIFT on the box of the view's rendering and its surroundings only (its
   // pyramid over the whole output would cost most of render's time).
   const cv::Rect box = cv::boundingRect(near_view);
@@ -338,7 +365,8 @@ cv::Matx23d Register(const cv::Mat3b& reference, const cv::Mat1b& reference_vali
   cv::Mat dr, dv;
   sift->detectAndCompute(grey_ref(box), ref_mask(box), kr, dr);
   sift->detectAndCompute(grey_view(box), view_mask(box), kv, dv);
-  if (kr.size() < size_t(min_inliers) || kv.size() < size_t(min_inliers)) return identity;
+  if (kr.size() < size_t(min_inliers) || kv.size() < size_t(min_inliers))
+    return identity;
   cv::BFMatcher matcher(cv::NORM_L2);
   std::vector<std::vector<cv::DMatch>> knn;
   matcher.knnMatch(dv, dr, knn, 2);
@@ -359,8 +387,10 @@ cv::Matx23d Register(const cv::Mat3b& reference, const cv::Mat1b& reference_vali
 // `view` moved by the affine map A (output pixels).
 ViewRendering Warp(const ViewRendering& view, const cv::Matx23d& A) {
   ViewRendering out;
-  cv::warpAffine(view.colour, out.colour, A, view.colour.size(), cv::INTER_LINEAR);
-  cv::warpAffine(view.density, out.density, A, view.density.size(), cv::INTER_NEAREST);
+  cv::warpAffine(view.colour, out.colour, A, view.colour.size(),
+                 cv::INTER_LINEAR);
+  cv::warpAffine(view.density, out.density, A, view.density.size(),
+                 cv::INTER_NEAREST);
   // Bilinear colour at the rendering's edge mixes in the empty black.
   cv::Mat1b inside = out.density > 0;
   cv::erode(inside, inside, cv::Mat());
@@ -395,11 +425,13 @@ double Agreement(const cv::Mat3b& reference, const cv::Mat1b& reference_valid,
 }  // namespace
 
 cv::Mat1b TextureStrips(const std::vector<const ExtensionStrip*>& strips,
-                        const std::vector<ViewMask>& views, const std::vector<cv::Mat>& photos,
-                        double x0, double y0, double scale,
-                        bool antialias, const cv::Mat3b& reference_render,
+                        const std::vector<ViewMask>& views,
+                        const std::vector<cv::Mat>& photos, double x0,
+                        double y0, double scale, bool antialias,
+                        const cv::Mat3b& reference_render,
                         const cv::Mat1b& reference_valid, const cv::Mat1b& todo,
-                        cv::Mat3b* image, std::vector<ViewRegistration>* registrations) {
+                        cv::Mat3b* image,
+                        std::vector<ViewRegistration>* registrations) {
   const int W = image->cols, H = image->rows;
   cv::Mat1b done(H, W, uchar(0));
   const StripMesh m = JoinStrips(strips, x0, y0, scale);
@@ -408,7 +440,8 @@ cv::Mat1b TextureStrips(const std::vector<const ExtensionStrip*>& strips,
   for (size_t v = 0; v < views.size(); ++v) {
     if (photos[v].empty()) continue;
     const TextureSampler sampler(photos[v]);
-    ViewRendering r = RenderStripsFromView(m, views[v], sampler, W, H, antialias);
+    ViewRendering r =
+        RenderStripsFromView(m, views[v], sampler, W, H, antialias);
     if (cv::countNonZero(r.density > 0) == 0) continue;
     // The other view sees M where it is least sure (the page's cut edge in
     // the reference view); move its texture onto the reference's where the
@@ -416,10 +449,12 @@ cv::Mat1b TextureStrips(const std::vector<const ExtensionStrip*>& strips,
     ViewRegistration reg;
     reg.view = int(v);
     reg.agreement = Agreement(reference_render, reference_valid, r);
-    const cv::Matx23d A = Register(reference_render, reference_valid, r, 15, &reg.inliers);
+    const cv::Matx23d A =
+        Register(reference_render, reference_valid, r, 15, &reg.inliers);
     if (reg.inliers >= 15) {
       ViewRendering moved = Warp(r, A);
-      const double agreement = Agreement(reference_render, reference_valid, moved);
+      const double agreement =
+          Agreement(reference_render, reference_valid, moved);
       if (agreement > reg.agreement) {
         reg.affine = A;
         reg.agreement = agreement;

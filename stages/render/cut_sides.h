@@ -5,13 +5,12 @@
 // other view, and the page edge is where it leaves that view's page mask.
 #pragma once
 
+#include <Eigen/Core>
 #include <array>
 #include <filesystem>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
-#include <opencv2/core.hpp>
 
 #include "common/camera.h"
 #include "common/grid_mesh.h"
@@ -66,10 +65,10 @@ struct CutSideOptions {
 struct ViewRegistration {
   int view = -1;
   cv::Matx23d affine = cv::Matx23d(1, 0, 0, 0, 1, 0);  // output pixels
-  int inliers = 0;         // SIFT matches that agree on it
-  bool moved = false;      // the map was applied (it improved the agreement)
-  double agreement = 0;    // correlation of fine detail with the reference
-  bool used = false;       // agreement high enough for the view to be used
+  int inliers = 0;       // SIFT matches that agree on it
+  bool moved = false;    // the map was applied (it improved the agreement)
+  double agreement = 0;  // correlation of fine detail with the reference
+  bool used = false;     // agreement high enough for the view to be used
 };
 
 // The surface continued past a cut side up to its page edge, as a grid of
@@ -98,7 +97,7 @@ struct CutSideEdge {
   int crossings = 0;     // border columns (in all views) that saw the edge
   int columns_seen = 0;  // border columns some view sees page past
   int views = 0;         // views with at least one crossing
-  std::string note;   // why it was not measured
+  std::string note;      // why it was not measured
   ExtensionStrip strip;  // when measured and extension > 0
 };
 
@@ -106,12 +105,10 @@ struct CutSideEdge {
 // `flat`) with cut[i] set: the page edge past that side of the mesh, seen in
 // `views`. `flat` is M' after render's deskew turn, `visible_box` (x0 y0 x1
 // y1) the box of the part of it the reference view sees.
-std::array<CutSideEdge, 4> FindCutSideEdges(const MeshPair& meshes,
-                                            const std::vector<Eigen::Vector2d>& flat,
-                                            const Eigen::Vector4d& visible_box,
-                                            const std::array<bool, 4>& cut,
-                                            const std::vector<ViewMask>& views,
-                                            const CutSideOptions& options = {});
+std::array<CutSideEdge, 4> FindCutSideEdges(
+    const MeshPair& meshes, const std::vector<Eigen::Vector2d>& flat,
+    const Eigen::Vector4d& visible_box, const std::array<bool, 4>& cut,
+    const std::vector<ViewMask>& views, const CutSideOptions& options = {});
 
 // Textures the extension strips from the other views' photos. For every
 // pixel of `image` (output pixel (x, y) is the point (x0 + (x + 0.5) /
@@ -121,13 +118,15 @@ std::array<CutSideEdge, 4> FindCutSideEdges(const MeshPair& meshes,
 // moved onto `reference_render` where the two overlap (`reference_valid`;
 // the strips' band rows) when SIFT matches agree on an affine map that
 // improves their agreement; a view whose detail then still does not
-// correlate with the reference's there is not used. `photos[v]` belongs to `views[v]` (empty: not
-// used). Returns the pixels textured (255).
+// correlate with the reference's there is not used. `photos[v]` belongs to
+// `views[v]` (empty: not used). Returns the pixels textured (255).
 cv::Mat1b TextureStrips(const std::vector<const ExtensionStrip*>& strips,
-                        const std::vector<ViewMask>& views, const std::vector<cv::Mat>& photos,
-                        double x0, double y0, double scale,
-                        bool antialias, const cv::Mat3b& reference_render,
+                        const std::vector<ViewMask>& views,
+                        const std::vector<cv::Mat>& photos, double x0,
+                        double y0, double scale, bool antialias,
+                        const cv::Mat3b& reference_render,
                         const cv::Mat1b& reference_valid, const cv::Mat1b& todo,
-                        cv::Mat3b* image, std::vector<ViewRegistration>* registrations);
+                        cv::Mat3b* image,
+                        std::vector<ViewRegistration>* registrations);
 
 }  // namespace docunfold::render

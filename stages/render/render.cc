@@ -564,7 +564,6 @@ Json MakeReport(const RenderOptions& options, const RenderInputs& in,
   return doc;
 }
 
-
 // The reader's down `down_image` (reference pixels) carried into M': the
 // least-squares affine map pixel -> M' over the text segments' points that
 // lie on M. nullopt when fewer than 10 do.
