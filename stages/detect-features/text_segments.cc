@@ -7,17 +7,11 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "common/statistics.h"
 #include "stages/detect-features/feature_parts.h"
 
 namespace docunfold::features::detail {
 namespace {
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  const size_t m = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + long(m), v.end());
-  return v[m];
-}
 
 // A character candidate: a connected component with its pixels and, once
 // the text direction d and its normal n are known, its extent along both.

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <limits>
 
+#include "common/statistics.h"
+
 namespace docunfold::render {
 namespace {
 
@@ -75,12 +77,6 @@ Line FitTotalLeastSquares(const std::vector<Eigen::Vector2d>& pts) {
   line.rms =
       std::sqrt(std::max(0.0, eig.eigenvalues()[0]) / double(pts.size()));
   return line;
-}
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
 }
 
 // Evaluations of the lines of the four sides: top/bottom as y(x),

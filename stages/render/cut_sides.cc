@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "common/raster.h"
+#include "common/statistics.h"
 #include "stages/render/texture_sampler.h"
 
 namespace docunfold::render {
@@ -54,14 +55,6 @@ Border GridBorder(const QuadGrid& g, int b, int depth) {
   }
   return border;
 }
-
-double Quantile(std::vector<double> v, double q) {
-  const size_t k = std::min(v.size() - 1, size_t(q * (v.size() - 1) + 0.5));
-  std::nth_element(v.begin(), v.begin() + k, v.end());
-  return v[k];
-}
-
-double Median(std::vector<double> v) { return Quantile(std::move(v), 0.5); }
 
 }  // namespace
 

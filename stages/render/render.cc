@@ -16,6 +16,7 @@
 #include "common/cli.h"
 #include "common/errors.h"
 #include "common/raster.h"
+#include "common/statistics.h"
 #include "stages/render/crop.h"
 #include "stages/render/texture_sampler.h"
 
@@ -129,12 +130,6 @@ void CheckInputs(const RenderInputs& in) {
   }
   if (!((hi - lo).minCoeff() > 0))
     throw InputError(m2.string() + ": the flat mesh has no area");
-}
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
 }
 
 double Cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
