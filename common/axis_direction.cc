@@ -3,7 +3,29 @@
 #include <algorithm>
 #include <cmath>
 
+#include <Eigen/Dense>
+
 namespace docunfold {
+
+std::optional<Eigen::Vector2d> CarryDirection(const std::vector<Eigen::Vector2d>& from,
+                                              const std::vector<Eigen::Vector2d>& to,
+                                              const Eigen::Vector2d& direction, int min_pairs) {
+  const size_t n = std::min(from.size(), to.size());
+  if (n < size_t(std::max(min_pairs, 3))) return std::nullopt;
+  // to = A^T [x y 1] for the 3x2 matrix A, by the normal equations.
+  Eigen::Matrix3d ata = Eigen::Matrix3d::Zero();
+  Eigen::Matrix<double, 3, 2> atb = Eigen::Matrix<double, 3, 2>::Zero();
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Vector3d a(from[i].x(), from[i].y(), 1);
+    ata += a * a.transpose();
+    atb += a * to[i].transpose();
+  }
+  if (!(std::abs(ata.determinant()) > 1e-12)) return std::nullopt;
+  const Eigen::Matrix<double, 3, 2> x = ata.ldlt().solve(atb);
+  const Eigen::Vector2d carried = x.topRows<2>().transpose() * direction;
+  if (!(carried.norm() > 0)) return std::nullopt;
+  return carried.normalized();
+}
 
 double WrapToQuarterTurn(double a) {
   a = std::fmod(a, 90.0);

@@ -2,7 +2,10 @@
 // length follows: on a page, printed rows and rules run along its axes.
 #pragma once
 
+#include <optional>
 #include <vector>
+
+#include <Eigen/Core>
 
 namespace docunfold {
 
@@ -28,5 +31,15 @@ AxisDirection DominantAxisDirection(const std::vector<DirectionVote>& votes,
 
 // `angle_deg` reduced modulo 90 to (-45, 45].
 double WrapToQuarterTurn(double angle_deg);
+
+// A direction given in one plane carried into another (e.g. the reader's
+// down from reference-image pixels into M'): the least-squares affine map
+// taking each `from[i]` to `to[i]`, applied to `direction`, normalised.
+// nullopt with fewer than `min_pairs` pairs, points on one line, or a
+// direction the map sends to nothing.
+std::optional<Eigen::Vector2d> CarryDirection(const std::vector<Eigen::Vector2d>& from,
+                                              const std::vector<Eigen::Vector2d>& to,
+                                              const Eigen::Vector2d& direction,
+                                              int min_pairs = 10);
 
 }  // namespace docunfold

@@ -5,6 +5,7 @@
 
 #include <Eigen/Geometry>
 
+#include "common/axis_direction.h"
 #include "common/cli.h"
 #include "common/errors.h"
 #include "common/isometry/subdivision.h"
@@ -177,22 +178,14 @@ OptimizeResult Run(const OptimizeInputs& in, const OptimizeOptions& o) {
   }
   result.meshes = meshes;
   if (in.features.text_down && !result.rounds.empty()) {
-    // Least squares flat = A pixel + b over every marker of the last round.
-    Eigen::Matrix3d ata = Eigen::Matrix3d::Zero();
-    Eigen::Matrix<double, 3, 2> atb = Eigen::Matrix<double, 3, 2>::Zero();
-    int n = 0;
+    // Through the affine map pixel -> M' over every marker of the last round.
+    std::vector<Eigen::Vector2d> pixels, flat;
     for (const LineRecord& l : result.rounds.back().lines)
       for (size_t k = 0; k < l.pixels.size() && k < l.flat.size(); ++k) {
-        const Eigen::Vector3d a(l.pixels[k].x(), l.pixels[k].y(), 1);
-        ata += a * a.transpose();
-        atb += a * l.flat[k].transpose();
-        ++n;
+        pixels.push_back(l.pixels[k]);
+        flat.push_back(l.flat[k]);
       }
-    if (n >= 10 && std::abs(ata.determinant()) > 1e-12) {
-      const Eigen::Matrix<double, 3, 2> x = ata.ldlt().solve(atb);
-      const Eigen::Vector2d down = x.topRows<2>().transpose() * *in.features.text_down;
-      if (down.norm() > 0) result.text_down_flat = down.normalized();
-    }
+    result.text_down_flat = CarryDirection(pixels, flat, *in.features.text_down);
   }
   result.seconds = SecondsSince(start);
   return result;

@@ -559,27 +559,17 @@ Json MakeReport(const RenderOptions& options, const RenderInputs& in,
   return doc;
 }
 
-// The reader's down `down_image` (reference pixels) carried into M': the
-// least-squares affine map pixel -> M' over the text segments' points that
-// lie on M. nullopt when fewer than 10 do.
+// The reader's down `down_image` (reference pixels) carried into M' by the
+// affine map pixel -> M' over the text segments' points that lie on M.
 std::optional<Eigen::Vector2d> DownInFlat(const RenderInputs& in, const PixelToSurface& lookup,
                                           const Eigen::Vector2d& down_image) {
-  Eigen::Matrix3d ata = Eigen::Matrix3d::Zero();
-  Eigen::Matrix<double, 3, 2> atb = Eigen::Matrix<double, 3, 2>::Zero();
-  int n = 0;
-  for (const Eigen::Vector2d& p : in.text_points) {
-    const auto sp = lookup.Lookup(p);
-    if (!sp) continue;
-    const Eigen::Vector3d a(p.x(), p.y(), 1);
-    ata += a * a.transpose();
-    atb += a * PointOnMesh2d(in.meshes, *sp).transpose();
-    ++n;
-  }
-  if (n < 10 || !(std::abs(ata.determinant()) > 1e-12)) return std::nullopt;
-  const Eigen::Matrix<double, 3, 2> x = ata.ldlt().solve(atb);
-  const Eigen::Vector2d down = x.topRows<2>().transpose() * down_image;
-  if (!(down.norm() > 0)) return std::nullopt;
-  return down.normalized();
+  std::vector<Eigen::Vector2d> pixels, flat;
+  for (const Eigen::Vector2d& p : in.text_points)
+    if (const auto sp = lookup.Lookup(p)) {
+      pixels.push_back(p);
+      flat.push_back(PointOnMesh2d(in.meshes, *sp));
+    }
+  return CarryDirection(pixels, flat, down_image);
 }
 
 }  // namespace
