@@ -190,10 +190,7 @@ std::array<CutSideEdge, 4> FindCutSideEdges(
           std::to_string(options.min_crossings) + " needed)";
       continue;
     }
-    const double visible_bound = side == 0   ? visible_box[1]
-                                 : side == 1 ? visible_box[2]
-                                 : side == 2 ? visible_box[3]
-                                             : visible_box[0];
+    const double visible_bound = visible_box[BoxIndexOfSide(side)];
     const double sign = (side == 0 || side == 3) ? -1 : 1;
     edge.extension = sign * (edge.bound - visible_bound);
     if (edge.extension < 0) {
@@ -207,7 +204,6 @@ std::array<CutSideEdge, 4> FindCutSideEdges(
       strip.cols = int(border.vertex.size());
       const int band = std::max(0, options.band_rows);
       strip.rows = band + std::max(2, options.strip_rows);
-      strip.band_rows = band;
       strip.mesh3d.resize(size_t(strip.cols) * strip.rows);
       strip.flat.resize(strip.mesh3d.size());
       const double target = (side == 0 || side == 3) ? -edge.bound : edge.bound;
@@ -328,26 +324,52 @@ ViewRendering RenderStripsFromView(const StripMesh& m, const ViewMask& view,
   return out;
 }
 
-// The affine map (output pixels) that moves `view` onto `reference` where
+// Grey levels minus their blur: the fine detail (print) of a rendering.
+cv::Mat1f FineDetail(const cv::Mat3b& image) {
+  cv::Mat grey;
+  cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
+  cv::Mat1f f, low;
+  grey.convertTo(f, CV_32F);
+  cv::GaussianBlur(f, low, cv::Size(0, 0), 3);
+  return f - low;
+}
+
+// The reference's rendering as every view is compared with it (computed
+// once for all views).
+struct ReferenceRendering {
+  cv::Mat grey;         // 8-bit
+  cv::Mat1f detail;     // FineDetail
+  cv::Mat1b valid;      // where it shows the page
+  cv::Mat1b keypoints;  // `valid` away from its border (SIFT's mask)
+};
+
+ReferenceRendering PrepareReference(const cv::Mat3b& image,
+                                    const cv::Mat1b& valid) {
+  ReferenceRendering r;
+  cv::cvtColor(image, r.grey, cv::COLOR_BGR2GRAY);
+  r.detail = FineDetail(image);
+  r.valid = valid;
+  cv::erode(valid, r.keypoints, cv::Mat(), cv::Point(-1, -1), 4);
+  return r;
+}
+
+// The affine map (output pixels) that moves `view` onto the reference where
 // both show the page: SIFT matches between the two renderings, RANSAC.
 // Identity when fewer than `min_inliers` matches agree.
-cv::Matx23d Register(const cv::Mat3b& reference,
-                     const cv::Mat1b& reference_valid,
+cv::Matx23d Register(const ReferenceRendering& reference,
                      const ViewRendering& view, int min_inliers, int* inliers) {
   *inliers = 0;
   const cv::Matx23d identity(1, 0, 0, 0, 1, 0);
-  cv::Mat grey_ref, grey_view;
-  cv::cvtColor(reference, grey_ref, cv::COLOR_BGR2GRAY);
+  cv::Mat grey_view;
   cv::cvtColor(view.colour, grey_view, cv::COLOR_BGR2GRAY);
   cv::Mat1b view_valid = view.density > 0;
   // Keypoints away from the renderings' own borders.
-  cv::Mat1b ref_mask, view_mask;
-  cv::erode(reference_valid, ref_mask, cv::Mat(), cv::Point(-1, -1), 4);
+  cv::Mat1b view_mask;
   cv::erode(view_valid, view_mask, cv::Mat(), cv::Point(-1, -1), 4);
   // Only near the overlap: the reference far from the strips says nothing.
   cv::Mat1b near_view;
   cv::dilate(view_valid, near_view, cv::Mat(), cv::Point(-1, -1), 40);
-  ref_mask &= near_view;
+  const cv::Mat1b ref_mask = reference.keypoints & near_view;
   if (cv::countNonZero(ref_mask) < 100 || cv::countNonZero(view_mask) < 100)
     return identity;
   // SIFT on the box of the view's rendering and its surroundings only (its
@@ -356,7 +378,7 @@ cv::Matx23d Register(const cv::Mat3b& reference,
   const cv::Ptr<cv::SIFT> sift = cv::SIFT::create(4000);
   std::vector<cv::KeyPoint> kr, kv;
   cv::Mat dr, dv;
-  sift->detectAndCompute(grey_ref(box), ref_mask(box), kr, dr);
+  sift->detectAndCompute(reference.grey(box), ref_mask(box), kr, dr);
   sift->detectAndCompute(grey_view(box), view_mask(box), kv, dv);
   if (kr.size() < size_t(min_inliers) || kv.size() < size_t(min_inliers))
     return identity;
@@ -392,22 +414,15 @@ ViewRendering Warp(const ViewRendering& view, const cv::Matx23d& A) {
 }
 
 // How well `view` matches the reference where both show the page: the
-// correlation of their fine detail (grey minus its blur), -1..1; 0 when they
-// overlap in fewer than 500 pixels.
-double Agreement(const cv::Mat3b& reference, const cv::Mat1b& reference_valid,
+// correlation of their fine detail, -1..1; 0 when they overlap in fewer than
+// 500 pixels.
+double Agreement(const ReferenceRendering& reference,
                  const ViewRendering& view) {
-  cv::Mat1b both = reference_valid & (view.density > 0);
+  cv::Mat1b both = reference.valid & (view.density > 0);
   cv::erode(both, both, cv::Mat(), cv::Point(-1, -1), 3);
   if (cv::countNonZero(both) < 500) return 0;
-  auto detail = [](const cv::Mat3b& image) {
-    cv::Mat grey;
-    cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
-    cv::Mat1f f, low;
-    grey.convertTo(f, CV_32F);
-    cv::GaussianBlur(f, low, cv::Size(0, 0), 3);
-    return cv::Mat1f(f - low);
-  };
-  const cv::Mat1f a = detail(reference), b = detail(view.colour);
+  const cv::Mat1f& a = reference.detail;
+  const cv::Mat1f b = FineDetail(view.colour);
   cv::Scalar ma, sa, mb, sb;
   cv::meanStdDev(a, ma, sa, both);
   cv::meanStdDev(b, mb, sb, both);
@@ -422,13 +437,15 @@ cv::Mat1b TextureStrips(const std::vector<const ExtensionStrip*>& strips,
                         const std::vector<cv::Mat>& photos, double x0,
                         double y0, double scale, bool antialias,
                         const cv::Mat3b& reference_render,
-                        const cv::Mat1b& reference_valid, const cv::Mat1b& todo,
-                        cv::Mat3b* image,
+                        const cv::Mat1b& reference_valid,
+                        const cv::Mat1b& fillable, cv::Mat3b* image,
                         std::vector<ViewRegistration>* registrations) {
   const int W = image->cols, H = image->rows;
   cv::Mat1b done(H, W, uchar(0));
   const StripMesh m = JoinStrips(strips, x0, y0, scale);
   if (m.triangles.empty()) return done;
+  const ReferenceRendering reference =
+      PrepareReference(reference_render, reference_valid);
   cv::Mat1f best(H, W, 0.0f);
   for (size_t v = 0; v < views.size(); ++v) {
     if (photos[v].empty()) continue;
@@ -441,13 +458,11 @@ cv::Mat1b TextureStrips(const std::vector<const ExtensionStrip*>& strips,
     // two overlap (the strips' band rows run back over M).
     ViewRegistration reg;
     reg.view = int(v);
-    reg.agreement = Agreement(reference_render, reference_valid, r);
-    const cv::Matx23d A =
-        Register(reference_render, reference_valid, r, 15, &reg.inliers);
+    reg.agreement = Agreement(reference, r);
+    const cv::Matx23d A = Register(reference, r, 15, &reg.inliers);
     if (reg.inliers >= 15) {
       ViewRendering moved = Warp(r, A);
-      const double agreement =
-          Agreement(reference_render, reference_valid, moved);
+      const double agreement = Agreement(reference, moved);
       if (agreement > reg.agreement) {
         reg.affine = A;
         reg.agreement = agreement;
@@ -463,7 +478,7 @@ cv::Mat1b TextureStrips(const std::vector<const ExtensionStrip*>& strips,
     for (int y = 0; y < H; ++y)
       for (int x = 0; x < W; ++x) {
         const float d = r.density(y, x);
-        if (!todo(y, x) || !(d > best(y, x))) continue;
+        if (!fillable(y, x) || !(d > best(y, x))) continue;
         best(y, x) = d;
         (*image)(y, x) = r.colour(y, x);
         done(y, x) = 255;

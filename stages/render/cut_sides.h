@@ -73,16 +73,21 @@ struct ViewRegistration {
 
 // The surface continued past a cut side up to its page edge, as a grid of
 // `cols` x `rows` vertices: column k runs out from the mesh border's vertex
-// k, row 0 lies on the border. Row-major like QuadGrid.
+// k; its first CutSideOptions::band_rows rows run back over the mesh (where
+// the other views' texture is registered with the reference's), the next
+// lies on the border. Row-major like QuadGrid.
 struct ExtensionStrip {
   int cols = 0;
   int rows = 0;
   std::vector<Eigen::Vector3d> mesh3d;  // M continued (world frame)
   std::vector<Eigen::Vector2d> flat;    // M' continued (turned as `flat`)
-  // The first rows run back over the mesh (to register the other views'
-  // texture with the reference's); row band_rows lies on the border.
-  int band_rows = 0;
 };
+
+// Index into a box (x0 y0 x1 y1) of the coordinate that bounds side `side`
+// (0 top: y0, 1 right: x1, 2 bottom: y1, 3 left: x0).
+inline int BoxIndexOfSide(int side) {
+  return side == 0 ? 1 : side == 1 ? 2 : side == 2 ? 3 : 0;
+}
 
 struct CutSideEdge {
   bool measured = false;
@@ -112,7 +117,7 @@ std::array<CutSideEdge, 4> FindCutSideEdges(
 
 // Textures the extension strips from the other views' photos. For every
 // pixel of `image` (output pixel (x, y) is the point (x0 + (x + 0.5) /
-// scale, y0 + (y + 0.5) / scale) of M') where `todo` is set and a strip
+// scale, y0 + (y + 0.5) / scale) of M') where `fillable` is set and a strip
 // lies, the colour of the view that resolves it best among those whose page
 // mask holds the whole strip triangle. Each view's rendering is first
 // moved onto `reference_render` where the two overlap (`reference_valid`;
@@ -125,8 +130,8 @@ cv::Mat1b TextureStrips(const std::vector<const ExtensionStrip*>& strips,
                         const std::vector<cv::Mat>& photos, double x0,
                         double y0, double scale, bool antialias,
                         const cv::Mat3b& reference_render,
-                        const cv::Mat1b& reference_valid, const cv::Mat1b& todo,
-                        cv::Mat3b* image,
+                        const cv::Mat1b& reference_valid,
+                        const cv::Mat1b& fillable, cv::Mat3b* image,
                         std::vector<ViewRegistration>* registrations);
 
 }  // namespace docunfold::render

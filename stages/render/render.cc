@@ -663,7 +663,7 @@ RenderResult Run(const RenderOptions& options, const RenderInputs& in) {
         continue;
       }
       // The box stands in for the sides the crop has no line for.
-      visible[i == 0 ? 1 : i == 1 ? 2 : i == 2 ? 3 : 0] = e.bound;
+      visible[BoxIndexOfSide(i)] = e.bound;
       const double axis_extent = i % 2 == 0 ? visible[3] - visible[1] : visible[2] - visible[0];
       const std::string share =
           std::to_string(int(std::lround(100 * e.extension / axis_extent))) + " % of the page";
@@ -685,7 +685,7 @@ RenderResult Run(const RenderOptions& options, const RenderInputs& in) {
     }
     r.sides[i].median_bound = Median(across);
     if (options.scattered_sides == "median")
-      visible[i == 0 ? 1 : i == 1 ? 2 : i == 2 ? 3 : 0] = r.sides[i].median_bound;
+      visible[BoxIndexOfSide(i)] = r.sides[i].median_bound;
   }
   CropRect crop = ChooseCrop(&r.sides, visible,
                              options.crop_rule == "middle" ? options.crop_middle_max_deg * M_PI / 180
