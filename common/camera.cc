@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "common/atomic_file.h"
 #include "common/errors.h"
 
 namespace docunfold {
@@ -72,6 +73,17 @@ std::optional<Eigen::Vector2d> ProjectDistorted(const PinholeCamera& camera,
   const Eigen::Vector2d pixel = p.head<2>() / p.z();
   if (!std::isfinite(pixel.x()) || !std::isfinite(pixel.y())) return std::nullopt;
   return pixel;
+}
+
+cv::Mat ReadViewPhoto(const fs::path& path, const PinholeCamera& view,
+                      const fs::path& cameras_file, int flags) {
+  cv::Mat photo = ReadImage(path, flags);
+  if (photo.cols != view.width || photo.rows != view.height)
+    throw InputError(path.string() + ": " + std::to_string(photo.cols) + "x" +
+                     std::to_string(photo.rows) + " differs from its camera's " +
+                     std::to_string(view.width) + "x" + std::to_string(view.height) + " in " +
+                     cameras_file.string());
+  return photo;
 }
 
 Json CameraToJson(const PinholeCamera& c) {

@@ -10,6 +10,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <opencv2/core.hpp>
 
 #include "common/json_io.h"
 
@@ -66,6 +67,12 @@ std::array<double, 4> ReadDistortion(const JsonReader& r, const std::string& vie
 std::optional<Eigen::Vector2d> ProjectDistorted(const PinholeCamera& camera,
                                                 const std::array<double, 4>& distortion,
                                                 const Eigen::Vector3d& x_world);
+
+// The photo `path` of `view`, read with cv::imread's `flags`; InputError
+// naming the file when it is missing, unreadable or not the size its camera
+// in `cameras_file` says.
+cv::Mat ReadViewPhoto(const fs::path& path, const PinholeCamera& view,
+                      const fs::path& cameras_file, int flags);
 
 // JSON for one camera: {"image","width","height","K","R","t"}.
 Json CameraToJson(const PinholeCamera& camera);

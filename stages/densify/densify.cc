@@ -699,14 +699,7 @@ DensifyInputs ReadInputs(const DensifyOptions& o) {
       in.photos.emplace_back();
       continue;
     }
-    const fs::path path = images / view.image;
-    cv::Mat photo = ReadImage(path, cv::IMREAD_GRAYSCALE);
-    if (photo.cols != view.width || photo.rows != view.height)
-      throw InputError(path.string() + ": " + std::to_string(photo.cols) + "x" +
-                       std::to_string(photo.rows) + " differs from its camera's " +
-                       std::to_string(view.width) + "x" + std::to_string(view.height) +
-                       " in " + cameras_path.string());
-    in.photos.push_back(photo);
+    in.photos.push_back(ReadViewPhoto(images / view.image, view, cameras_path, cv::IMREAD_GRAYSCALE));
   }
   const fs::path boundary_file =
       fs::is_directory(o.boundary) ? o.boundary / "boundary.json" : o.boundary;

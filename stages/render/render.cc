@@ -12,7 +12,6 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "common/atomic_file.h"
 #include "common/cli.h"
 #include "common/errors.h"
 #include "common/raster.h"
@@ -739,12 +738,7 @@ RenderResult Run(const RenderOptions& options, const RenderInputs& in) {
     for (size_t v = 0; v < in.views.size(); ++v) {
       const ViewMask& view = in.views[v];
       if (view.photo.empty()) continue;
-      photos[v] = ReadImage(view.photo, cv::IMREAD_COLOR);
-      if (photos[v].cols != view.camera.width || photos[v].rows != view.camera.height)
-        throw InputError(view.photo.string() + ": " + std::to_string(photos[v].cols) + "x" +
-                         std::to_string(photos[v].rows) + ", but " + in.cameras_file.string() +
-                         " says " + std::to_string(view.camera.width) + "x" +
-                         std::to_string(view.camera.height));
+      photos[v] = ReadViewPhoto(view.photo, view.camera, in.cameras_file, cv::IMREAD_COLOR);
     }
     const cv::Mat3b reference_render = image.clone();
     const cv::Mat1b textured = TextureStrips(

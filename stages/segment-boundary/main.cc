@@ -99,12 +99,8 @@ int main(int argc, char** argv) {
         if (view.image == cameras.reference) continue;
         ++views;
         const fs::path photo = views_dir / view.image;
-        const cv::Mat view_image = ReadImage(photo, 1 /*cv::IMREAD_COLOR*/);
-        if (view_image.cols != view.width || view_image.rows != view.height)
-          throw InputError(photo.string() + ": " + std::to_string(view_image.cols) + "x" +
-                           std::to_string(view_image.rows) + ", but " + cameras_path.string() +
-                           " says " + std::to_string(view.width) + "x" +
-                           std::to_string(view.height));
+        const cv::Mat view_image =
+            ReadViewPhoto(photo, view, cameras_path, 1 /*cv::IMREAD_COLOR*/);
         boundary::BoundaryResult view_result;
         try {
           view_result = boundary::SegmentBoundary(view_image, opt);
