@@ -11,6 +11,48 @@
 
 using namespace docunfold;
 
+namespace {
+
+// One other view's page, as written to <out>/views/<photo name>/.
+struct ViewOutput {
+  fs::path dir;
+  cv::Mat1b mask;
+  cv::Mat overlay;
+  Json doc;
+};
+
+// The page in every view of `cameras_path` but the reference. A view without
+// a page is logged and left out (render uses whichever views it finds); a
+// photo that is missing or not the size cameras.json says fails. `views`
+// receives how many views were tried.
+std::vector<ViewOutput> SegmentOtherViews(const fs::path& views_dir, const fs::path& cameras_path,
+                                          const fs::path& out_dir,
+                                          const boundary::BoundaryOptions& opt, int* views) {
+  std::vector<ViewOutput> outputs;
+  *views = 0;
+  const CameraSet cameras = ReadCameras(cameras_path);
+  for (const PinholeCamera& view : cameras.views) {
+    if (view.image == cameras.reference) continue;
+    ++*views;
+    const fs::path photo = views_dir / view.image;
+    const cv::Mat view_image = ReadViewPhoto(photo, view, cameras_path, 1 /*cv::IMREAD_COLOR*/);
+    boundary::BoundaryResult result;
+    try {
+      result = boundary::SegmentBoundary(view_image, opt);
+    } catch (const InputError& e) {
+      Log(photo.string() + ": " + e.what() + "; view left out");
+      continue;
+    }
+    outputs.push_back({out_dir / "views" / fs::path(view.image).stem(), result.mask,
+                       boundary::DrawBoundaryOverlay(view_image, result, 800),
+                       boundary::BoundaryToJson(result, view.image, view_image.cols,
+                                                view_image.rows, opt)});
+  }
+  return outputs;
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   CLI::App app{"Finds the page in the reference image: its region (mask.png), outline, "
                "corners and sides (boundary.json, real sides vs sides cut by the image "
@@ -82,39 +124,11 @@ int main(int argc, char** argv) {
     if (opt.verbose)
       Log("page found in " + std::to_string(SecondsSince(start)) + " s; orientation by " +
           result.orientation.method);
-    // The other views, all found before anything is written: a view without
-    // a page is logged and left out (render uses whichever views it finds);
-    // a photo that is missing or not the size cameras.json says fails.
-    struct ViewOutput {
-      fs::path dir;
-      cv::Mat1b mask;
-      cv::Mat overlay;
-      Json doc;
-    };
-    std::vector<ViewOutput> view_outputs;
+    // The other views, all found before anything is written.
     int views = 0;
-    if (!views_dir.empty()) {
-      const CameraSet cameras = ReadCameras(cameras_path);
-      for (const PinholeCamera& view : cameras.views) {
-        if (view.image == cameras.reference) continue;
-        ++views;
-        const fs::path photo = views_dir / view.image;
-        const cv::Mat view_image =
-            ReadViewPhoto(photo, view, cameras_path, 1 /*cv::IMREAD_COLOR*/);
-        boundary::BoundaryResult view_result;
-        try {
-          view_result = boundary::SegmentBoundary(view_image, opt);
-        } catch (const InputError& e) {
-          Log(photo.string() + ": " + e.what() + "; view left out");
-          continue;
-        }
-        view_outputs.push_back({out_dir / "views" / fs::path(view.image).stem(),
-                                view_result.mask,
-                                boundary::DrawBoundaryOverlay(view_image, view_result, 800),
-                                boundary::BoundaryToJson(view_result, view.image,
-                                                         view_image.cols, view_image.rows, opt)});
-      }
-    }
+    const std::vector<ViewOutput> view_outputs =
+        views_dir.empty() ? std::vector<ViewOutput>{}
+                          : SegmentOtherViews(views_dir, cameras_path, out_dir, opt, &views);
     EnsureDirectory(out_dir);
     const Json doc = boundary::BoundaryToJson(result, image_path.filename().string(),
                                               image.cols, image.rows, opt);
