@@ -85,7 +85,9 @@ int main(int argc, char** argv) {
   app.add_option("--axis-tolerance", o.grouping.axis_tolerance_deg,
                  "lines kept within this many degrees of horizontal or vertical")
       ->capture_default_str();
-  std::string axis_lines = "none";
+  std::string axis_lines = o.axis_lines == optimize::AxisLines::kNone       ? "none"
+                           : o.axis_lines == optimize::AxisLines::kFeatures ? "features"
+                                                                            : "all";
   app.add_option("--axis-lines", axis_lines,
                  "lines held along the axes of M': none (only straight, as in the paper), "
                  "features (text and rules), all (and the real page sides)")

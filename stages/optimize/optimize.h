@@ -49,12 +49,14 @@ struct OptimizeOptions {
   bool features = true;        // false: no feature lines at all (--no-features)
   bool boundary_only = false;  // only the real boundary sides (--boundary-only)
   bool project = true;         // feature line projection (paper §"Feature line projection")
-  // Which lines run exactly along the axes of the upright M' (the others
-  // are only straight, as in the paper). Measured on 11 benchmark sets
-  // against kNone: kFeatures changed MS-SSIM by -0.010 .. +0.013 (mean
-  // +0.0001); kAll squares the page but on set04 bent M at its bottom edge
-  // until the crop failed (0.565 -> 0.447). Hence the paper's default.
-  AxisLines axis_lines = AxisLines::kNone;
+  // Which lines run exactly along the axes of the upright M' (kNone: only
+  // straight, as in the paper). A page is a rectangle: with only straight
+  // sides, M' kept one of set04's sides 1.5 degrees off the others (M is
+  // least certain at the page edge) and the crop cut into the page. kAll
+  // against kNone, 12 sets on three sfm runs: mean MS-SSIM of the samples
+  // +0.017, +0.015, +0.030 (set04 +0.16 each time, r02 +0.10, r01 +0.05;
+  // worst single change set02 -0.022 and set07 -0.011).
+  AxisLines axis_lines = AxisLines::kAll;
   double marker_step_px = 4;   // sample spacing along segments, reference pixels
   // Turn M' before the first round when the detected segments (text rows,
   // rules) run at least upright_min_deg off its axes: at least
