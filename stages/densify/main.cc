@@ -35,6 +35,14 @@ int main(int argc, char** argv) {
   app.add_option("--texture-min-views", o.texture.min_views,
                  "texture: photos a point needs, the reference included")
       ->capture_default_str()->check(CLI::Range(2, 1000));
+  app.add_flag("--surface-prewarp", o.texture.surface_prewarp,
+               "texture: a second pass for the samples the first left without a point, the "
+               "photos brought onto the reference through the surface of the points found "
+               "first instead of the page's homography (flaps, the far side of a fold)");
+  app.add_option("--surface-grid", o.texture.surface_grid_px,
+                 "texture, second pass: the surface's depth is fitted every this many "
+                 "working-copy pixels and interpolated in between")
+      ->capture_default_str()->check(CLI::Range(1.0, 100.0));
   app.add_flag("--no-outline", no_outline, "no outline points");
   app.add_option("--outline-step", o.outline.step_px,
                  "outline: spacing of the samples along the real sides (working-copy pixels)")

@@ -17,6 +17,7 @@
 
 #include "common/atomic_file.h"
 #include "common/cli.h"
+#include "common/depth_field.h"
 #include "common/errors.h"
 #include "common/isometry/mesh_index.h"
 #include "common/isometry/metrics.h"
@@ -117,85 +118,6 @@ class NearestPoint {
   nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, Cloud>, Cloud, 3,
                                       uint32_t>
       tree_;
-};
-
-// Depth of a pixel from its nearest projected points, RBF weights
-// φ(r) = 1/(1+r²). kAverage: the weighted mean depth of the k nearest (the
-// paper). kPlanar: a weighted least-squares fit of 1/depth as an affine
-// function of the pixel over the `planar_k` nearest (r in units of the
-// farthest of them), which is exact for a plane and so carries each panel
-// on over blank paper (margins, gaps between columns) instead of levelling
-// it to the nearest points' depth.
-class DepthField {
- public:
-  DepthField(std::vector<Eigen::Vector2d> pixels, std::vector<double> depths, int k, double scale,
-             DepthModel model, int planar_k)
-      : pixels_(std::move(pixels)), depths_(std::move(depths)), k_(k), scale_(scale),
-        model_(model), planar_k_(planar_k),
-        cloud_{&pixels_}, tree_(2, cloud_, nanoflann::KDTreeSingleIndexAdaptorParams(10)) {
-    tree_.buildIndex();
-  }
-  double At(const Eigen::Vector2d& px) const {
-    const int want = model_ == DepthModel::kPlanar ? std::max(k_, planar_k_) : k_;
-    const size_t k = std::min<size_t>(size_t(want), pixels_.size());
-    std::vector<uint32_t> idx(k);
-    std::vector<double> d2(k);
-    nanoflann::KNNResultSet<double, uint32_t> knn(k);
-    knn.init(idx.data(), d2.data());
-    tree_.findNeighbors(knn, px.data(), nanoflann::SearchParams());
-    const size_t found = knn.size();
-    auto weight = [&](size_t i) { return 1 / (1 + d2[i] / (scale_ * scale_)); };
-    double sw = 0, sz = 0;
-    for (size_t i = 0; i < std::min<size_t>(found, size_t(k_)); ++i) {
-      sw += weight(i);
-      sz += weight(i) * depths_[idx[i]];
-    }
-    const double average = sz / sw;
-    if (model_ != DepthModel::kPlanar || found < 6) return average;
-    // 1/z = c + a·du + b·dv around px (weighted normal equations). The
-    // weights' unit is at least the farthest neighbour's distance: with the
-    // points' spacing as unit (often ~1 px where text is dense) the nearest
-    // two or three would decide the slope alone and extrapolate it wildly.
-    const double unit2 = std::max(scale_ * scale_, d2[found - 1]);
-    auto planar_weight = [&](size_t i) { return 1 / (1 + d2[i] / unit2); };
-    const double unit = std::sqrt(unit2);
-    Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
-    Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
-    double lo = 1e300, hi = 0;
-    for (size_t i = 0; i < found; ++i) {
-      const Eigen::Vector2d d = (pixels_[idx[i]] - px) / unit;
-      const Eigen::Vector3d row(1, d.x(), d.y());
-      const double inv = 1 / depths_[idx[i]];
-      A += planar_weight(i) * row * row.transpose();
-      rhs += planar_weight(i) * inv * row;
-      lo = std::min(lo, inv);
-      hi = std::max(hi, inv);
-    }
-    // Points (nearly) on a line (one text line) leave the slope across it
-    // free: then the average. Their weighted covariance about their mean:
-    const Eigen::Vector2d mean = A.block<2, 1>(1, 0) / A(0, 0);
-    const Eigen::Matrix2d covariance =
-        A.bottomRightCorner<2, 2>() / A(0, 0) - mean * mean.transpose();
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> spread(covariance);
-    if (!(spread.eigenvalues()(0) >= 1e-2 * spread.eigenvalues()(1))) return average;
-    const double inv = A.ldlt().solve(rhs)(0);
-    // Far from every point a slope would run away: stay within the
-    // neighbours' range (measured on set08, whose page leaves the picture:
-    // widening it by half on each side put M 14 % of the diagonal off the
-    // true surface where the border cuts the page, 5 % without).
-    if (!(inv > 0)) return average;
-    return 1 / std::clamp(inv, lo, hi);
-  }
-
- private:
-  std::vector<Eigen::Vector2d> pixels_;
-  std::vector<double> depths_;
-  int k_;
-  double scale_;
-  DepthModel model_;
-  int planar_k_;
-  PixelCloud cloud_;
-  PixelTree tree_;
 };
 
 // ---------------------------------------------------------------------------

@@ -26,13 +26,12 @@
 #include "common/camera.h"
 #include "common/grid_mesh.h"
 #include "common/isometry/isometry.h"
+#include "common/depth_field.h"
 #include "common/json_io.h"
 
 namespace docunfold::init_mesh {
 
 namespace fs = std::filesystem;
-
-enum class DepthModel { kAverage, kPlanar };
 
 struct Options {
   // Grid of M^r in quads: `grid_short` across the page's shorter side,

@@ -41,9 +41,9 @@ int main(int argc, char** argv) {
                  "--planar-k points (continues each panel's plane over blank paper); average: "
                  "the weighted mean depth of the --k nearest (the paper)")
       ->transform(CLI::CheckedTransformer(
-          std::map<std::string, init_mesh::DepthModel>{
-              {"planar", init_mesh::DepthModel::kPlanar},
-              {"average", init_mesh::DepthModel::kAverage}},
+          std::map<std::string, DepthModel>{
+              {"planar", DepthModel::kPlanar},
+              {"average", DepthModel::kAverage}},
           CLI::ignore_case))
       ->default_str("planar");
   app.add_option("--planar-k", o.planar_neighbours,

@@ -67,6 +67,25 @@ TEST_F(DensifyCli, WritesItsFilesAndKeepsSfmPointsFirstAndUnchanged) {
     EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << e.path();
 }
 
+TEST_F(DensifyCli, SurfacePrewarpIsASecondPassCountedApart) {
+  const CommandResult plain = Run(Out());
+  ASSERT_EQ(plain.exit_code, 0) << plain.output;
+  const Json before = ReadJsonFile(dir_ / "25_points/points.json");
+  EXPECT_EQ(before["points"]["texture_surface_prewarp"].get<int>(), 0);
+  const CommandResult r = Run(Out() + " --surface-prewarp");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("through the points' surface"), std::string::npos) << r.output;
+  const Json after = ReadJsonFile(dir_ / "25_points/points.json");
+  // The first pass is the same; the second only adds.
+  EXPECT_EQ(after["points"]["texture"].get<int>() -
+                after["points"]["texture_surface_prewarp"].get<int>(),
+            before["points"]["texture"].get<int>());
+  EXPECT_TRUE(after["producer"]["options"]["texture"]["surface_prewarp"].get<bool>());
+  const CommandResult v = RunCommand(Quote((SourceDir() / "scripts/validate-json").string()) +
+                                     " " + Quote((dir_ / "25_points/points.json").string()));
+  EXPECT_EQ(v.exit_code, 0) << v.output;
+}
+
 TEST_F(DensifyCli, HelpAndUsage) {
   const CommandResult help = RunCommand(Quote(StageBinary("densify").string()) + " --help");
   EXPECT_EQ(help.exit_code, 0);
