@@ -176,13 +176,20 @@ Scene MakeScene() {
   return s;
 }
 
-DensifyInputs InputsOf(const Scene& s, int sfm_points) {
+// Inputs with the cameras and photos of a scene (the first is the reference);
+// no boundary, region or points yet.
+DensifyInputs PhotoInputs(const CameraSet& cameras, const std::vector<cv::Mat>& photos) {
   DensifyInputs in;
-  in.cameras = s.cameras;
-  in.distortion.assign(s.cameras.views.size(), {0, 0, 0, 0});
-  cv::cvtColor(s.photos[0], in.reference, cv::COLOR_GRAY2BGR);
-  in.photos = s.photos;
+  in.cameras = cameras;
+  in.distortion.assign(cameras.views.size(), {0, 0, 0, 0});
+  cv::cvtColor(photos[0], in.reference, cv::COLOR_GRAY2BGR);
+  in.photos = photos;
   in.photos[0] = cv::Mat();
+  return in;
+}
+
+DensifyInputs InputsOf(const Scene& s, int sfm_points) {
+  DensifyInputs in = PhotoInputs(s.cameras, s.photos);
   const PinholeCamera& ref = s.cameras.views[0];
   const auto corners = s.Corners();
   in.boundary.width = ref.width;
@@ -322,12 +329,7 @@ FoldedScene MakeFoldedScene() {
 
 TEST(Densify, TheFarSideOfAFoldGetsPointsThroughTheSurfaceOfTheFirst) {
   const FoldedScene scene = MakeFoldedScene();
-  DensifyInputs in;
-  in.cameras = scene.cameras;
-  in.distortion.assign(scene.cameras.views.size(), {0, 0, 0, 0});
-  cv::cvtColor(scene.photos[0], in.reference, cv::COLOR_GRAY2BGR);
-  in.photos = scene.photos;
-  in.photos[0] = cv::Mat();
+  DensifyInputs in = PhotoInputs(scene.cameras, scene.photos);
   const PinholeCamera& ref = scene.cameras.views[0];
   const double r = scene.texture.cols - 0.5, b = scene.texture.rows - 0.5;
   for (const Eigen::Vector3d& X :
