@@ -34,7 +34,10 @@
 # Rows per set: homography and oracle (build/bin/baseline), docunfold
 # (60_render/rectified.png) when render ran, and, when the binaries exist,
 # docunfold-init (render on 40_init), docunfold-nofeatures and
-# docunfold-boundary (optimize --no-features / --boundary-only, then render).
+# docunfold-boundary (optimize --no-features / --boundary-only, then render),
+# and docunfold-deshaded and oracle-deshaded (render / baseline --shading
+# remove: the light's shading divided out of the final meshes' rendering and
+# of the oracle alike).
 # To add a built-in row, write a make_row_<name> function below and list it
 # in ROWS: it makes the image (through `timed`) and sets `image` (and
 # `mesh_dir` for geometry), or returns 1 with `reason` set when not applicable.
@@ -143,6 +146,26 @@ make_row_docunfold() {
   [[ -f $work/60_render/rectified.png ]] || { reason="render did not run"; return 1; }
   image=$work/60_render/rectified.png
 }
+# The same meshes rendered with the light's shading divided out, and the
+# oracle with it divided out the same way (the fair ceiling for that row).
+make_row_docunfold-deshaded() {
+  have render || { reason="no render binary"; return 1; }
+  local meshes=$work/50_optimize
+  [[ -f $meshes/mesh3d.ply ]] || meshes=$work/40_init
+  [[ -f $meshes/mesh3d.ply ]] || { reason="no meshes"; return 1; }
+  mesh_dir=$meshes
+  timed docunfold-deshaded "$bin/render" --sfm "$work/10_sfm" --boundary "$work/20_boundary" \
+    --meshes "$meshes" --out "$work/60_render_deshaded" --images "$data/images" \
+    --features "$work/30_features/features.json" --shading remove || return
+  image=$work/60_render_deshaded/rectified.png
+}
+make_row_oracle-deshaded() {
+  [[ -f $work/10_sfm/cameras.json ]] || { reason="no 10_sfm/cameras.json"; return 1; }
+  [[ -f $data/ground_truth/mesh.ply ]] || { reason="no ground_truth/mesh.ply"; return 1; }
+  image=$work/bench/oracle-deshaded.png
+  timed oracle-deshaded "$bin/baseline" --method oracle --data "$data" --work "$work" \
+    --out "$image" --shading remove
+}
 make_row_docunfold-init() {
   have render || { reason="no render binary"; return 1; }
   [[ -f $work/40_init/mesh3d.ply ]] || { reason="no 40_init/mesh3d.ply"; return 1; }
@@ -174,7 +197,8 @@ optimize_variant() {  # optimize_variant <row> <suffix> <optimize flag>
 make_row_docunfold-nofeatures() { optimize_variant docunfold-nofeatures nofeatures --no-features; }
 make_row_docunfold-boundary() { optimize_variant docunfold-boundary boundary --boundary-only; }
 
-ROWS=(homography oracle docunfold docunfold-init docunfold-nofeatures docunfold-boundary)
+ROWS=(homography oracle docunfold docunfold-init docunfold-nofeatures docunfold-boundary
+      oracle-deshaded docunfold-deshaded)
 if [[ -n ${BENCH_ONLY:-} ]]; then read -r -a ROWS <<< "$BENCH_ONLY"; fi
 read -r -a extra_rows <<< "${BENCH_ROWS:-}"
 

@@ -27,7 +27,7 @@ FIGURES = [("ms_ssim", "MS-SSIM ↑", "%.4f"), ("ld", "LD ↓", "%.2f"), ("li_d"
            ("surface_mean_pct", "surface mean % ↓", "%.3f"),
            ("isometry_mean", "isometry ↓", "%.4f")]
 ROW_ORDER = ["homography", "oracle", "docunfold", "docunfold-init", "docunfold-nofeatures",
-             "docunfold-boundary"]
+             "docunfold-boundary", "oracle-deshaded", "docunfold-deshaded"]
 
 
 def read_jsonl(path):
@@ -235,7 +235,10 @@ def markdown(result):
               "relative edge-length error between M and M'. "
               "Rows: `homography` = reference photo warped by the 4 page corners (scanner app); "
               "`oracle` = reference photo textured through the true surface and camera (ceiling "
-              "for one-view texturing); `docunfold` = 60_render/rectified.png." % (
+              "for one-view texturing); `docunfold` = 60_render/rectified.png; `-deshaded` = "
+              "the same with the light's shading divided out (render/baseline `--shading "
+              "remove`): compare `docunfold-deshaded` with `oracle-deshaded`, not with "
+              "`oracle`." % (
                   " resized to flat.png's size" if "--ocr-at-truth-size" in result["producer"]
                   ["options"]["eval_flags"] else " as it is"),
               "Evaluate flags: `%s`." % (result["producer"]["options"]["eval_flags"] or "(none)"),

@@ -10,6 +10,7 @@
 
 #include "common/atomic_file.h"
 #include "common/errors.h"
+#include "common/shading.h"
 #include "common/json_io.h"
 #include "common/raster.h"
 
@@ -270,6 +271,10 @@ BaselineResult Run(const BaselineInputs& in, const BaselineOptions& options) {
                   cameras.reference.c_str(), size.width, size.height);
   }
   out.summary = buf;
+  if (options.remove_shading) {
+    out.image = RemoveShading(out.image).image;
+    out.summary += ", shading removed";
+  }
   return out;
 }
 

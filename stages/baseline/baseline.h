@@ -52,6 +52,9 @@ struct BaselineOptions {
   // (homography only) the mean length of the page's top and bottom sides in
   // the reference view.
   int width = 0;
+  // Divide out the light's shading afterwards (common/shading.h), as render
+  // --shading remove does: the ceiling for results rendered that way.
+  bool remove_shading = false;
 };
 
 struct BaselineInputs {

@@ -30,10 +30,17 @@ int main(int argc, char** argv) {
                  "the size of flat.png, else the page's width in the reference view)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
+  std::string shading = "keep";
+  app.add_option("--shading", shading,
+                 "remove: divide out the light's shading afterwards, as render --shading "
+                 "remove does (the ceiling for such results); keep: as photographed")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"keep", "remove"}));
 
   return RunStage("baseline", app, argc, argv, [&] {
     options.method = method == "oracle" ? baseline::Method::kOracle
                                         : baseline::Method::kHomography;
+    options.remove_shading = shading == "remove";
     const baseline::BaselineResult r = baseline::Run(in, options);
     EnsureDirectory(out.parent_path().empty() ? fs::path(".") : out.parent_path());
     WriteImageAtomic(out, r.image);

@@ -89,6 +89,11 @@ int main(int argc, char** argv) {
                  "by their median (median) or not at all (box: the part of M' the reference "
                  "view sees)")
       ->capture_default_str()->check(CLI::IsMember({"median", "box"}));
+  app.add_option("--shading", o.shading,
+                 "remove: divide out the light's shading (folds, curls, shadows) so that the "
+                 "paper comes out one even colour, as from a scanner (far better OCR); keep: "
+                 "the reference photo's brightness, as the paper's method renders it")
+      ->capture_default_str()->check(CLI::IsMember({"keep", "remove"}));
   bool no_extend = false, no_texture_cut = false;
   std::string images, features;
   app.add_option("--features", features,

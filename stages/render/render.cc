@@ -465,6 +465,7 @@ Json OptionsToJson(const RenderOptions& o) {
           {"max_deskew_deg", o.max_deskew_deg},
           {"deskew_by", o.deskew_by},
           {"sample_hidden", o.sample_hidden},
+          {"shading", o.shading},
           {"side_snap", o.side_snap},
           {"crop_rule", o.crop_rule},
           {"crop_middle_max_deg", o.crop_middle_max_deg},
@@ -536,6 +537,8 @@ Json MakeReport(const RenderOptions& options, const RenderInputs& in,
   doc["hidden_fraction"] = r.hidden_fraction;
   doc["minified_fraction"] = r.minified_fraction;
   doc["other_view_fraction"] = r.other_view_fraction;
+  doc["shading"] = {{"removed", r.shading_removed}};
+  if (r.shading_removed) doc["shading"]["paper_fraction"] = r.shading_paper_fraction;
   Json regs = Json::array();
   for (const ViewRegistration& g : r.registrations)
     regs.push_back({{"view", in.views[g.view].camera.image},
@@ -753,6 +756,13 @@ RenderResult Run(const RenderOptions& options, const RenderInputs& in) {
   const cv::Mat1b unfilled =
       (state != kPage) & (state != kHiddenSampled) & (state != kOtherView);
   image.setTo(cv::Scalar(r.fill[0], r.fill[1], r.fill[2]), unfilled);
+  if (options.shading == "remove") {
+    ShadingRemoval removal = RemoveShading(image, options.shading_removal);
+    image = removal.image;
+    r.shading_removed = true;
+    r.shading_paper_fraction = removal.paper_fraction;
+    timer.Mark("shading");
+  }
   const double n = double(size.width) * size.height;
   r.page_fraction = stats.page / n;
   r.hidden_fraction = stats.hidden / n;

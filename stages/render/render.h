@@ -18,6 +18,7 @@
 #include "common/axis_direction.h"
 #include "common/camera.h"
 #include "common/grid_mesh.h"
+#include "common/shading.h"
 #include "common/json_io.h"
 #include "common/page_files.h"
 #include "stages/render/cut_sides.h"
@@ -106,6 +107,12 @@ struct RenderOptions {
   // it (RenderInputs::views[].photo); off: the fill colour.
   bool texture_cut_sides = true;
   CutSideOptions cut_sides;
+  // "remove": divide out the light's shading (folds, curls, shadows) so the
+  // paper comes out one even colour, as a scan (common/shading.h); "keep":
+  // the reference photo's brightness, as the paper's method renders it (and
+  // as the benchmark's oracle does).
+  std::string shading = "keep";
+  ShadingOptions shading_removal;
   cv::Scalar grid_color = cv::Scalar(40, 40, 230);
   double grid_min_spacing_px = 12;
 };
@@ -173,6 +180,8 @@ struct RenderResult {
   double hidden_fraction = 0;    // output pixels on M' but not seen
   double minified_fraction = 0;  // output pixels that needed pre-filtering
   double other_view_fraction = 0;  // output pixels from another view's photo
+  bool shading_removed = false;
+  double shading_paper_fraction = 0;  // of the image taken as paper (shading = remove)
   int grid_line_step = 1;
   // Clockwise quarter turns applied to the images after rendering (the crop
   // and pixels_per_unit above refer to the unturned image).

@@ -408,12 +408,23 @@ TEST_P(EndToEnd, ResultIsBetterThanTheReferenceMethods) {
   ASSERT_FALSE(std::isnan(ours)) << set_ << ": no docunfold row";
   RecordProperty("ms_ssim", std::to_string(ours));
   // Issues 5 and 6 ask for docunfold above homography and init on every set;
-  // measured: not yet on set02, set05, set07 (front-end errors: boundary
-  // corners on fold kinks). With the true front end (bench
-  // BENCH_FRONTEND=truth) set04 reaches 0.947 against the oracle's 0.959.
+  // measured: below the homography on set07 in weak sfm runs, and below
+  // init on set05 and r03 by under 0.01 in the benchmark at fd584fd (on set04
+  // by 0.09 in an earlier one).
   // Asserted: a real page comes out, and the oracle row is sound.
   EXPECT_GT(ours, 0.25) << set_;
   EXPECT_GT(oracle, homography + 0.05) << set_ << ": the oracle should clearly beat homography";
+  // The light's shading divided out (render/baseline --shading remove) never
+  // costs the page: measured +0.0001 (r02) to +0.14 (set07) on docunfold and
+  // +0.0006 to +0.16 on the oracle over the 12 sets.
+  const double deshaded = Metric(rows, "docunfold-deshaded", "ms_ssim");
+  const double oracle_deshaded = Metric(rows, "oracle-deshaded", "ms_ssim");
+  std::printf("%s: MS-SSIM with the shading removed: docunfold %.4f, oracle %.4f\n",
+              set_.c_str(), deshaded, oracle_deshaded);
+  ASSERT_FALSE(std::isnan(deshaded)) << set_ << ": no docunfold-deshaded row";
+  ASSERT_FALSE(std::isnan(oracle_deshaded)) << set_ << ": no oracle-deshaded row";
+  EXPECT_GE(deshaded, ours - 0.01) << set_;
+  EXPECT_GE(oracle_deshaded, oracle - 0.01) << set_;
 }
 
 // segment-boundary finds the page in the other photos too; where the
@@ -512,9 +523,10 @@ TEST(EndToEndSummary, SamplesOnAverage) {
   std::printf("samples: mean MS-SSIM docunfold %.4f, oracle %.4f; mean LD %.2f\n", ours / n,
               oracle / n, ld / n);
   // Issue 6's targets (within 0.05 of the oracle, LD <= 2) are not met yet:
-  // measured 0.50 vs 0.84 and LD 8.5. Asserted: the figures exist.
+  // measured 2026-11-25 0.79-0.80 against 0.88, LD 2.3-2.5 (set07 and set08
+  // account for most of both gaps). Asserted: no large regression.
   EXPECT_FALSE(std::isnan(ours));
-  EXPECT_GT(ours / n, 0.3);
+  EXPECT_GT(ours / n, 0.7);
 }
 
 }  // namespace

@@ -201,6 +201,26 @@ TEST_F(RenderCli, ContradictoryFlagsAreUsageErrors) {
   ExpectFailure(Render(scene(), out, "--dpi 300"), 2, "--page-width-mm", out);
   ExpectFailure(Render(scene(), out, "--fill purple"), 2, "--fill", out);
   ExpectFailure(Render(scene(), out, "--width 100000"), 2, "--max-pixels", out);
+  ExpectFailure(Render(scene(), out, "--shading dim"), 2, "--shading", out);
+}
+
+// --shading remove divides the light out (common/shading.h, tested there):
+// the report says so, the page's pixels change and the size does not.
+TEST_F(RenderCli, ShadingRemoveIsReportedAndKeepsTheSize) {
+  const fs::path keep = dir_ / "keep", removed = dir_ / "removed";
+  ASSERT_EQ(Render(scene(), keep).exit_code, 0);
+  const CommandResult r = Render(scene(), removed, "--shading remove");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const Json kept_report = ReadJsonFile(keep / "render.json");
+  const Json report = ReadJsonFile(removed / "render.json");
+  EXPECT_FALSE(kept_report["shading"]["removed"].get<bool>());
+  EXPECT_TRUE(report["shading"]["removed"].get<bool>());
+  EXPECT_GT(report["shading"]["paper_fraction"].get<double>(), 0.5);
+  EXPECT_EQ(report["producer"]["options"]["shading"], "remove");
+  const cv::Mat a = cv::imread((keep / "rectified.png").string());
+  const cv::Mat b = cv::imread((removed / "rectified.png").string());
+  ASSERT_EQ(a.size(), b.size());
+  EXPECT_GT(cv::norm(a, b, cv::NORM_L1), 0);
 }
 
 TEST_F(RenderCli, MissingMeshesAreBadInput) {
