@@ -3,30 +3,9 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cstdint>
-#include <nanoflann.hpp>
+#include <tuple>
 
 namespace docunfold {
-
-struct DepthField::Index {
-  struct Cloud {
-    const std::vector<Eigen::Vector2d>* pts;
-    size_t kdtree_get_point_count() const { return pts->size(); }
-    double kdtree_get_pt(size_t i, size_t d) const { return (*pts)[i][int(d)]; }
-    template <class B>
-    bool kdtree_get_bbox(B&) const {
-      return false;
-    }
-  };
-  using Tree = nanoflann::KDTreeSingleIndexAdaptor<
-      nanoflann::L2_Simple_Adaptor<double, Cloud>, Cloud, 2, uint32_t>;
-  explicit Index(const std::vector<Eigen::Vector2d>* pixels)
-      : cloud{pixels},
-        tree(2, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(10)) {
-    tree.buildIndex();
-  }
-  Cloud cloud;
-  Tree tree;
-};
 
 DepthField::DepthField(std::vector<Eigen::Vector2d> pixels,
                        std::vector<double> depths, int k, double scale,
@@ -37,19 +16,17 @@ DepthField::DepthField(std::vector<Eigen::Vector2d> pixels,
       scale_(scale),
       model_(model),
       planar_k_(planar_k),
-      index_(std::make_unique<Index>(&pixels_)) {}
+      index_(std::make_unique<PointIndex2d>(pixels_)) {}
 
 DepthField::~DepthField() = default;
 
 double DepthField::At(const Eigen::Vector2d& px) const {
   const int want = model_ == DepthModel::kPlanar ? std::max(k_, planar_k_) : k_;
-  const size_t k = std::min<size_t>(size_t(want), pixels_.size());
-  std::vector<uint32_t> idx(k);
-  std::vector<double> d2(k);
-  nanoflann::KNNResultSet<double, uint32_t> knn(k);
-  knn.init(idx.data(), d2.data());
-  index_->tree.findNeighbors(knn, px.data(), nanoflann::SearchParams());
-  const size_t found = knn.size();
+  const std::vector<std::pair<int, double>> nearest = index_->Nearest(px, want);
+  const size_t found = nearest.size();
+  std::vector<int> idx(found);
+  std::vector<double> d2(found);
+  for (size_t i = 0; i < found; ++i) std::tie(idx[i], d2[i]) = nearest[i];
   auto weight = [&](size_t i) { return 1 / (1 + d2[i] / (scale_ * scale_)); };
   double sw = 0, sz = 0;
   for (size_t i = 0; i < std::min<size_t>(found, size_t(k_)); ++i) {

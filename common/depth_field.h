@@ -6,6 +6,8 @@
 #include <memory>
 #include <vector>
 
+#include "common/point_index.h"
+
 namespace docunfold {
 
 enum class DepthModel { kAverage, kPlanar };
@@ -30,14 +32,13 @@ class DepthField {
   double At(const Eigen::Vector2d& pixel) const;
 
  private:
-  struct Index;
   std::vector<Eigen::Vector2d> pixels_;
   std::vector<double> depths_;
   int k_;
   double scale_;
   DepthModel model_;
   int planar_k_;
-  std::unique_ptr<Index> index_;
+  std::unique_ptr<PointIndex2d> index_;
 };
 
 }  // namespace docunfold

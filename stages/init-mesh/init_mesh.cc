@@ -570,6 +570,8 @@ Inputs ReadInputs(const fs::path& sfm_dir, const fs::path& boundary_dir,
   const fs::path points_path = points_file.empty() ? sfm_dir / "points.ply" : points_file;
   PlyData ply = ReadPly(points_path);
   if (ply.vertices.empty()) throw InputError(points_path.string() + ": no points");
+  if (const PlyProperty* source = ply.FindProperty("source"))
+    for (double v : source->values) in.point_sources.push_back(int(v));
   in.points = std::move(ply.vertices);
 
   in.reference_image = sfm_dir / "reference.png";
@@ -600,13 +602,18 @@ Result Run(const Inputs& in, const Options& o) {
   auto t = Clock::now();
   const cv::Mat1b region = GrowRegion(in.mask, o.mask_margin_px);
   std::vector<Eigen::Vector3d> region_points;
-  std::vector<Eigen::Vector2d> pixels;
-  std::vector<double> depths;
+  std::vector<Eigen::Vector2d> pixels, outline_pixels;
+  std::vector<double> depths, outline_depths;
+  constexpr int kOutlineSource = 2;  // densify's points.ply
   for (const int i : PointsInRegion(in.points, cam, region)) {
     const Eigen::Vector3d xc = cam.CamFromWorld(in.points[i]);
     region_points.push_back(in.points[i]);
     pixels.push_back(cam.ProjectCam(xc));
     depths.push_back(xc.z());
+    if (size_t(i) < in.point_sources.size() && in.point_sources[i] == kOutlineSource) {
+      outline_pixels.push_back(pixels.back());
+      outline_depths.push_back(depths.back());
+    }
   }
   res.points_total = int(in.points.size());
   res.points_in_region = int(region_points.size());
@@ -678,6 +685,28 @@ Result Run(const Inputs& in, const Options& o) {
   MeshPair& m = res.meshes;
   m.grid = g.grid;
   for (const auto& px : g.pixels) m.mesh3d.push_back(lift(px));
+  if (res.grid_source == "coons") {
+    std::vector<double> grid_depths;
+    for (const Eigen::Vector3d& x : m.mesh3d) grid_depths.push_back(cam.CamFromWorld(x).z());
+    std::array<std::vector<Eigen::Vector2d>, 4> sides;
+    std::array<bool, 4> real{};
+    for (int s = 0; s < 4; ++s) {
+      sides[s] = in.boundary.sides[s].points;
+      real[s] = in.boundary.sides[s].real;
+    }
+    res.outline_prior = OutlinePriorDepths(m.grid, g.pixels, grid_depths, sides, real, cam,
+                                           outline_pixels, outline_depths, kept_px, kept_depth,
+                                           o.outline_prior);
+    if (res.outline_prior.used)
+      for (size_t v = 0; v < m.mesh3d.size(); ++v) {
+        const Eigen::Vector2d& px = g.pixels[v];
+        const Eigen::Vector3d xc =
+            res.outline_prior.depth[v] * (K_inv * Eigen::Vector3d(px.x(), px.y(), 1));
+        m.mesh3d[v] = R_t * (xc - cam.t);
+      }
+  } else {
+    res.outline_prior.note = "no boundary sides (grid over the mask's bounding box)";
+  }
   res.timings.grid = Since(t);
 
   // --- Unfold to the plane.
@@ -785,6 +814,15 @@ Json OptionsToJson(const Options& o) {
       {"min_points_per_ninth", o.min_points_per_ninth},
       {"min_covered_ninths", o.min_covered_ninths},
       {"upright", o.upright},
+      {"outline_prior",
+       {{"enabled", o.outline_prior.enabled},
+        {"side_distance_px", o.outline_prior.side_distance_px},
+        {"min_side_points", o.outline_prior.min_side_points},
+        {"min_measured_sides", o.outline_prior.min_measured_sides},
+        {"neighbours", o.outline_prior.neighbours},
+        {"radius_fraction", o.outline_prior.radius_fraction},
+        {"prior_weight", o.outline_prior.prior_weight},
+        {"agreement", o.outline_prior.agreement}}},
       {"refine",
        {{"lambda",
          {r.weights.iso, r.weights.dist, r.weights.fair3d, r.weights.fair2d, 0.0, o.outline_hold}},
@@ -822,6 +860,18 @@ Json ResultToJson(const Inputs& in, const Result& r, const Options& o, double re
                   {"rbf_scale_px", r.rbf_scale_px},
                   {"model", o.depth_model == DepthModel::kPlanar ? "planar" : "average"},
                   {"planar_neighbours", o.planar_neighbours}};
+  {
+    const OutlinePriorResult& p = r.outline_prior;
+    doc["outline_prior"] = {{"used", p.used},
+                            {"sides_measured", p.measured_sides},
+                            {"outline_points_per_side",
+                             {{"top", p.side_points[0]},
+                              {"right", p.side_points[1]},
+                              {"bottom", p.side_points[2]},
+                              {"left", p.side_points[3]}}},
+                            {"mean_weight", p.mean_weight}};
+    if (!p.note.empty()) doc["outline_prior"]["note"] = p.note;
+  }
   doc["unfold"] = {{"method", "arap"}, {"iterations", r.unfold_iterations}};
   Json refine = isometry::ToJson(r.refine);
   if (!r.refine.iterations.empty()) {

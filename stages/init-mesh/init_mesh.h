@@ -28,6 +28,7 @@
 #include "common/isometry/isometry.h"
 #include "common/depth_field.h"
 #include "common/json_io.h"
+#include "stages/init-mesh/outline_prior.h"
 
 namespace docunfold::init_mesh {
 
@@ -103,6 +104,9 @@ struct Options {
   // ... and those farther than this (fraction of the model size) from every
   // point of the region.
   double outline_hold_support = 0.1;
+  // The depth of blank paper from the page's outline in 3D (densify's
+  // outline points, source 2 in points.ply): outline_prior.h.
+  OutlinePriorOptions outline_prior;
 };
 
 // boundary.json as init-mesh uses it (pixels of the reference image).
@@ -121,6 +125,9 @@ inline constexpr std::array<const char*, 4> kSideNames = {"top", "right", "botto
 struct Inputs {
   PinholeCamera reference;              // the reference view
   std::vector<Eigen::Vector3d> points;  // SfM points, world frame
+  // Per point: points.ply's `source` (densify: 0 sfm, 1 texture, 2 outline,
+  // ...); empty when the file has none (sfm's own cloud).
+  std::vector<int> point_sources;
   Boundary boundary;
   cv::Mat1b mask;                       // 255 inside the page
   fs::path reference_image;             // 10_sfm/reference.png
@@ -154,6 +161,7 @@ struct Result {
   double isometry_error_mean = 0;  // mean relative edge-length difference of (M, M')
   double isometry_error_max = 0;
   double mean_inlier_distance = 0;  // of the SfM inliers to M, / model size
+  OutlinePriorResult outline_prior;
   Timings timings;
 };
 

@@ -114,6 +114,14 @@ int main(int argc, char** argv) {
   bool no_regrid = false;
   app.add_flag("--no-regrid", no_regrid,
                "keep the image-space grid (do not re-grid uniformly on the page after unfolding)");
+  bool no_outline_prior = false;
+  app.add_flag("--no-outline-prior", no_outline_prior,
+               "lift the grid by the points alone (by default the page's outline in 3D, from "
+               "densify's outline points, shapes blank paper where the points agree with it)");
+  app.add_option("--outline-prior-agreement", o.outline_prior.agreement,
+                 "the outline's surface counts where the nearby points' depths differ from it "
+                 "by about this fraction or less (weight exp(-(e/a)^2))")
+      ->capture_default_str()->check(CLI::Range(1e-6, 1.0));
   app.add_flag("--verbose", verbose, "log every outer iteration of the refinement");
 
   return RunStage("init-mesh", app, argc, argv, [&] {
@@ -128,6 +136,7 @@ int main(int argc, char** argv) {
       throw UsageError("--grid: between 1 and 2000 quads per side");
     o.upright = !no_upright;
     o.regrid_on_page = !no_regrid;
+    o.outline_prior.enabled = !no_outline_prior;
     o.refine.method = method == "gn" ? isometry::Method::kGaussNewton : isometry::Method::kLbfgs;
     o.refine.iso_normalization = iso == "strain" ? isometry::IsoNormalization::kStrain
                                                  : isometry::IsoNormalization::kRaw;
@@ -136,6 +145,12 @@ int main(int argc, char** argv) {
     const double read_seconds = SecondsSince(start);
     const init_mesh::Result result = init_mesh::Run(inputs, o);
     for (const std::string& w : result.warnings) Log("warning: " + w);
+    if (result.outline_prior.used)
+      Log("outline prior: " + std::to_string(result.outline_prior.measured_sides) +
+          " sides measured, weight " +
+          std::to_string(result.outline_prior.mean_weight).substr(0, 4) + " on average");
+    else if (o.outline_prior.enabled)
+      Log("outline prior not used: " + result.outline_prior.note);
     if (verbose)
       for (const auto& it : result.refine.iterations)
         Log("refine " + std::to_string(it.iteration) + ": F " + std::to_string(it.F) +

@@ -64,6 +64,33 @@ TEST(InitMeshCli, BlankMarginsContinueTheirPanels) {
   EXPECT_LT(isometry::IsometryEdgeError(ReadMeshPair(ours / "40_init")).mean, 0.005);
 }
 
+// A zig-zag folded page whose print lies in strips along two sides, the folds
+// crossing blank paper between (set07's receipt): the page's outline in 3D
+// (outline points) gives the blank band its panels; the points alone cannot
+// tell a panel's blank middle from a bulge. init.json says what was used.
+TEST(InitMeshCli, TheOutlineShapesBlankPaperBetweenFolds) {
+  TempDir with, without;
+  const MeshPair truth = WriteZigZagWithBlankBandWork(with.path(), 60, 0.2);
+  WriteZigZagWithBlankBandWork(without.path(), 60, 0.2);
+  const CommandResult a = RunCommand(InitMeshCommand(with.path(), "--max-iterations 0"));
+  ASSERT_EQ(a.exit_code, 0) << a.output;
+  const CommandResult b =
+      RunCommand(InitMeshCommand(without.path(), "--max-iterations 0 --no-outline-prior"));
+  ASSERT_EQ(b.exit_code, 0) << b.output;
+  const double size = isometry::ModelSize(truth);
+  const auto prior = SurfaceDistance(ReadMeshPair(with / "40_init"), truth);
+  const auto points = SurfaceDistance(ReadMeshPair(without / "40_init"), truth);
+  std::printf("[init] zig-zag, blank band: mean distance of the lifted grid %.3f %% of the model "
+              "size with the outline prior, %.3f %% from the points alone\n",
+              100 * prior.mean / size, 100 * points.mean / size);
+  EXPECT_LT(prior.mean, 0.5 * points.mean);
+  EXPECT_LT(prior.mean, 0.003 * size);
+  const Json report = ReadJsonFile(with / "40_init/init.json");
+  EXPECT_TRUE(report["outline_prior"]["used"].get<bool>());
+  EXPECT_EQ(report["outline_prior"]["sides_measured"].get<int>(), 4);
+  EXPECT_FALSE(ReadJsonFile(without / "40_init/init.json")["outline_prior"]["used"].get<bool>());
+}
+
 // Mean distance, in reference pixels, from M's border vertices to the page
 // outline of boundary.json.
 double BorderToOutlinePx(const fs::path& work) {

@@ -187,6 +187,48 @@ inline MeshPair WriteFoldedPageWithMarginsWork(const fs::path& work, double fold
   });
 }
 
+// A sheet folded twice along lines from its top side to its bottom side (a
+// zig-zag, like a receipt), tilted, with points only in strips along the top
+// and bottom sides (`strip` of the height each: rows of print) and none in the
+// blank band between, plus densify-like outline points (source 2) along all
+// four sides; points.ply carries `source` (0 for the strips' points).
+inline MeshPair WriteZigZagWithBlankBandWork(const fs::path& work, double fold_deg, double strip) {
+  const int nx = 31, ny = 30;
+  const double w = 0.21, h = 0.297;
+  MeshPair sheet = ProfileSheet(nx, ny, w, h, [&](int c) {
+    return c == 9 ? fold_deg * M_PI / 180 : c == 19 ? -fold_deg * M_PI / 180 : 0.0;
+  });
+  const Eigen::Matrix3d tilt =
+      Eigen::AngleAxisd(25 * M_PI / 180, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  const Eigen::Vector3d centre(0, 0, 1);
+  for (auto& v : sheet.mesh3d) v = centre + tilt * (v - centre);
+  const MeshPair placed = WriteSheetWork(work, sheet, 3000, [&](const Eigen::Vector2d& flat) {
+    return flat.y() <= strip * h || flat.y() >= (1 - strip) * h;
+  });
+  PlyData cloud = ReadPly(work / "10_sfm/points.ply");
+  PlyProperty source{"source", PlyScalar::kUint8, std::vector<double>(cloud.vertices.size(), 0)};
+  const QuadGrid& g = placed.grid;
+  auto along = [&](int r0, int c0, int r1, int c1) {  // border vertex to vertex
+    const Eigen::Vector3d a = placed.mesh3d[g.Index(r0, c0)], b = placed.mesh3d[g.Index(r1, c1)];
+    for (int k = 0; k < 8; ++k) {
+      cloud.vertices.push_back(a + (b - a) * (k / 8.0));
+      cloud.colors.push_back({250, 250, 250});
+      source.values.push_back(2);
+    }
+  };
+  for (int c = 0; c + 1 < g.nx; ++c) {
+    along(0, c, 0, c + 1);
+    along(g.ny - 1, c, g.ny - 1, c + 1);
+  }
+  for (int r = 0; r + 1 < g.ny; ++r) {
+    along(r, 0, r + 1, 0);
+    along(r, g.nx - 1, r + 1, g.nx - 1);
+  }
+  cloud.properties.push_back(source);
+  WritePly(work / "10_sfm/points.ply", cloud);
+  return placed;
+}
+
 // The command line pipeline.mk uses, on a work folder.
 inline std::string InitMeshCommand(const fs::path& work, const std::string& extra = "") {
   return Quote(StageBinary("init-mesh").string()) + " --sfm " + Quote((work / "10_sfm").string()) +
