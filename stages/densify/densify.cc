@@ -16,6 +16,7 @@
 #include "common/cli.h"
 #include "common/depth_field.h"
 #include "common/errors.h"
+#include "common/point_index.h"
 
 namespace docunfold::densify {
 namespace {
@@ -759,7 +760,8 @@ Json DensifyOptions::ToJson() const {
             {"min_triangulation_angle_deg", texture.min_triangulation_angle_deg},
             {"surface_prewarp", texture.surface_prewarp},
             {"surface_grid_px", texture.surface_grid_px},
-            {"surface_neighbours", texture.surface_neighbours}}},
+            {"surface_neighbours", texture.surface_neighbours},
+            {"surface_hole_px", texture.surface_hole_px}}},
           {"outline",
            {{"enabled", outline.enabled},
             {"step_px", outline.step_px},
@@ -946,6 +948,18 @@ DensifyResult Run(const DensifyInputs& in, const DensifyOptions& o) {
     std::vector<Eigen::Vector3d> known = page_points;
     known.insert(known.end(), r.points.vertices.begin() + first_new_point, r.points.vertices.end());
     for (Track& track : tracks) track.obs.clear();
+    if (o.texture.surface_hole_px > 0) {
+      std::vector<Eigen::Vector2d> found;
+      for (const Track& track : tracks)
+        if (track.done) found.push_back(track.pixel);
+      if (!found.empty()) {
+        const PointIndex2d index(found);
+        const double hole2 = o.texture.surface_hole_px * o.texture.surface_hole_px;
+        for (Track& track : tracks)
+          if (!track.done && index.Nearest(track.pixel, 1).front().second < hole2)
+            track.done = true;  // next to what the first pass found: left alone
+      }
+    }
     FollowBySurface(ref, others, region, known, o.texture, &tracks, &r);
     r.texture_points_surface = TriangulateTracks(ref, in.reference, o.texture, &tracks, &r);
     r.texture_points += r.texture_points_surface;

@@ -70,6 +70,10 @@ struct TextureOptions {
   bool surface_prewarp = false;
   double surface_grid_px = 4;
   int surface_neighbours = 16;
+  // The second pass tries only samples at least this far (working-copy
+  // pixels) from every point the first pass made: the holes it left (a far
+  // panel), not the ragged edges of what it found. 0: every sample left.
+  double surface_hole_px = 0;
 };
 
 struct OutlineOptions {

@@ -39,6 +39,10 @@ int main(int argc, char** argv) {
                "texture: a second pass for the samples the first left without a point, the "
                "photos brought onto the reference through the surface of the points found "
                "first instead of the page's homography (flaps, the far side of a fold)");
+  app.add_option("--surface-hole-px", o.texture.surface_hole_px,
+                 "texture, second pass: only samples at least this far from every point the "
+                 "first pass made (working-copy pixels; 0 = every sample it left)")
+      ->capture_default_str()->check(CLI::Range(0.0, 10000.0));
   app.add_option("--surface-grid", o.texture.surface_grid_px,
                  "texture, second pass: the surface's depth is fitted every this many "
                  "working-copy pixels and interpolated in between")
