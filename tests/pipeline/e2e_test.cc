@@ -338,9 +338,12 @@ TEST_P(EndToEnd, MeshesAreCloseToTheTruthAndReadable) {
   // on every set over five sfm runs but set07's, 0.17-1.30 % (5.5-6.4 % with
   // the paper's diagonals alone; 0.25 % on the 1.30 % run since init stops
   // no more on heavily damped steps).
+  // Since init-mesh's outline prior (2026-11-25), set07's init isometry
+  // error is 0.07, 0.11 and 0.19 % and its M 0.41, 0.40 and 0.78 % off in three runs; the
+  // benchmark's run: isometry at most 0.12 % (r01) on every set.
   EXPECT_LE(final_surface, 3.0) << set_;
   EXPECT_LE(final_surface, 1.05 * init_surface + 0.1) << set_;
-  EXPECT_LT(init_iso, 0.02) << set_;
+  EXPECT_LT(init_iso, 0.01) << set_;
   EXPECT_LT(final_iso, 0.03) << set_;
   // Every PLY of the run opens in an independent reader.
   for (const char* f : {"40_init/mesh3d.ply", "40_init/mesh2d.ply", "50_optimize/mesh3d.ply",
