@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <numeric>
+#include <optional>
 
 #include <Eigen/Eigenvalues>
 #include <nanoflann.hpp>
@@ -72,6 +73,72 @@ bool MergedIsStraight(const Cluster& a, const Cluster& b, double max_straightnes
   return *straightness < max_straightness && overlap < 0.3 * std::min(a.Width(), b.Width());
 }
 
+// The border edges of M as seen by a camera, for outline samples that lie
+// off M's image: their marker goes on the nearest border point, and the ray
+// term then pulls M's border out to the page's outline. Snapping to the
+// nearest covered pixel instead extrapolates a border triangle's plane onto
+// the ray, which leaves the ray term nothing to pull.
+class MeshBorder {
+ public:
+  MeshBorder(const MeshPair& m, const PinholeCamera& camera) {
+    const QuadGrid& g = m.grid;
+    const std::vector<Triangle> tris = g.Triangles();
+    for (int t = 0; t < int(tris.size()); ++t) {
+      const auto quad = g.Quad(t / 2);
+      const int qr = quad[0] / g.nx, qc = quad[0] % g.nx;
+      for (int i = 0; i < 3; ++i) {
+        const int j = (i + 1) % 3, a = tris[t][i], b = tris[t][j];
+        // An outer edge of a quad in the grid's first or last row (column).
+        const int ra = a / g.nx, rb = b / g.nx, ca = a % g.nx, cb = b % g.nx;
+        const bool row_edge =
+            ra == rb && ((ra == 0 && qr == 0) || (ra == g.ny - 1 && qr == g.ny - 2));
+        const bool col_edge =
+            ca == cb && ((ca == 0 && qc == 0) || (ca == g.nx - 1 && qc == g.nx - 2));
+        if (!row_edge && !col_edge) continue;
+        const Eigen::Vector3d pa = camera.CamFromWorld(m.mesh3d[a]);
+        const Eigen::Vector3d pb = camera.CamFromWorld(m.mesh3d[b]);
+        if (pa.z() <= 0 || pb.z() <= 0) continue;
+        edges_.push_back({t, i, j, camera.ProjectCam(pa), camera.ProjectCam(pb)});
+      }
+    }
+  }
+
+  // The border point whose image is nearest to `pixel` within `radius`,
+  // among edges running within 45 degrees of `along` (so a sample near a
+  // corner keeps to its own side).
+  std::optional<SurfacePoint> Nearest(const Eigen::Vector2d& pixel, const Eigen::Vector2d& along,
+                                      double radius) const {
+    const double along_norm = along.norm();
+    std::optional<SurfacePoint> best;
+    double best_d = radius;
+    for (const Edge& e : edges_) {
+      const Eigen::Vector2d d = e.b - e.a;
+      const double len2 = d.squaredNorm();
+      if (len2 <= 0) continue;
+      if (along_norm > 0 &&
+          std::abs(d.dot(along)) < std::cos(kPi / 4) * std::sqrt(len2) * along_norm)
+        continue;
+      const double t = std::clamp((pixel - e.a).dot(d) / len2, 0.0, 1.0);
+      const double dist = (e.a + t * d - pixel).norm();
+      if (dist >= best_d) continue;
+      best_d = dist;
+      SurfacePoint sp;
+      sp.triangle = e.triangle;
+      sp.bary[e.corner_a] = 1 - t;
+      sp.bary[e.corner_b] = t;
+      best = sp;
+    }
+    return best;
+  }
+
+ private:
+  struct Edge {
+    int triangle, corner_a, corner_b;
+    Eigen::Vector2d a, b;  // images of the two corners
+  };
+  std::vector<Edge> edges_;
+};
+
 }  // namespace
 
 std::vector<Eigen::Vector2d> SamplePolyline(const std::vector<Eigen::Vector2d>& polyline,
@@ -93,11 +160,21 @@ MarkerSet CastMarkers(const MeshPair& meshes, const PinholeCamera& reference,
   const double scale = std::min(1.0, std::sqrt(options.max_raster_pixels / pixels));
   PixelToSurface map(meshes, reference, scale);
   const Eigen::Vector3d origin = reference.Center();
+  const double border_radius =
+      options.border_snap * std::hypot(double(reference.width), double(reference.height));
+  std::optional<MeshBorder> border;
   MarkerSet set;
   set.markers_of_segment.assign(segments.size(), 0);
   for (size_t s = 0; s < segments.size(); ++s)
-    for (const Eigen::Vector2d& px : segments[s].pixels) {
+    for (size_t k = 0; k < segments[s].pixels.size(); ++k) {
+      const Eigen::Vector2d& px = segments[s].pixels[k];
       auto where = map.LookupNear(px, options.snap_px);
+      if (!where && segments[s].kind == "boundary" && border_radius > 0) {
+        if (!border) border.emplace(meshes, reference);
+        const auto& p = segments[s].pixels;
+        const Eigen::Vector2d along = p[std::min(k + 1, p.size() - 1)] - p[k > 0 ? k - 1 : 0];
+        where = border->Nearest(px, along, border_radius);
+      }
       if (!where) continue;
       isometry::Marker m;
       m.where = *where;

@@ -72,6 +72,12 @@ int main(int argc, char** argv) {
   app.add_flag("--no-projection", no_projection, "without feature line projection (ablation)");
   app.add_option("--marker-step", o.marker_step_px, "sample spacing along segments, pixels")
       ->capture_default_str();
+  app.add_option("--border-snap", o.cast.border_snap,
+                 "page-side samples off M's image go on M's nearest border point within this "
+                 "fraction of the image diagonal, so the ray term pulls the border to the "
+                 "outline (0: dropped; README, \"Choices we measured\")")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
   app.add_option("--merge-gap", o.grouping.gap,
                  "segments merge when their closest ends are this close along the line "
                  "(fraction of the M' diagonal)")
