@@ -410,12 +410,16 @@ TEST_P(EndToEnd, ResultIsBetterThanTheReferenceMethods) {
               set_.c_str(), ours, init, homography, oracle, Metric(rows, "docunfold", "ld"));
   ASSERT_FALSE(std::isnan(ours)) << set_ << ": no docunfold row";
   RecordProperty("ms_ssim", std::to_string(ours));
-  // Issues 5 and 6 ask for docunfold above homography and init on every set;
-  // measured: below the homography on set07 in weak sfm runs, and below
-  // init on set05 and r03 by under 0.01 in the benchmark at fd584fd (on set04
-  // by 0.09 in an earlier one).
-  // Asserted: a real page comes out, and the oracle row is sound.
+  // Issues 5 and 6 ask for docunfold-init and docunfold above the homography
+  // on every set: since init-mesh's outline prior the smallest margins are
+  // set07's, 0.11-0.13 (docunfold) and 0.13-0.15 (init) over four sfm runs
+  // (2026-11-25; set07 fell below the homography in weak runs before it).
+  // Issue 6 also asks for docunfold above init - 0.01 on every set; not
+  // asserted: set07 stays 0.015-0.03 below its init (README, "Where set07
+  // loses to its init"), set05 within 0.01 either way.
   EXPECT_GT(ours, 0.25) << set_;
+  EXPECT_GT(ours, homography) << set_ << ": docunfold should beat the homography";
+  EXPECT_GT(init, homography) << set_ << ": docunfold-init should beat the homography";
   EXPECT_GT(oracle, homography + 0.05) << set_ << ": the oracle should clearly beat homography";
   // The light's shading divided out (render/baseline --shading remove) never
   // costs the page: measured +0.0001 (r02) to +0.14 (set07) on docunfold and
@@ -525,11 +529,13 @@ TEST(EndToEndSummary, SamplesOnAverage) {
   ASSERT_GT(n, 0);
   std::printf("samples: mean MS-SSIM docunfold %.4f, oracle %.4f; mean LD %.2f\n", ours / n,
               oracle / n, ld / n);
-  // Issue 6's targets (within 0.05 of the oracle, LD <= 2) are not met yet:
-  // measured 2026-11-25 0.79-0.80 against 0.88, LD 2.3-2.5 (set07 and set08
-  // account for most of both gaps). Asserted: no large regression.
+  // Issue 6's targets: within 0.05 of the oracle (not met: 0.798-0.806
+  // against 0.882 over five runs since 2026-11-25's outline prior; set08, cut
+  // off in every photo, alone costs 0.05 of it) and mean LD <= 2 (1.81-2.19
+  // over those runs). Asserted: no regression beyond the runs' spread.
   EXPECT_FALSE(std::isnan(ours));
-  EXPECT_GT(ours / n, 0.7);
+  EXPECT_GT(ours / n, 0.76);
+  EXPECT_LT(ld / n, 2.6);
 }
 
 }  // namespace
