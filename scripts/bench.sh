@@ -134,7 +134,17 @@ make_row_homography() {
   [[ -f $work/10_sfm/cameras.json && -f $work/20_boundary/boundary.json ]] ||
     { reason="no 10_sfm/ or 20_boundary/boundary.json"; return 1; }
   image=$work/bench/homography.png
-  timed homography "$bin/baseline" --method homography --data "$data" --work "$work" --out "$image"
+  # Read the same way up as docunfold's result (a scanner app turns its page
+  # upright too): segment-boundary's corner labels are a quarter or half turn
+  # off wherever it cannot read the text.
+  local turns=0
+  if [[ -f $work/60_render/render.json ]]; then
+    turns=$(/usr/bin/python3 -c 'import json, sys
+print(json.load(open(sys.argv[1])).get("orientation", {}).get("quarter_turns_clockwise", 0))' \
+      "$work/60_render/render.json" 2>/dev/null) || turns=0
+  fi
+  timed homography "$bin/baseline" --method homography --data "$data" --work "$work" \
+    --quarter-turns "${turns:-0}" --out "$image"
 }
 make_row_oracle() {
   [[ -f $work/10_sfm/cameras.json ]] || { reason="no 10_sfm/cameras.json"; return 1; }

@@ -215,8 +215,13 @@ BaselineResult Run(const BaselineInputs& in, const BaselineOptions& options) {
   if (options.method == Method::kHomography) {
     const cv::Mat reference =
         ReadImage(MustExist(in.work / "10_sfm" / "reference.png", "run sfm first"));
-    const Corners corners = ReadCorners(
+    const Corners labelled = ReadCorners(
         MustExist(in.work / "20_boundary" / "boundary.json", "run segment-boundary first"));
+    // Turned clockwise k times, the page's new top-left is its old corner k
+    // places back (TL, TR, BR, BL order).
+    const int turns = ((options.quarter_turns % 4) + 4) % 4;
+    Corners corners;
+    for (int i = 0; i < 4; ++i) corners[i] = labelled[(i - turns + 4) % 4];
     double aspect;
     const char* aspect_from;
     if (fs::is_regular_file(gt / "page.json", ec)) {
@@ -242,8 +247,10 @@ BaselineResult Run(const BaselineInputs& in, const BaselineOptions& options) {
     }
     size = cv::Size(std::max(1, size.width), std::max(1, size.height));
     out.image = WarpByCorners(reference, corners, size);
-    std::snprintf(buf, sizeof buf, "homography of %s by its 4 corners, %dx%d, aspect %.4f (%s)",
-                  cameras.reference.c_str(), size.width, size.height, aspect, aspect_from);
+    std::snprintf(buf, sizeof buf,
+                  "homography of %s by its 4 corners, %dx%d, aspect %.4f (%s), %d quarter "
+                  "turns",
+                  cameras.reference.c_str(), size.width, size.height, aspect, aspect_from, turns);
   } else {
     if (!has_flat)
       throw InputError((gt / "flat.png").string() +

@@ -55,6 +55,12 @@ struct BaselineOptions {
   // Divide out the light's shading afterwards (common/shading.h), as render
   // --shading remove does: the ceiling for results rendered that way.
   bool remove_shading = false;
+  // Homography: turn the page clockwise by this many quarter turns (render's
+  // orientation.quarter_turns_clockwise in 60_render/render.json), so that
+  // it reads the same way up as docunfold's result, as a scanner app's page
+  // would. The corners' labels come from segment-boundary, which tells up
+  // from down only when it can read the text.
+  int quarter_turns = 0;
 };
 
 struct BaselineInputs {

@@ -30,6 +30,12 @@ int main(int argc, char** argv) {
                  "the size of flat.png, else the page's width in the reference view)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
+  app.add_option("--quarter-turns", options.quarter_turns,
+                 "homography: turn the page clockwise this many quarter turns first (bench "
+                 "passes 60_render/render.json's orientation.quarter_turns_clockwise, so it "
+                 "reads the same way up as docunfold's result)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 3));
   std::string shading = "keep";
   app.add_option("--shading", shading,
                  "remove: divide out the light's shading afterwards, as render --shading "
