@@ -233,7 +233,7 @@ def markdown(result):
               "of Tesseract (eng) on the result%s against Tesseract on flat.png; surface mean "
               "distance of M to the true surface in %% of the page diagonal; isometry = mean "
               "relative edge-length error between M and M'. "
-              "Rows: `homography` = reference photo warped by the 4 page corners (scanner app); "
+              "Rows: `homography` = reference photo warped by the 4 page corners (scanner app), turned the way render turned docunfold's page; "
               "`oracle` = reference photo textured through the true surface and camera (ceiling "
               "for one-view texturing); `docunfold` = 60_render/rectified.png; `-deshaded` = "
               "the same with the light's shading divided out (render/baseline `--shading "

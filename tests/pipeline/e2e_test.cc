@@ -530,9 +530,10 @@ TEST(EndToEndSummary, SamplesOnAverage) {
   std::printf("samples: mean MS-SSIM docunfold %.4f, oracle %.4f; mean LD %.2f\n", ours / n,
               oracle / n, ld / n);
   // Issue 6's targets: within 0.05 of the oracle (not met: 0.798-0.806
-  // against 0.882 over five runs since 2026-11-25's outline prior; set08, cut
-  // off in every photo, alone costs 0.05 of it) and mean LD <= 2 (1.81-2.19
-  // over those runs). Asserted: no regression beyond the runs' spread.
+  // against 0.882 over six runs since 2026-11-25's outline prior; set08, cut
+  // off in every photo, alone costs 0.05 of it) and mean LD <= 2 (1.81-2.39
+  // over those runs: not met in all). Asserted: no regression beyond the
+  // runs' spread.
   EXPECT_FALSE(std::isnan(ours));
   EXPECT_GT(ours / n, 0.76);
   EXPECT_LT(ld / n, 2.6);
