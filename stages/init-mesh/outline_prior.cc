@@ -194,16 +194,22 @@ OutlinePriorResult OutlinePriorDepths(
     lines[1].push_back(grid.Index(row, nx - 1));
     lines[3].push_back(grid.Index(row, 0));
   }
-  for (const auto& line : lines) {
-    std::vector<Eigen::Vector2d> px;
-    std::vector<double> w;
-    for (int v : line) {
-      px.push_back(grid_pixels[size_t(v)]);
-      w.push_back(border[size_t(v)]);
+  // A line without points of its own (no outline point on its side) gets
+  // its corners from the crossing lines, so the rows go again once the
+  // columns are done: which side that is depends only on how the grid lies
+  // on the page (set07 lost the prior in every sfm run that labelled its
+  // unseen side top or bottom).
+  for (int pass = 0; pass < 2; ++pass)
+    for (const auto& line : lines) {
+      std::vector<Eigen::Vector2d> px;
+      std::vector<double> w;
+      for (int v : line) {
+        px.push_back(grid_pixels[size_t(v)]);
+        w.push_back(border[size_t(v)]);
+      }
+      if (!FillBorderLine(px, &w)) continue;  // maybe filled from a crossing line
+      for (size_t k = 0; k < line.size(); ++k) border[size_t(line[k])] = w[k];
     }
-    if (!FillBorderLine(px, &w)) continue;  // maybe filled from a crossing line
-    for (size_t k = 0; k < line.size(); ++k) border[size_t(line[k])] = w[k];
-  }
   for (const auto& line : lines)
     for (int v : line)
       if (!(border[size_t(v)] > 0)) {
