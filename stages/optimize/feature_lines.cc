@@ -84,16 +84,12 @@ class MeshBorder {
     const QuadGrid& g = m.grid;
     const std::vector<Triangle> tris = g.Triangles();
     for (int t = 0; t < int(tris.size()); ++t) {
-      const auto quad = g.Quad(t / 2);
-      const int qr = quad[0] / g.nx, qc = quad[0] % g.nx;
       for (int i = 0; i < 3; ++i) {
         const int j = (i + 1) % 3, a = tris[t][i], b = tris[t][j];
-        // An outer edge of a quad in the grid's first or last row (column).
+        // Both ends in the grid's first or last row (column): an outer edge.
         const int ra = a / g.nx, rb = b / g.nx, ca = a % g.nx, cb = b % g.nx;
-        const bool row_edge =
-            ra == rb && ((ra == 0 && qr == 0) || (ra == g.ny - 1 && qr == g.ny - 2));
-        const bool col_edge =
-            ca == cb && ((ca == 0 && qc == 0) || (ca == g.nx - 1 && qc == g.nx - 2));
+        const bool row_edge = ra == rb && (ra == 0 || ra == g.ny - 1);
+        const bool col_edge = ca == cb && (ca == 0 || ca == g.nx - 1);
         if (!row_edge && !col_edge) continue;
         const Eigen::Vector3d pa = camera.CamFromWorld(m.mesh3d[a]);
         const Eigen::Vector3d pb = camera.CamFromWorld(m.mesh3d[b]);
