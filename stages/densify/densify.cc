@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <limits>
+#include <memory>
 
 #include <Eigen/SVD>
 #include <opencv2/calib3d.hpp>
@@ -491,14 +493,30 @@ bool ContinuesSurface(const Eigen::Vector2d& pixel, double depth,
   return !(inverse_depth > 0 && std::abs(1 / inverse_depth - depth) > o.max_depth_jump * depth);
 }
 
-void AddOutlinePoints(const View& ref, const std::vector<View>& others, int num_views,
-                      const Boundary& boundary, const cv::Mat1b& page,
+// What became of the edge samples handed to MatchEdgeSamples.
+struct EdgeCounts {
+  int unmatched = 0;    // fewer than min_views agree
+  int ambiguous = 0;    // another depth is as well supported
+  int off_surface = 0;  // refused by the caller's check
+  int points = 0;
+};
+
+// Whether a triangulated edge sample at `depth` (reference camera) may be kept.
+using EdgeCheck = std::function<bool(const EdgeSample&, double depth)>;
+
+// Matches edge samples of the reference along their epipolar segments in the
+// other views (steps of the same sign crossing them, continuing straight
+// along the edge), triangulates those enough views agree on unambiguously,
+// and appends the points `check` accepts, with `source` and `colour`.
+// `stats`, when given, counts candidates and votes per view.
+void MatchEdgeSamples(const View& ref, const std::vector<View>& others, int num_views,
+                      std::vector<EdgeSample>* samples_in,
                       const std::vector<Eigen::Vector2d>& known_pixels,
                       const std::vector<double>& known_depths, const OutlineOptions& o,
-                      DensifyResult* result) {
-  if (known_pixels.empty()) return;
-  std::vector<EdgeSample> samples = EdgeSamples(ref, boundary, page, result->working_scale, o);
-  result->outline_samples = int(samples.size());
+                      const EdgeCheck& check, PointSource source,
+                      const std::array<uint8_t, 3>& colour, EdgeCounts* counts,
+                      std::vector<ViewStats>* stats, PlyData* points) {
+  std::vector<EdgeSample>& samples = *samples_in;
   // Depth range of each sample from its nearest known points.
   {
     std::vector<std::pair<double, double>> by_distance(known_pixels.size());
@@ -520,7 +538,6 @@ void AddOutlinePoints(const View& ref, const std::vector<View>& others, int num_
 
   const double min_cos = std::sin(o.min_epipolar_angle_deg * M_PI / 180);
   for (const View& view : others) {
-    ViewStats& stats = result->views[view.index];
     for (EdgeSample& e : samples) {
       const Eigen::Vector3d A = view.camera.CamFromWorld(RayPoint(ref.camera, e.pixel, e.near_depth));
       const Eigen::Vector3d B = view.camera.CamFromWorld(RayPoint(ref.camera, e.pixel, e.far_depth));
@@ -566,7 +583,7 @@ void AddOutlinePoints(const View& ref, const std::vector<View>& others, int num_
         }
         if (!straight) continue;
         e.candidates[view.index].push_back({c, normal});
-        ++stats.outline_candidates;
+        if (stats) ++(*stats)[view.index].outline_candidates;
       }
     }
   }
@@ -621,7 +638,7 @@ void AddOutlinePoints(const View& ref, const std::vector<View>& others, int num_
     for (size_t h = 0; h < hypotheses.size(); ++h)
       if (best < 0 || hypotheses[h].obs.size() > hypotheses[best].obs.size()) best = int(h);
     if (best < 0 || int(hypotheses[best].obs.size()) < o.min_views) {
-      ++result->outline_unmatched;
+      ++counts->unmatched;
       continue;
     }
     // Unambiguous: no hypothesis at a clearly different depth (its points
@@ -639,25 +656,208 @@ void AddOutlinePoints(const View& ref, const std::vector<View>& others, int num_
       ambiguous = apart > 3;
     }
     if (ambiguous) {
-      ++result->outline_ambiguous;
+      ++counts->ambiguous;
       continue;
     }
     const Hypothesis& h = hypotheses[best];
     double depth = ref.camera.CamFromWorld(h.point).z(), worst = 0, error = 0;
     if (!DepthAcrossEdges(ref.camera, e.pixel, h.obs, h.normals, &depth, &worst, &error) ||
         worst > o.max_reprojection_px) {
-      ++result->outline_unmatched;
+      ++counts->unmatched;
       continue;
     }
-    if (!ContinuesSurface(e.pixel, depth, known_pixels, known_depths, o)) {
-      ++result->outline_off_surface;
+    if (!check(e, depth)) {
+      ++counts->off_surface;
       continue;
     }
-    AppendPoint(RayPoint(ref.camera, e.pixel, depth), {255, 0, 255}, int(h.obs.size()), error,
-                kOutline, &result->points);
-    for (int vi : h.views) ++result->views[vi].outline_votes;
-    ++result->outline_points;
+    AppendPoint(RayPoint(ref.camera, e.pixel, depth), colour, int(h.obs.size()), error, source,
+                points);
+    if (stats)
+      for (int vi : h.views) ++(*stats)[vi].outline_votes;
+    ++counts->points;
   }
+}
+
+void AddOutlinePoints(const View& ref, const std::vector<View>& others, int num_views,
+                      const Boundary& boundary, const cv::Mat1b& page,
+                      const std::vector<Eigen::Vector2d>& known_pixels,
+                      const std::vector<double>& known_depths, const OutlineOptions& o,
+                      DensifyResult* result) {
+  if (known_pixels.empty()) return;
+  std::vector<EdgeSample> samples = EdgeSamples(ref, boundary, page, result->working_scale, o);
+  result->outline_samples = int(samples.size());
+  EdgeCounts counts;
+  MatchEdgeSamples(
+      ref, others, num_views, &samples, known_pixels, known_depths, o,
+      [&](const EdgeSample& e, double depth) {
+        return ContinuesSurface(e.pixel, depth, known_pixels, known_depths, o);
+      },
+      kOutline, {255, 0, 255}, &counts, &result->views, &result->points);
+  result->outline_unmatched = counts.unmatched;
+  result->outline_ambiguous = counts.ambiguous;
+  result->outline_off_surface = counts.off_surface;
+  result->outline_points = counts.points;
+}
+
+// --- shading-step points ----------------------------------------------------
+
+// `view` with the gradient of a copy blurred by `sigma` instead: print is
+// gone from it, the shading of folds is not.
+View BlurredView(const View& view, double sigma) {
+  View v = view;
+  cv::Mat blurred;
+  cv::GaussianBlur(view.grey, blurred, cv::Size(0, 0), sigma);
+  cv::Sobel(blurred, v.gx, CV_32F, 1, 0, 3, 0.125);
+  cv::Sobel(blurred, v.gy, CV_32F, 0, 1, 3, 0.125);
+  return v;
+}
+
+// Steps of the blurred reference inside the page, at least
+// `outline_gap_px` from its outline: the strongest ridge pixel of the
+// gradient (non-maximum suppressed across the step) in each `step_px` cell,
+// where it reaches `min_contrast` and continues as a step along its
+// direction. Normals point the way grey rises (sign +1).
+std::vector<EdgeSample> StepSamples(const View& blurred_ref, const cv::Mat1b& page,
+                                    const std::vector<Eigen::Vector2d>& known_pixels,
+                                    const StepOptions& o, double straight_px) {
+  std::unique_ptr<PointIndex2d> known;
+  if (o.min_point_gap_px > 0 && !known_pixels.empty())
+    known = std::make_unique<PointIndex2d>(known_pixels);
+  cv::Mat1b inside;
+  const int gap = std::max(1, int(std::lround(o.outline_gap_px)));
+  cv::erode(page, inside,
+            cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * gap + 1, 2 * gap + 1)));
+  const cv::Mat1f &gx = blurred_ref.gx, &gy = blurred_ref.gy;
+  cv::Mat1f magnitude;
+  cv::magnitude(gx, gy, magnitude);
+  const int cell = std::max(1, int(std::lround(o.step_px)));
+  const int cells_x = (page.cols + cell - 1) / cell;
+  std::vector<std::pair<float, cv::Point>> best(size_t(cells_x) * ((page.rows + cell - 1) / cell),
+                                                {0.f, cv::Point(-1, -1)});
+  for (int y = 1; y + 1 < page.rows; ++y)
+    for (int x = 1; x + 1 < page.cols; ++x) {
+      const float m = magnitude(y, x);
+      if (m < o.min_contrast || !inside(y, x)) continue;
+      // Neighbours across the step (the gradient's direction, to 45 degrees).
+      const double angle = std::atan2(gy(y, x), gx(y, x));
+      const int q = int(std::lround(angle / (M_PI / 4))) & 3;
+      const int dx = q == 0 ? 1 : q == 2 ? 0 : 1, dy = q == 0 ? 0 : q == 1 ? 1 : q == 2 ? 1 : -1;
+      if (m < magnitude(y + dy, x + dx) || m < magnitude(y - dy, x - dx)) continue;
+      auto& b = best[size_t(y / cell) * cells_x + x / cell];
+      if (m > b.first) b = {m, cv::Point(x, y)};
+    }
+  std::vector<EdgeSample> samples;
+  for (const auto& [m, p] : best) {
+    if (p.x < 0) continue;
+    const Eigen::Vector2d c(p.x, p.y);
+    if (known && known->Nearest(c, 1).front().second < o.min_point_gap_px * o.min_point_gap_px)
+      continue;
+    const Eigen::Vector2d n = blurred_ref.Gradient(c).normalized();
+    if (!n.allFinite()) continue;
+    double offset = 0, strength = 0;
+    if (!FindStep(blurred_ref, c, n, 2, 1, &offset, &strength)) continue;
+    const Eigen::Vector2d at = c + offset * n;
+    const Eigen::Vector2d tangent(-n.y(), n.x());
+    bool straight = true;
+    for (double along : {-straight_px, -straight_px / 2, straight_px / 2, straight_px}) {
+      double o2 = 0, s2 = 0;
+      if (!FindStep(blurred_ref, at + along * tangent, n, 1.5, 1, &o2, &s2) || s2 < 0.5 * strength) {
+        straight = false;
+        break;
+      }
+    }
+    if (!straight) continue;
+    EdgeSample e;
+    e.pixel = at;
+    e.normal = n;
+    e.sign = 1;
+    samples.push_back(e);
+  }
+  return samples;
+}
+
+// The surface of the known points within `radius` of `pixel` on one side of
+// the line through it with normal `normal` (side +1 or -1), by an affine
+// fit of 1/depth (exact on a plane): its depth at `pixel` and |cos| of the
+// angle between the reference ray there and the fitted plane's normal.
+// False when fewer than 6 points there span an area.
+bool SideSurface(const PinholeCamera& camera, const Eigen::Vector2d& pixel,
+                 const Eigen::Vector2d& normal, int side, double radius,
+                 const std::vector<Eigen::Vector2d>& known_pixels,
+                 const std::vector<double>& known_depths, double* depth, double* cos_ray) {
+  Eigen::Matrix3d ata = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d atb = Eigen::Vector3d::Zero();
+  int near = 0;
+  for (size_t i = 0; i < known_pixels.size(); ++i) {
+    const Eigen::Vector2d d = known_pixels[i] - pixel;
+    if (d.squaredNorm() > radius * radius || side * d.dot(normal) < 1) continue;
+    const Eigen::Vector3d a(d.x(), d.y(), 1);
+    ata += a * a.transpose();
+    atb += a / known_depths[i];
+    ++near;
+  }
+  if (near < 6 || !(std::abs(ata.determinant()) > 1e-6 * std::pow(ata.trace(), 3))) return false;
+  const Eigen::Vector3d c = ata.ldlt().solve(atb);  // 1/z = c0 du + c1 dv + c2
+  if (!(c(2) > 0)) return false;
+  *depth = 1 / c(2);
+  // 1/z = n.(K^-1 [u v 1]) / d for the plane n.X = d: n ~ K^T (c0, c1, c2 - c0 u - c1 v).
+  const Eigen::Vector3d plane = camera.K.transpose() *
+                                Eigen::Vector3d(c(0), c(1), c(2) - c(0) * pixel.x() - c(1) * pixel.y());
+  const Eigen::Vector3d ray = camera.K.inverse() * Eigen::Vector3d(pixel.x(), pixel.y(), 1);
+  *cos_ray = std::abs(plane.normalized().dot(ray.normalized()));
+  return true;
+}
+
+void AddStepPoints(const View& ref, const std::vector<View>& others, int num_views,
+                   const cv::Mat1b& page, const std::vector<Eigen::Vector2d>& known_pixels,
+                   const std::vector<double>& known_depths, const StepOptions& so,
+                   const OutlineOptions& outline, DensifyResult* result) {
+  if (known_pixels.empty()) return;
+  const View blurred_ref = BlurredView(ref, so.blur_px);
+  std::vector<View> blurred;
+  for (const View& v : others) blurred.push_back(BlurredView(v, so.blur_px));
+  // The outline's matching, but with the step's own contrast and views.
+  OutlineOptions o = outline;
+  o.min_contrast = so.min_contrast;
+  o.min_views = so.min_views;
+  std::vector<EdgeSample> samples =
+      StepSamples(blurred_ref, page, known_pixels, so, o.straight_px);
+  result->step_samples = int(samples.size());
+  EdgeCounts counts;
+  MatchEdgeSamples(
+      blurred_ref, blurred, num_views, &samples, known_pixels, known_depths, o,
+      [&](const EdgeSample& e, double depth) {
+        // On the surface of the points on each side of the step that has
+        // them (a fold's crease lies on both panels; a silhouette does not),
+        // and neither side seen edge-on (a fold seen edge-on in the
+        // reference is its silhouette there, matched elsewhere in the
+        // others). Without points on either side there is nothing to check
+        // it against.
+        auto on_sides = [&](double radius, int* fitted) {
+          *fitted = 0;
+          for (const int side : {1, -1}) {
+            double d = 0, cos_ray = 0;
+            if (!SideSurface(ref.camera, e.pixel, e.normal, side, radius, known_pixels,
+                             known_depths, &d, &cos_ray))
+              continue;
+            ++*fitted;
+            if (std::abs(d - depth) > so.max_depth_jump * depth || cos_ray < so.min_side_cos)
+              return false;
+          }
+          return true;
+        };
+        int fitted = 0;
+        if (!on_sides(so.side_radius_px, &fitted)) return false;
+        if (fitted > 0) return true;
+        if (!so.unsupported) return false;
+        // Without points next to it, against the surface further out.
+        return on_sides(so.unsupported_radius_factor * so.side_radius_px, &fitted);
+      },
+      kStep, {255, 255, 0}, &counts, nullptr, &result->points);
+  result->step_unmatched = counts.unmatched;
+  result->step_ambiguous = counts.ambiguous;
+  result->step_off_surface = counts.off_surface;
+  result->step_points = counts.points;
 }
 
 
@@ -776,6 +976,19 @@ Json DensifyOptions::ToJson() const {
             {"continuity_radius_px", outline.continuity_radius_px},
             {"max_depth_jump", outline.max_depth_jump},
             {"min_views", outline.min_views}}},
+          {"steps",
+           {{"enabled", steps.enabled},
+            {"blur_px", steps.blur_px},
+            {"step_px", steps.step_px},
+            {"min_contrast", steps.min_contrast},
+            {"outline_gap_px", steps.outline_gap_px},
+            {"min_point_gap_px", steps.min_point_gap_px},
+            {"side_radius_px", steps.side_radius_px},
+            {"max_depth_jump", steps.max_depth_jump},
+            {"min_side_cos", steps.min_side_cos},
+            {"unsupported", steps.unsupported},
+            {"unsupported_radius_factor", steps.unsupported_radius_factor},
+            {"min_views", steps.min_views}}},
           {"hidden",
            {{"enabled", hidden.enabled},
             {"max_colour_distance", hidden.max_colour_distance},
@@ -878,8 +1091,8 @@ DensifyResult Run(const DensifyInputs& in, const DensifyOptions& o) {
       "docunfold densify: sfm's points (source 0; those the reference view " +
           in.cameras.reference +
           " shows in another colour, behind the page, left out), then points triangulated "
-          "from the texture of the page (1) and from its outline (2), cameras of 10_sfm held "
-          "fixed",
+          "from the texture of the page (1), from its outline (2) and from shading steps of "
+          "blank paper (3), cameras of 10_sfm held fixed",
       "frame: that of 10_sfm/cameras.json (camera of the reference view " +
           in.cameras.reference + ")"};
 
@@ -944,6 +1157,29 @@ DensifyResult Run(const DensifyInputs& in, const DensifyOptions& o) {
       std::to_string(r.seconds_outline).substr(0, 4) + " s");
 
   t = Clock::now();
+  if (o.steps.enabled && !others.empty()) {
+    // Known depths: the page's sfm points and every point made so far.
+    std::vector<Eigen::Vector2d> pixels;
+    std::vector<double> depths;
+    auto add = [&](const Eigen::Vector3d& X) {
+      const Eigen::Vector3d xc = ref.camera.CamFromWorld(X);
+      if (!(xc.z() > 0)) return;
+      pixels.push_back(ref.camera.ProjectCam(xc));
+      depths.push_back(xc.z());
+    };
+    for (const Eigen::Vector3d& X : page_points) add(X);
+    for (size_t i = first_new_point; i < r.points.vertices.size(); ++i)
+      add(r.points.vertices[i]);
+    AddStepPoints(ref, others, num_views, page, pixels, depths, o.steps, o.outline, &r);
+    r.seconds_steps = SecondsSince(t);
+    Log(std::to_string(r.step_points) + " shading-step points from " +
+        std::to_string(r.step_samples) + " step samples (" + std::to_string(r.step_unmatched) +
+        " unmatched, " + std::to_string(r.step_ambiguous) + " ambiguous, " +
+        std::to_string(r.step_off_surface) + " off the surface), " +
+        std::to_string(r.seconds_steps).substr(0, 4) + " s");
+  }
+
+  t = Clock::now();
   if (o.texture.enabled && o.texture.surface_prewarp && !others.empty()) {
     std::vector<Eigen::Vector3d> known = page_points;
     known.insert(known.end(), r.points.vertices.begin() + first_new_point, r.points.vertices.end());
@@ -981,10 +1217,10 @@ void WriteOutputs(const DensifyInputs& in, const DensifyResult& r, const Densify
   cv::Mat overlay = in.reference * 0.55;
   const PinholeCamera& ref = *in.cameras.Find(in.cameras.reference);
   const double radius_scale = std::max(1.0, std::max(ref.width, ref.height) / 1600.0);
-  const cv::Scalar colours[3] = {cv::Scalar(255, 200, 0), cv::Scalar(80, 220, 80),
-                                 cv::Scalar(255, 0, 255)};
+  const cv::Scalar colours[4] = {cv::Scalar(255, 200, 0), cv::Scalar(80, 220, 80),
+                                 cv::Scalar(255, 0, 255), cv::Scalar(0, 230, 255)};
   const std::vector<double>& source = r.points.properties[2].values;
-  for (int pass = 0; pass < 3; ++pass)
+  for (int pass = 0; pass < 4; ++pass)
     for (size_t i = 0; i < r.points.vertices.size(); ++i) {
       if (int(source[i]) != pass) continue;
       const Eigen::Vector3d xc = ref.CamFromWorld(r.points.vertices[i]);
@@ -1011,14 +1247,19 @@ void WriteOutputs(const DensifyInputs& in, const DensifyResult& r, const Densify
   const double font = 0.8 * radius_scale;
   const int thick = int(std::lround(2 * radius_scale));
   const int sfm_kept = r.sfm_points_in_region - int(r.hidden.size());
-  const std::string legend[4] = {"sfm " + std::to_string(sfm_kept),
+  const std::string legend[5] = {"sfm " + std::to_string(sfm_kept),
                                  "texture " + std::to_string(r.texture_points),
                                  "outline " + std::to_string(r.outline_points),
+                                 "shading steps " + std::to_string(r.step_points),
                                  "hidden (left out) " + std::to_string(r.hidden.size())};
-  const cv::Scalar legend_colours[4] = {colours[0], colours[1], colours[2], hidden_colour};
-  for (int i = 0; i < 4; ++i)
-    cv::putText(overlay, legend[i], cv::Point(int(20 * radius_scale), int((40 + 34 * i) * radius_scale)),
+  const cv::Scalar legend_colours[5] = {colours[0], colours[1], colours[2], colours[3],
+                                        hidden_colour};
+  for (int i = 0, row = 0; i < 5; ++i) {
+    if (i == 3 && !o.steps.enabled) continue;
+    cv::putText(overlay, legend[i],
+                cv::Point(int(20 * radius_scale), int((40 + 34 * row++) * radius_scale)),
                 cv::FONT_HERSHEY_SIMPLEX, font, legend_colours[i], thick, cv::LINE_AA);
+  }
   WriteImageAtomic(o.out_dir / "overlay.png", overlay, {cv::IMWRITE_PNG_COMPRESSION, 1});
 
   Json doc = MakeHeader("docunfold.points", 1, "densify", o.ToJson());
@@ -1030,12 +1271,17 @@ void WriteOutputs(const DensifyInputs& in, const DensifyResult& r, const Densify
                    {"texture", r.texture_points},
                    {"texture_surface_prewarp", r.texture_points_surface},
                    {"outline", r.outline_points},
+                   {"steps", r.step_points},
                    {"total", r.points.vertices.size()}};
   doc["texture"] = {{"samples", r.texture_samples}};
   doc["outline"] = {{"samples", r.outline_samples},
                     {"unmatched", r.outline_unmatched},
                     {"ambiguous", r.outline_ambiguous},
                     {"off_surface", r.outline_off_surface}};
+  doc["steps"] = {{"samples", r.step_samples},
+                  {"unmatched", r.step_unmatched},
+                  {"ambiguous", r.step_ambiguous},
+                  {"off_surface", r.step_off_surface}};
   doc["views"] = Json::array();
   for (const ViewStats& v : r.views)
     doc["views"].push_back({{"image", v.image},
@@ -1049,6 +1295,7 @@ void WriteOutputs(const DensifyInputs& in, const DensifyResult& r, const Densify
                     {"texture", r.seconds_texture},
                     {"outline", r.seconds_outline},
                     {"texture_surface_prewarp", r.seconds_surface},
+                    {"steps", r.seconds_steps},
                     {"total", r.seconds_total}};
   WriteJsonAtomic(o.out_dir / "points.json", doc);
 }

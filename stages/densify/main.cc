@@ -8,7 +8,8 @@ using namespace docunfold;
 int main(int argc, char** argv) {
   CLI::App app{"Adds 3D points of the page to sfm's sparse cloud, cameras held fixed: "
                "text and print followed from the reference view into the other photos by "
-               "optical flow, and the page's outline matched along epipolar lines. Writes "
+               "optical flow, and the page's outline and the shading steps of its blank paper "
+               "(a fold's crease) matched along epipolar lines. Writes "
                "points.ply (sfm's points first), points.json and overlay.png."};
   densify::DensifyOptions o;
   bool no_texture = false, no_outline = false, keep_hidden = false;
@@ -58,6 +59,42 @@ int main(int argc, char** argv) {
                  "outline: other photos agree when their edge is within this distance")
       ->capture_default_str()->check(CLI::Range(0.1, 100.0));
 
+  bool no_steps = false, supported_only = false;
+  app.add_flag("--no-steps", no_steps,
+               "no shading-step points (steps of blank paper such as a fold's crease, matched "
+               "on copies blurred so that print is gone)");
+  app.add_option("--step-blur", o.steps.blur_px,
+                 "steps: Gaussian sigma of the blurred copies (working-copy pixels)")
+      ->capture_default_str()->check(CLI::Range(0.5, 50.0));
+  app.add_option("--step-min-contrast", o.steps.min_contrast,
+                 "steps: grey levels per pixel across a step on the blurred copy")
+      ->capture_default_str()->check(CLI::Range(0.01, 255.0));
+  app.add_option("--step-min-views", o.steps.min_views,
+                 "steps: photos that must agree on a point, the reference included")
+      ->capture_default_str()->check(CLI::Range(2, 1000));
+  app.add_option("--step-point-gap", o.steps.min_point_gap_px,
+                 "steps: only where no point is this close already, blank paper (working-copy "
+                 "pixels; 0 = in print too)")
+      ->capture_default_str()->check(CLI::Range(0.0, 10000.0));
+  app.add_option("--step-max-depth-jump", o.steps.max_depth_jump,
+                 "steps: a point's depth may differ this much (fraction) from the surface of "
+                 "the points on either side of its step")
+      ->capture_default_str()->check(CLI::Range(0.0, 1.0));
+  app.add_option("--step-min-side-cos", o.steps.min_side_cos,
+                 "steps: refused where the surface on either side is seen this edge-on from the "
+                 "reference (|cos| between ray and normal)")
+      ->capture_default_str()->check(CLI::Range(0.0, 1.0));
+  app.add_flag("--step-supported-only", supported_only,
+               "steps: drop points with no known points on either side to check them against");
+  app.add_option("--step-unsupported-radius", o.steps.unsupported_radius_factor,
+                 "steps: points without known points next to them are checked against those "
+                 "within this many times the side radius")
+      ->capture_default_str()->check(CLI::Range(1.0, 100.0));
+  app.add_option("--step-side-radius", o.steps.side_radius_px,
+                 "steps: a point must lie on the surface of the known points within this "
+                 "radius on each side of its step (working-copy pixels)")
+      ->capture_default_str()->check(CLI::Range(1.0, 10000.0));
+
   app.add_flag("--keep-hidden", keep_hidden,
                "keep sfm points of the document region that the reference view shows in "
                "another colour (by default they are left out as behind the page)");
@@ -69,6 +106,8 @@ int main(int argc, char** argv) {
   return RunStage("densify", app, argc, argv, [&] {
     o.texture.enabled = !no_texture;
     o.outline.enabled = !no_outline;
+    o.steps.enabled = !no_steps;
+    if (supported_only) o.steps.unsupported = false;
     o.hidden.enabled = !keep_hidden;
     const densify::DensifyInputs in = densify::ReadInputs(o);
     const densify::DensifyResult r = densify::Run(in, o);
@@ -78,7 +117,8 @@ int main(int argc, char** argv) {
         std::to_string(r.sfm_points - int(r.hidden.size())) + " sfm (" +
         std::to_string(r.hidden.size()) + " hidden behind the page left out) + " +
         std::to_string(r.texture_points) + " texture + " + std::to_string(r.outline_points) +
-        " outline points, " +
+        " outline" + (o.steps.enabled ? " + " + std::to_string(r.step_points) + " step" : "") +
+        " points, " +
         std::to_string(r.seconds_total).substr(0, 4) + " s");
   });
 }

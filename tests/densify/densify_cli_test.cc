@@ -63,6 +63,9 @@ TEST_F(DensifyCli, WritesItsFilesAndKeepsSfmPointsFirstAndUnchanged) {
   const CommandResult v = RunCommand(Quote((SourceDir() / "scripts/validate-json").string()) +
                                      " " + Quote((dir_ / "25_points/points.json").string()));
   EXPECT_EQ(v.exit_code, 0) << v.output;
+  const Json report = ReadJsonFile(dir_ / "25_points/points.json");
+  EXPECT_TRUE(report["points"].contains("steps")) << report.dump();
+  EXPECT_TRUE(report.contains("steps")) << report.dump();
   for (const auto& e : fs::directory_iterator(dir_ / "25_points"))
     EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << e.path();
 }
