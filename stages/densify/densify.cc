@@ -470,26 +470,41 @@ bool DepthAcrossEdges(const PinholeCamera& ref, const Eigen::Vector2d& pixel,
   return true;
 }
 
+// Affine fit of 1/depth to the known points within `radius` of `pixel` that
+// `keep` accepts (given their offset from it): 1/depth = c0 du + c1 dv + c2.
+// False when fewer than 6 points there span an area.
+template <class Keep>
+bool FitInverseDepth(const Eigen::Vector2d& pixel, double radius,
+                     const std::vector<Eigen::Vector2d>& known_pixels,
+                     const std::vector<double>& known_depths, const Keep& keep,
+                     Eigen::Vector3d* c) {
+  Eigen::Matrix3d ata = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d atb = Eigen::Vector3d::Zero();
+  int near = 0;
+  for (size_t i = 0; i < known_pixels.size(); ++i) {
+    const Eigen::Vector2d d = known_pixels[i] - pixel;
+    if (d.squaredNorm() > radius * radius || !keep(d)) continue;
+    const Eigen::Vector3d a(d.x(), d.y(), 1);
+    ata += a * a.transpose();
+    atb += a / known_depths[i];
+    ++near;
+  }
+  if (near < 6 || !(std::abs(ata.determinant()) > 1e-6 * std::pow(ata.trace(), 3))) return false;
+  *c = ata.ldlt().solve(atb);
+  return true;
+}
+
 // Whether `depth` at `pixel` continues the surface of the known points
 // within continuity_radius_px (an affine fit of 1/depth, when at least 6 are
 // there and they span an area) to max_depth_jump of the depth.
 bool ContinuesSurface(const Eigen::Vector2d& pixel, double depth,
                       const std::vector<Eigen::Vector2d>& known_pixels,
                       const std::vector<double>& known_depths, const OutlineOptions& o) {
-  Eigen::Matrix3d ata = Eigen::Matrix3d::Zero();
-  Eigen::Vector3d atb = Eigen::Vector3d::Zero();
-  int near = 0;
-  const double r2 = o.continuity_radius_px * o.continuity_radius_px;
-  for (size_t i = 0; i < known_pixels.size(); ++i) {
-    const Eigen::Vector2d d = known_pixels[i] - pixel;
-    if (d.squaredNorm() > r2) continue;
-    const Eigen::Vector3d a(d.x(), d.y(), 1);
-    ata += a * a.transpose();
-    atb += a / known_depths[i];
-    ++near;
-  }
-  if (near < 6 || !(std::abs(ata.determinant()) > 1e-6 * std::pow(ata.trace(), 3))) return true;
-  const double inverse_depth = ata.ldlt().solve(atb)(2);
+  Eigen::Vector3d c;
+  if (!FitInverseDepth(pixel, o.continuity_radius_px, known_pixels, known_depths,
+                       [](const Eigen::Vector2d&) { return true; }, &c))
+    return true;
+  const double inverse_depth = c(2);
   return !(inverse_depth > 0 && std::abs(1 / inverse_depth - depth) > o.max_depth_jump * depth);
 }
 
@@ -699,12 +714,31 @@ void AddOutlinePoints(const View& ref, const std::vector<View>& others, int num_
   result->outline_points = counts.points;
 }
 
+// Pixels and depths in `camera` of `page_points` and of the points made so far
+// (`points` from `first_new` on): what the edge matching searches around.
+void KnownPoints(const PinholeCamera& camera, const std::vector<Eigen::Vector3d>& page_points,
+                 const PlyData& points, size_t first_new, std::vector<Eigen::Vector2d>* pixels,
+                 std::vector<double>* depths) {
+  auto add = [&](const Eigen::Vector3d& X) {
+    const Eigen::Vector3d xc = camera.CamFromWorld(X);
+    if (!(xc.z() > 0)) return;
+    pixels->push_back(camera.ProjectCam(xc));
+    depths->push_back(xc.z());
+  };
+  for (const Eigen::Vector3d& X : page_points) add(X);
+  for (size_t i = first_new; i < points.vertices.size(); ++i) add(points.vertices[i]);
+}
+
 // --- shading-step points ----------------------------------------------------
 
 // `view` with the gradient of a copy blurred by `sigma` instead: print is
 // gone from it, the shading of folds is not.
 View BlurredView(const View& view, double sigma) {
   View v = view;
+  // New buffers: the copy's gx and gy share the original's, which Sobel
+  // would otherwise overwrite.
+  v.gx = cv::Mat1f();
+  v.gy = cv::Mat1f();
   cv::Mat blurred;
   cv::GaussianBlur(view.grey, blurred, cv::Size(0, 0), sigma);
   cv::Sobel(blurred, v.gx, CV_32F, 1, 0, 3, 0.125);
@@ -785,19 +819,10 @@ bool SideSurface(const PinholeCamera& camera, const Eigen::Vector2d& pixel,
                  const Eigen::Vector2d& normal, int side, double radius,
                  const std::vector<Eigen::Vector2d>& known_pixels,
                  const std::vector<double>& known_depths, double* depth, double* cos_ray) {
-  Eigen::Matrix3d ata = Eigen::Matrix3d::Zero();
-  Eigen::Vector3d atb = Eigen::Vector3d::Zero();
-  int near = 0;
-  for (size_t i = 0; i < known_pixels.size(); ++i) {
-    const Eigen::Vector2d d = known_pixels[i] - pixel;
-    if (d.squaredNorm() > radius * radius || side * d.dot(normal) < 1) continue;
-    const Eigen::Vector3d a(d.x(), d.y(), 1);
-    ata += a * a.transpose();
-    atb += a / known_depths[i];
-    ++near;
-  }
-  if (near < 6 || !(std::abs(ata.determinant()) > 1e-6 * std::pow(ata.trace(), 3))) return false;
-  const Eigen::Vector3d c = ata.ldlt().solve(atb);  // 1/z = c0 du + c1 dv + c2
+  Eigen::Vector3d c;  // 1/z = c0 du + c1 dv + c2
+  if (!FitInverseDepth(pixel, radius, known_pixels, known_depths,
+                       [&](const Eigen::Vector2d& d) { return side * d.dot(normal) >= 1; }, &c))
+    return false;
   if (!(c(2) > 0)) return false;
   *depth = 1 / c(2);
   // 1/z = n.(K^-1 [u v 1]) / d for the plane n.X = d: n ~ K^T (c0, c1, c2 - c0 u - c1 v).
@@ -1135,15 +1160,7 @@ DensifyResult Run(const DensifyInputs& in, const DensifyOptions& o) {
     // texture points just made.
     std::vector<Eigen::Vector2d> pixels;
     std::vector<double> depths;
-    auto add = [&](const Eigen::Vector3d& X) {
-      const Eigen::Vector3d xc = ref.camera.CamFromWorld(X);
-      if (!(xc.z() > 0)) return;
-      pixels.push_back(ref.camera.ProjectCam(xc));
-      depths.push_back(xc.z());
-    };
-    for (const Eigen::Vector3d& X : page_points) add(X);
-    for (size_t i = first_new_point; i < r.points.vertices.size(); ++i)
-      add(r.points.vertices[i]);
+    KnownPoints(ref.camera, page_points, r.points, first_new_point, &pixels, &depths);
     if (in.boundary.RealSides() == 0)
       r.warnings.push_back("no real boundary side: no outline points");
     AddOutlinePoints(ref, others, num_views, in.boundary, page, pixels, depths, o.outline, &r);
@@ -1161,15 +1178,7 @@ DensifyResult Run(const DensifyInputs& in, const DensifyOptions& o) {
     // Known depths: the page's sfm points and every point made so far.
     std::vector<Eigen::Vector2d> pixels;
     std::vector<double> depths;
-    auto add = [&](const Eigen::Vector3d& X) {
-      const Eigen::Vector3d xc = ref.camera.CamFromWorld(X);
-      if (!(xc.z() > 0)) return;
-      pixels.push_back(ref.camera.ProjectCam(xc));
-      depths.push_back(xc.z());
-    };
-    for (const Eigen::Vector3d& X : page_points) add(X);
-    for (size_t i = first_new_point; i < r.points.vertices.size(); ++i)
-      add(r.points.vertices[i]);
+    KnownPoints(ref.camera, page_points, r.points, first_new_point, &pixels, &depths);
     AddStepPoints(ref, others, num_views, page, pixels, depths, o.steps, o.outline, &r);
     r.seconds_steps = SecondsSince(t);
     Log(std::to_string(r.step_points) + " shading-step points from " +
