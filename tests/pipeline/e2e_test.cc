@@ -540,7 +540,7 @@ TEST(EndToEndSummary, SamplesOnAverage) {
   // against 0.882 over eight runs since 2026-11-25's outline prior, 0.801-0.816
   // over three with the shading-step points; set08, cut off in every photo,
   // alone costs 0.05 of it) and mean LD <= 2 (1.46-2.39 over those runs,
-  // 1.78-2.12 with the steps: not met in all). Asserted: no regression beyond
+  // 1.82-2.12 with the steps: not met in all). Asserted: no regression beyond
   // the runs' spread.
   EXPECT_FALSE(std::isnan(ours));
   EXPECT_GT(ours / n, 0.76);
