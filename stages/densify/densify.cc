@@ -367,6 +367,23 @@ bool FindStep(const View& view, const Eigen::Vector2d& c, const Eigen::Vector2d&
   return true;
 }
 
+// Whether the step at c (grey rising along the unit `normal`) continues
+// straight along the edge: a step of the same sign of at least
+// `min_strength` within 1.5 px of the line through c, half and all of
+// `reach` to either side. Texture of a table or carpet gives short gradient
+// blobs, a page's edge or a fold a straight step.
+bool StepContinues(const View& view, const Eigen::Vector2d& c, const Eigen::Vector2d& normal,
+                   double reach, double min_strength) {
+  const Eigen::Vector2d tangent(-normal.y(), normal.x());
+  for (double along : {-reach, -reach / 2, reach / 2, reach}) {
+    double offset = 0, strength = 0;
+    if (!FindStep(view, c + along * tangent, normal, 1.5, 1, &offset, &strength) ||
+        strength < min_strength)
+      return false;
+  }
+  return true;
+}
+
 // A crossing of an edge found in another view: where, and the edge's unit
 // normal there (from that image's gradient).
 struct EdgeMatch {
@@ -586,17 +603,8 @@ void MatchEdgeSamples(const View& ref, const std::vector<View>& others, int num_
         // tangent predicted from the reference is off where the edge
         // recedes in depth: set07's tilted panel).
         const Eigen::Vector2d normal = grad.normalized();  // grey rises along it
-        const Eigen::Vector2d tangent(-normal.y(), normal.x());
-        bool straight = true;
-        for (double along : {-o.straight_px, -o.straight_px / 2, o.straight_px / 2, o.straight_px}) {
-          double offset = 0, strength = 0;
-          if (!FindStep(view, c + along * tangent, normal, 1.5, 1, &offset, &strength) ||
-              strength < 0.5 * g[i] * std::abs(cos_cross)) {
-            straight = false;
-            break;
-          }
-        }
-        if (!straight) continue;
+        if (!StepContinues(view, c, normal, o.straight_px, 0.5 * g[i] * std::abs(cos_cross)))
+          continue;
         e.candidates[view.index].push_back({c, normal});
         if (stats) ++(*stats)[view.index].outline_candidates;
       }
@@ -791,16 +799,7 @@ std::vector<EdgeSample> StepSamples(const View& blurred_ref, const cv::Mat1b& pa
     double offset = 0, strength = 0;
     if (!FindStep(blurred_ref, c, n, 2, 1, &offset, &strength)) continue;
     const Eigen::Vector2d at = c + offset * n;
-    const Eigen::Vector2d tangent(-n.y(), n.x());
-    bool straight = true;
-    for (double along : {-straight_px, -straight_px / 2, straight_px / 2, straight_px}) {
-      double o2 = 0, s2 = 0;
-      if (!FindStep(blurred_ref, at + along * tangent, n, 1.5, 1, &o2, &s2) || s2 < 0.5 * strength) {
-        straight = false;
-        break;
-      }
-    }
-    if (!straight) continue;
+    if (!StepContinues(blurred_ref, at, n, straight_px, 0.5 * strength)) continue;
     EdgeSample e;
     e.pixel = at;
     e.normal = n;

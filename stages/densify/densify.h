@@ -110,11 +110,11 @@ struct OutlineOptions {
 // Under diffuse light a fold's shading step lies at the same place on the
 // paper in every photo, so steps found on copies blurred by `blur_px`
 // (print gone, folds not) are matched along epipolar segments like the
-// outline. Measured on two sfm front ends of the 12 benchmark sets (rerun
-// from densify): mean MS-SSIM +0.011 and +0.007, M 0.291 -> 0.264 % and
-// 0.286 -> 0.245 % of the diagonal off the true surface, r02 +0.06, set08's
-// init M 1.09 -> 0.83 % and 1.21 -> 0.64 %. The safeguards were each added
-// after a measured failure (see the README).
+// outline. Measured on four sfm runs of the 12 benchmark sets (rerun from
+// densify, with against without): mean MS-SSIM -0.014 to +0.011 (+0.002 on
+// average), M closer to the true surface in every run (0.291 -> 0.264 % of
+// the diagonal in the first), set08's init M 0.52-0.83 % against 0.74-1.21 %.
+// The safeguards were each added after a measured failure (see the README).
 struct StepOptions {
   bool enabled = true;
   double blur_px = 3;          // Gaussian sigma of the copies, working-copy pixels

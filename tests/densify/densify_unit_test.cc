@@ -390,7 +390,7 @@ TEST(Densify, TheFarSideOfAFoldGetsPointsThroughTheSurfaceOfTheFirst) {
 
 // A step in the grey of blank paper (as a fold's shading gives under diffuse
 // light: at the same place on the paper in every photo) gets points, on the
-// page; print, which has texture points, gets none.
+// page and on the step.
 TEST(Densify, ShadingStepsOfBlankPaperGetPointsOnThePage) {
   const Scene scene = MakeScene([](cv::Mat1b* texture) {
     // The lower third blank, darker right of a diagonal (x - 80 = y - 260),
