@@ -552,7 +552,7 @@ TEST(EndToEndSummary, SamplesOnAverage) {
       ours / n, oracle / n, ld / n, ld_whole / n_whole, n_whole);
   // Issue 6's targets: within 0.05 of the oracle (not met: 0.795-0.808
   // against 0.882 over eight runs since 2026-11-25's outline prior, 0.786-0.816
-  // over six with the shading-step points; set08, cut off in every photo,
+  // over eight with the shading-step points; set08, cut off in every photo,
   // alone costs 0.05 of it) and mean LD <= 2 (1.46-2.39 over those runs,
   // 1.74-2.70 with the steps: not met in all; set08's LD alone swings
   // 4.4-8.9, moving the mean by 0.55). Over the seven pages seen whole the
