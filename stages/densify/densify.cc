@@ -525,14 +525,6 @@ bool ContinuesSurface(const Eigen::Vector2d& pixel, double depth,
   return !(inverse_depth > 0 && std::abs(1 / inverse_depth - depth) > o.max_depth_jump * depth);
 }
 
-// What became of the edge samples handed to MatchEdgeSamples.
-struct EdgeCounts {
-  int unmatched = 0;    // fewer than min_views agree
-  int ambiguous = 0;    // another depth is as well supported
-  int off_surface = 0;  // refused by the caller's check
-  int points = 0;
-};
-
 // Whether a triangulated edge sample at `depth` (reference camera) may be kept.
 using EdgeCheck = std::function<bool(const EdgeSample&, double depth)>;
 
@@ -708,18 +700,13 @@ void AddOutlinePoints(const View& ref, const std::vector<View>& others, int num_
                       DensifyResult* result) {
   if (known_pixels.empty()) return;
   std::vector<EdgeSample> samples = EdgeSamples(ref, boundary, page, result->working_scale, o);
-  result->outline_samples = int(samples.size());
-  EdgeCounts counts;
+  result->outline.samples = int(samples.size());
   MatchEdgeSamples(
       ref, others, num_views, &samples, known_pixels, known_depths, o,
       [&](const EdgeSample& e, double depth) {
         return ContinuesSurface(e.pixel, depth, known_pixels, known_depths, o);
       },
-      kOutline, {255, 0, 255}, &counts, &result->views, &result->points);
-  result->outline_unmatched = counts.unmatched;
-  result->outline_ambiguous = counts.ambiguous;
-  result->outline_off_surface = counts.off_surface;
-  result->outline_points = counts.points;
+      kOutline, {255, 0, 255}, &result->outline, &result->views, &result->points);
 }
 
 // Pixels and depths in `camera` of `page_points` and of the points made so far
@@ -846,8 +833,7 @@ void AddStepPoints(const View& ref, const std::vector<View>& others, int num_vie
   o.min_views = so.min_views;
   std::vector<EdgeSample> samples =
       StepSamples(blurred_ref, page, known_pixels, so, o.straight_px);
-  result->step_samples = int(samples.size());
-  EdgeCounts counts;
+  result->steps.samples = int(samples.size());
   MatchEdgeSamples(
       blurred_ref, blurred, num_views, &samples, known_pixels, known_depths, o,
       [&](const EdgeSample& e, double depth) {
@@ -877,13 +863,24 @@ void AddStepPoints(const View& ref, const std::vector<View>& others, int num_vie
         // Without points next to it, against the surface further out.
         return on_sides(so.unsupported_radius_factor * so.side_radius_px, &fitted);
       },
-      kStep, {255, 255, 0}, &counts, nullptr, &result->points);
-  result->step_unmatched = counts.unmatched;
-  result->step_ambiguous = counts.ambiguous;
-  result->step_off_surface = counts.off_surface;
-  result->step_points = counts.points;
+      kStep, {255, 255, 0}, &result->steps, nullptr, &result->points);
 }
 
+// "N <what> from M <samples> (U unmatched, A ambiguous, S off the surface), T s"
+std::string CountsLine(const EdgeCounts& c, const std::string& what, const std::string& samples,
+                       double seconds) {
+  return std::to_string(c.points) + " " + what + " from " + std::to_string(c.samples) + " " +
+         samples + " (" + std::to_string(c.unmatched) + " unmatched, " +
+         std::to_string(c.ambiguous) + " ambiguous, " + std::to_string(c.off_surface) +
+         " off the surface), " + std::to_string(seconds).substr(0, 4) + " s";
+}
+
+Json CountsJson(const EdgeCounts& c) {
+  return {{"samples", c.samples},
+          {"unmatched", c.unmatched},
+          {"ambiguous", c.ambiguous},
+          {"off_surface", c.off_surface}};
+}
 
 }  // namespace
 
@@ -1165,12 +1162,7 @@ DensifyResult Run(const DensifyInputs& in, const DensifyOptions& o) {
     AddOutlinePoints(ref, others, num_views, in.boundary, page, pixels, depths, o.outline, &r);
   }
   r.seconds_outline = SecondsSince(t);
-  Log(std::to_string(r.outline_points) + " outline points from " +
-      std::to_string(r.outline_samples) + " edge samples (" +
-      std::to_string(r.outline_unmatched) + " unmatched, " +
-      std::to_string(r.outline_ambiguous) + " ambiguous, " +
-      std::to_string(r.outline_off_surface) + " off the surface), " +
-      std::to_string(r.seconds_outline).substr(0, 4) + " s");
+  Log(CountsLine(r.outline, "outline points", "edge samples", r.seconds_outline));
 
   t = Clock::now();
   if (o.steps.enabled && !others.empty()) {
@@ -1180,11 +1172,7 @@ DensifyResult Run(const DensifyInputs& in, const DensifyOptions& o) {
     KnownPoints(ref.camera, page_points, r.points, first_new_point, &pixels, &depths);
     AddStepPoints(ref, others, num_views, page, pixels, depths, o.steps, o.outline, &r);
     r.seconds_steps = SecondsSince(t);
-    Log(std::to_string(r.step_points) + " shading-step points from " +
-        std::to_string(r.step_samples) + " step samples (" + std::to_string(r.step_unmatched) +
-        " unmatched, " + std::to_string(r.step_ambiguous) + " ambiguous, " +
-        std::to_string(r.step_off_surface) + " off the surface), " +
-        std::to_string(r.seconds_steps).substr(0, 4) + " s");
+    Log(CountsLine(r.steps, "shading-step points", "step samples", r.seconds_steps));
   }
 
   t = Clock::now();
@@ -1257,8 +1245,8 @@ void WriteOutputs(const DensifyInputs& in, const DensifyResult& r, const Densify
   const int sfm_kept = r.sfm_points_in_region - int(r.hidden.size());
   const std::string legend[5] = {"sfm " + std::to_string(sfm_kept),
                                  "texture " + std::to_string(r.texture_points),
-                                 "outline " + std::to_string(r.outline_points),
-                                 "shading steps " + std::to_string(r.step_points),
+                                 "outline " + std::to_string(r.outline.points),
+                                 "shading steps " + std::to_string(r.steps.points),
                                  "hidden (left out) " + std::to_string(r.hidden.size())};
   const cv::Scalar legend_colours[5] = {colours[0], colours[1], colours[2], colours[3],
                                         hidden_colour};
@@ -1278,18 +1266,12 @@ void WriteOutputs(const DensifyInputs& in, const DensifyResult& r, const Densify
                    {"sfm_hidden", r.hidden.size()},
                    {"texture", r.texture_points},
                    {"texture_surface_prewarp", r.texture_points_surface},
-                   {"outline", r.outline_points},
-                   {"steps", r.step_points},
+                   {"outline", r.outline.points},
+                   {"steps", r.steps.points},
                    {"total", r.points.vertices.size()}};
   doc["texture"] = {{"samples", r.texture_samples}};
-  doc["outline"] = {{"samples", r.outline_samples},
-                    {"unmatched", r.outline_unmatched},
-                    {"ambiguous", r.outline_ambiguous},
-                    {"off_surface", r.outline_off_surface}};
-  doc["steps"] = {{"samples", r.step_samples},
-                  {"unmatched", r.step_unmatched},
-                  {"ambiguous", r.step_ambiguous},
-                  {"off_surface", r.step_off_surface}};
+  doc["outline"] = CountsJson(r.outline);
+  doc["steps"] = CountsJson(r.steps);
   doc["views"] = Json::array();
   for (const ViewStats& v : r.views)
     doc["views"].push_back({{"image", v.image},

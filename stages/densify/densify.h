@@ -200,18 +200,23 @@ struct ViewStats {
   int outline_votes = 0;      // of those, in a triangulated outline point
 };
 
+// What became of the edge samples of one kind (outline or shading steps).
+struct EdgeCounts {
+  int samples = 0;      // edge samples matched in the other views
+  int unmatched = 0;    // fewer than min_views agree
+  int ambiguous = 0;    // another depth is as well supported
+  int off_surface = 0;  // off the surface of the known points
+  int points = 0;       // triangulated and kept
+};
+
 struct DensifyResult {
   PlyData points;  // sfm's points, then texture, outline and step points
-  int sfm_points = 0, sfm_points_in_region = 0, texture_points = 0, outline_points = 0;
+  int sfm_points = 0, sfm_points_in_region = 0, texture_points = 0;
   int texture_points_surface = 0;  // of texture_points, from the second pass
   std::vector<Eigen::Vector3d> hidden;  // sfm points left out (HiddenOptions)
   int texture_samples = 0;     // textured grid pixels in the region
-  int outline_samples = 0;     // edge samples on the real sides
-  int outline_unmatched = 0;   // fewer than min_views agree
-  int outline_ambiguous = 0;   // another depth is as well supported
-  int outline_off_surface = 0; // off the surface of the points just inside
-  int step_points = 0, step_samples = 0, step_unmatched = 0, step_ambiguous = 0,
-      step_off_surface = 0;    // the same for shading steps (StepOptions)
+  EdgeCounts outline;          // samples on the real sides (OutlineOptions)
+  EdgeCounts steps;            // shading steps (StepOptions)
   double working_scale = 1;    // working copies / photos
   std::vector<ViewStats> views;
   double seconds_reading = 0, seconds_texture = 0, seconds_outline = 0, seconds_surface = 0,

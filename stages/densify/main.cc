@@ -116,8 +116,8 @@ int main(int argc, char** argv) {
     Log("wrote " + (o.out_dir / "points.ply").string() + ": " +
         std::to_string(r.sfm_points - int(r.hidden.size())) + " sfm (" +
         std::to_string(r.hidden.size()) + " hidden behind the page left out) + " +
-        std::to_string(r.texture_points) + " texture + " + std::to_string(r.outline_points) +
-        " outline" + (o.steps.enabled ? " + " + std::to_string(r.step_points) + " step" : "") +
+        std::to_string(r.texture_points) + " texture + " + std::to_string(r.outline.points) +
+        " outline" + (o.steps.enabled ? " + " + std::to_string(r.steps.points) + " step" : "") +
         " points, " +
         std::to_string(r.seconds_total).substr(0, 4) + " s");
   });

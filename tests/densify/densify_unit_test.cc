@@ -248,7 +248,7 @@ TEST(Densify, PointsLieOnTheRenderedPageAndItsOutline) {
       on_outline.push_back(DistanceToOutline(scene, r.points.vertices[i]));
   }
   ASSERT_EQ(int(on_page.size()), r.texture_points);
-  ASSERT_EQ(int(on_outline.size()), r.outline_points);
+  ASSERT_EQ(int(on_outline.size()), r.outline.points);
   auto quantile = [](std::vector<double> v, double q) {
     std::sort(v.begin(), v.end());
     return v.empty() ? NAN : v[size_t(q * (v.size() - 1))];
@@ -257,13 +257,13 @@ TEST(Densify, PointsLieOnTheRenderedPageAndItsOutline) {
               "diagonal off the page), %d of %d outline samples (median %.3f %%, p95 %.3f %% off "
               "the outline)\n",
               r.texture_points, 100 * quantile(on_page, 0.5) / diagonal,
-              100 * quantile(on_page, 0.95) / diagonal, r.outline_points, r.outline_samples,
+              100 * quantile(on_page, 0.95) / diagonal, r.outline.points, r.outline.samples,
               100 * quantile(on_outline, 0.5) / diagonal,
               100 * quantile(on_outline, 0.95) / diagonal);
   EXPECT_GT(r.texture_points, 2000);
   EXPECT_LT(quantile(on_page, 0.5), 0.0005 * diagonal);
   EXPECT_LT(quantile(on_page, 0.95), 0.002 * diagonal);
-  EXPECT_GT(r.outline_points, r.outline_samples / 2);
+  EXPECT_GT(r.outline.points, r.outline.samples / 2);
   EXPECT_LT(quantile(on_outline, 0.5), 0.001 * diagonal);
   EXPECT_LT(quantile(on_outline, 0.95), 0.003 * diagonal);
   // Nothing of the table: every new point is on the page or its edge.
@@ -403,9 +403,9 @@ TEST(Densify, ShadingStepsOfBlankPaperGetPointsOnThePage) {
   const DensifyInputs in = InputsOf(scene, 20);
   DensifyOptions o;
   const DensifyResult r = densify::Run(in, o);
-  ASSERT_GT(r.step_samples, 0);
-  ASSERT_GT(r.step_points, 5) << r.step_samples << " samples, " << r.step_unmatched
-                              << " unmatched, " << r.step_off_surface << " off the surface";
+  ASSERT_GT(r.steps.samples, 0);
+  ASSERT_GT(r.steps.points, 5) << r.steps.samples << " samples, " << r.steps.unmatched
+                              << " unmatched, " << r.steps.off_surface << " off the surface";
   const std::vector<double>& source = r.points.properties[2].values;
   const Eigen::Vector3d n = scene.along.cross(scene.down).normalized();
   for (size_t i = 0; i < r.points.vertices.size(); ++i) {
@@ -422,7 +422,7 @@ TEST(Densify, ShadingStepsOfBlankPaperGetPointsOnThePage) {
     EXPECT_GT(v, 255);
   }
   o.steps.enabled = false;
-  EXPECT_EQ(densify::Run(in, o).step_points, 0);
+  EXPECT_EQ(densify::Run(in, o).steps.points, 0);
 }
 
 TEST(Densify, EachSourceCanBeSwitchedOffAndOneViewAddsNothing) {
@@ -432,19 +432,19 @@ TEST(Densify, EachSourceCanBeSwitchedOffAndOneViewAddsNothing) {
   o.texture.enabled = false;
   DensifyResult r = densify::Run(in, o);
   EXPECT_EQ(r.texture_points, 0);
-  EXPECT_GT(r.outline_points, 0);
+  EXPECT_GT(r.outline.points, 0);
   o.texture.enabled = true;
   o.outline.enabled = false;
   r = densify::Run(in, o);
   EXPECT_GT(r.texture_points, 0);
-  EXPECT_EQ(r.outline_points, 0);
+  EXPECT_EQ(r.outline.points, 0);
   // Only the reference view: sfm's points come back unchanged, with a warning.
   in.cameras.views.resize(1);
   in.photos.resize(1);
   in.distortion.resize(1);
   r = densify::Run(in, DensifyOptions());
   EXPECT_EQ(r.points.vertices.size(), 150u);
-  EXPECT_EQ(r.texture_points + r.outline_points, 0);
+  EXPECT_EQ(r.texture_points + r.outline.points, 0);
   EXPECT_FALSE(r.warnings.empty());
 }
 
