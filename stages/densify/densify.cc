@@ -767,10 +767,12 @@ std::vector<EdgeSample> StepSamples(const View& blurred_ref, const cv::Mat1b& pa
     for (int x = 1; x + 1 < page.cols; ++x) {
       const float m = magnitude(y, x);
       if (m < o.min_contrast || !inside(y, x)) continue;
-      // Neighbours across the step (the gradient's direction, to 45 degrees).
+      // Neighbours across the step: the gradient's direction rounded to 45
+      // degrees, modulo 180 (0, 45, 90, 135 degrees).
+      static constexpr int kAcross[4][2] = {{1, 0}, {1, 1}, {0, 1}, {1, -1}};
       const double angle = std::atan2(gy(y, x), gx(y, x));
       const int q = int(std::lround(angle / (M_PI / 4))) & 3;
-      const int dx = q == 0 ? 1 : q == 2 ? 0 : 1, dy = q == 0 ? 0 : q == 1 ? 1 : q == 2 ? 1 : -1;
+      const int dx = kAcross[q][0], dy = kAcross[q][1];
       if (m < magnitude(y + dy, x + dx) || m < magnitude(y - dy, x - dx)) continue;
       auto& b = best[size_t(y / cell) * cells_x + x / cell];
       if (m > b.first) b = {m, cv::Point(x, y)};
