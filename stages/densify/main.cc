@@ -36,10 +36,11 @@ int main(int argc, char** argv) {
   app.add_option("--texture-min-views", o.texture.min_views,
                  "texture: photos a point needs, the reference included")
       ->capture_default_str()->check(CLI::Range(2, 1000));
-  app.add_flag("--surface-prewarp", o.texture.surface_prewarp,
+  app.add_flag("--surface-prewarp,!--no-surface-prewarp", o.texture.surface_prewarp,
                "texture: a second pass for the samples the first left without a point, the "
                "photos brought onto the reference through the surface of the points found "
-               "first instead of the page's homography (flaps, the far side of a fold)");
+               "first instead of the page's homography (the far side of a fold); on by "
+               "default, --no-surface-prewarp turns it off");
   app.add_option("--surface-hole-px", o.texture.surface_hole_px,
                  "texture, second pass: only samples at least this far from every point the "
                  "first pass made (working-copy pixels; 0 = every sample it left)")

@@ -71,11 +71,12 @@ TEST_F(DensifyCli, WritesItsFilesAndKeepsSfmPointsFirstAndUnchanged) {
 }
 
 TEST_F(DensifyCli, SurfacePrewarpIsASecondPassCountedApart) {
-  const CommandResult plain = Run(Out());
+  const CommandResult plain = Run(Out() + " --no-surface-prewarp");
   ASSERT_EQ(plain.exit_code, 0) << plain.output;
   const Json before = ReadJsonFile(dir_ / "25_points/points.json");
   EXPECT_EQ(before["points"]["texture_surface_prewarp"].get<int>(), 0);
-  const CommandResult r = Run(Out() + " --surface-prewarp");
+  EXPECT_FALSE(before["producer"]["options"]["texture"]["surface_prewarp"].get<bool>());
+  const CommandResult r = Run(Out());  // on by default
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("through the points' surface"), std::string::npos) << r.output;
   const Json after = ReadJsonFile(dir_ / "25_points/points.json");

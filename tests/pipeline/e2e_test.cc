@@ -344,7 +344,11 @@ TEST_P(EndToEnd, MeshesAreCloseToTheTruthAndReadable) {
   // Since densify's shading-step points (2026-11-25) set08's far panel has
   // points: its init M 0.83, 0.64, 0.52 and 0.72 % over four sfm runs (1.09,
   // 1.21, 0.74 and 1.10 % without), every other set's at most 0.71 %
-  // (set07); issue 5's 1 % is asserted.
+  // (set07); issue 5's 1 % is asserted. Those few points still let it
+  // above 1 % in 3 of 17 later runs; with densify's second texture pass on
+  // (2026-11-26) the far panel has 800-3000 points and set08's init M was
+  // 0.33-0.47 % in 8 of 8 runs with view_00 as reference (1.32 % when sfm
+  // picks view_03: its third strip gets no point; README).
   EXPECT_LT(init_surface, 1.0) << set_;
   EXPECT_LE(final_surface, 3.0) << set_;
   EXPECT_LE(final_surface, 1.05 * init_surface + 0.1) << set_;
