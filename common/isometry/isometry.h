@@ -162,6 +162,10 @@ struct SolveOptions {
   // after max_outer_iterations (Q).
   int max_outer_iterations = 100;
   double relative_tolerance = 0.01;
+  // |ΔF/F| < ε must hold this many outer iterations in a row (1 = the
+  // paper): one short step (a rejected Levenberg-Marquardt step, markers
+  // re-decided) is a pause, not convergence.
+  int converged_iterations = 1;
   // Also stop once F has risen from one outer iteration to the next this
   // many times (it oscillates); 0 = never.
   int max_rises = 0;

@@ -43,6 +43,10 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--tolerance", o.relative_tolerance, "inner loop stops when |ΔF/F| < this")
       ->capture_default_str();
+  app.add_option("--converged-iterations", o.converged_iterations,
+                 "... in this many outer iterations in a row, in the rounds before "
+                 "--rises-from-round (1 = the paper: a single short step ends a round)")
+      ->capture_default_str()->check(CLI::Range(1, 100));
   app.add_option("--max-rises", o.max_rises,
                  "inner loop also stops once F has risen from one outer iteration to the next this "
                  "many times (footpoints and markers re-decided make it oscillate); 0 = off")
@@ -136,6 +140,7 @@ int main(int argc, char** argv) {
                                            o.weights.fair2d, o.weights.line, o.weights.ray}},
                                {"feature_growth", o.feature_weight_growth},
                                {"tolerance", o.relative_tolerance},
+                               {"converged_iterations", o.converged_iterations},
                                {"max_iterations", o.max_outer_iterations},
                                {"max_rises", o.max_rises},
                                {"rises_from_round", o.rises_from_round},

@@ -120,6 +120,7 @@ OptimizeResult Run(const OptimizeInputs& in, const OptimizeOptions& o) {
     so.support_radius = o.support_radius;
     so.iso_edges = o.iso_edges;
     so.relative_tolerance = o.relative_tolerance;
+    so.converged_iterations = r < o.rises_from_round ? o.converged_iterations : 1;
     so.max_outer_iterations = o.max_outer_iterations;
     so.max_rises = r >= o.rises_from_round ? o.max_rises : 0;
     so.method = o.method;

@@ -525,6 +525,27 @@ TEST(Isometry, StopsWhenFOscillates) {
   EXPECT_EQ(isometry::Solve(p, o).report.iterations.size(), 41u);
 }
 
+// converged_iterations = k: the solve ends only after k outer iterations in
+// a row with |ΔF/F| < ε, never on a single short step.
+TEST(Isometry, ConvergenceNeedsSmallChangesInARow) {
+  Problem p;
+  const MeshPair truth = CurledSheet(6, 5, 0.5, 0.4, 0.4);
+  p.meshes = Flattened(truth, 0.5);
+  p.points = SampleSurface(truth, 300, 0.0, 0.0, 2).points;
+  SolveOptions o;
+  o.relative_tolerance = 0.05;
+  const auto once = isometry::Solve(p, o);
+  o.converged_iterations = 3;
+  const auto thrice = isometry::Solve(p, o);
+  ASSERT_EQ(thrice.report.stop_reason, "converged");
+  const auto& it = thrice.report.iterations;
+  ASSERT_GE(it.size(), 4u);
+  for (size_t i = it.size() - 3; i < it.size(); ++i)
+    EXPECT_LE(std::abs(it[i].F - it[i - 1].F), o.relative_tolerance * it[i - 1].F) << i;
+  EXPECT_GE(it.size(), once.report.iterations.size() + 2);
+  EXPECT_LE(it.back().F, once.report.iterations.back().F * (1 + 1e-9));
+}
+
 TEST(Isometry, RejectsInconsistentProblems) {
   Problem p;
   p.meshes = CurledSheet(4, 3, 0.5, 0.4, 0.4);
