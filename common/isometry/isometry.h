@@ -162,9 +162,11 @@ struct SolveOptions {
   // after max_outer_iterations (Q).
   int max_outer_iterations = 100;
   double relative_tolerance = 0.01;
-  // |ΔF/F| < ε must hold this many outer iterations in a row (1 = the
-  // paper): one short step (a rejected Levenberg-Marquardt step, markers
-  // re-decided) is a pause, not convergence.
+  // The solve stops at the outer iteration where |ΔF/F| < ε for the
+  // converged_iterations-th time (1 = the paper: the first): one short step
+  // (Levenberg-Marquardt raising its damping, markers re-decided) is a pause,
+  // not convergence. Counted whether in a row or not, so that a solve whose
+  // F keeps alternating between short and long steps still ends soon.
   int converged_iterations = 1;
   // Also stop once F has risen from one outer iteration to the next this
   // many times (it oscillates); 0 = never.

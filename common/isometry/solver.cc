@@ -755,7 +755,7 @@ Result Solve(const Problem& problem, const SolveOptions& o) {
 
   double f_previous = 0;
   int rises = 0;
-  int small_changes = 0;  // consecutive outer iterations with |ΔF/F| < ε
+  int small_changes = 0;  // outer iterations so far with |ΔF/F| < ε
   for (int it = 0;; ++it) {
     IterationReport ir;
     ir.iteration = it;
@@ -804,8 +804,8 @@ Result Solve(const Problem& problem, const SolveOptions& o) {
     const bool damped = gn && o.converged_max_damping > 0 && gn->damping() > o.converged_max_damping;
     const bool small_change = it > 0 && !damped &&
                               std::abs(ir.F - f_previous) <= o.relative_tolerance * std::abs(f_previous);
-    small_changes = small_change ? small_changes + 1 : 0;
-    const bool converged = small_changes >= std::max(1, o.converged_iterations);
+    small_changes += small_change;
+    const bool converged = small_change && small_changes >= std::max(1, o.converged_iterations);
     // F measured after re-deciding footpoints and markers can oscillate
     // without settling; then |ΔF/F| falls below ε only by chance.
     if (it > 0 && ir.F > f_previous) ++rises;

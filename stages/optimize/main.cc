@@ -44,8 +44,8 @@ int main(int argc, char** argv) {
   app.add_option("--tolerance", o.relative_tolerance, "inner loop stops when |ΔF/F| < this")
       ->capture_default_str();
   app.add_option("--converged-iterations", o.converged_iterations,
-                 "... in this many outer iterations in a row, in the rounds before "
-                 "--rises-from-round (1 = the paper: a single short step ends a round)")
+                 "... for this many times (in a row or not), in the rounds before "
+                 "--rises-from-round (1 = the paper: the first short step ends a round)")
       ->capture_default_str()->check(CLI::Range(1, 100));
   app.add_option("--max-rises", o.max_rises,
                  "inner loop also stops once F has risen from one outer iteration to the next this "

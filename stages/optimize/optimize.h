@@ -22,7 +22,7 @@ struct OptimizeOptions {
   isometry::Weights weights;          // λ1..λ6 of the first round (paper values)
   double feature_weight_growth = 4;   // λ5 and λ6 are multiplied by this per subdivision
   double relative_tolerance = 0.01;   // inner loop stops when |ΔF/F| < this (ε)
-  // ... in this many outer iterations in a row (1 = the paper; see
+  // ... for the converged_iterations-th time (1 = the paper; see
   // isometry::SolveOptions::converged_iterations), in the rounds before
   // rises_from_round (below): they are cheap, and a round that stops on one
   // short step hands the next a page it has not finished fitting.

@@ -110,8 +110,8 @@ TEST(OptimizeCli, TextRowsTurnAnOffUprightFlatMesh) {
   EXPECT_GT(std::abs(turned_lines["text_down_flat"][1].get<double>()), 0.99);
   // Without the turn and with the paper's stopping rule the rows stay off
   // the axes and are dropped. (With the default --converged-iterations 2 the
-  // first rounds run on until the real sides, held along the axes, have
-  // turned M' upright by themselves: 24 lines, measured 2026-11-26.)
+  // first rounds can run on until the real sides, held along the axes, have
+  // turned M' upright by themselves: 24 lines in one run on 2026-11-26.)
   const CommandResult kept = RunCommand(OptimizeCommand(dir.path(), points, dir / "kept") +
                                         " --no-upright-by-lines --converged-iterations 1");
   ASSERT_EQ(kept.exit_code, 0) << kept.output;
