@@ -480,11 +480,18 @@ TEST(Isometry, MarkersStraightenLinesAndFollowTheirRays) {
   }
 }
 
-TEST(Isometry, CallbackSeesEveryOuterIteration) {
+// A 6x5 curled sheet started flat, fitted to 300 exact points of it: small,
+// and a few outer iterations from converged.
+Problem FlatStartOfACurledSheet() {
   Problem p;
   const MeshPair truth = CurledSheet(6, 5, 0.5, 0.4, 0.4);
   p.meshes = Flattened(truth, 0.5);
   p.points = SampleSurface(truth, 300, 0.0, 0.0, 2).points;
+  return p;
+}
+
+TEST(Isometry, CallbackSeesEveryOuterIteration) {
+  const Problem p = FlatStartOfACurledSheet();
   SolveOptions o;
   int calls = 0;
   o.on_outer_iteration = [&](const isometry::OuterIterationContext& c) {
@@ -528,10 +535,7 @@ TEST(Isometry, StopsWhenFOscillates) {
 // converged_iterations = k: the solve ends at the k-th outer iteration with
 // |ΔF/F| < ε, never on the first short step.
 TEST(Isometry, ConvergenceWaitsForTheKthShortStep) {
-  Problem p;
-  const MeshPair truth = CurledSheet(6, 5, 0.5, 0.4, 0.4);
-  p.meshes = Flattened(truth, 0.5);
-  p.points = SampleSurface(truth, 300, 0.0, 0.0, 2).points;
+  const Problem p = FlatStartOfACurledSheet();
   SolveOptions o;
   o.relative_tolerance = 0.05;
   const auto once = isometry::Solve(p, o);
