@@ -186,7 +186,9 @@ struct SolveOptions {
   // the moved point (found in M') as the marker's new surface point.
   bool project_markers = false;
 
-  int num_threads = 2;  // OpenMP threads for footpoints and assembly
+  // OpenMP threads for footpoints, assembly and CG at most; each outer
+  // iteration runs fewer while other processes keep cores busy (CpuShare).
+  int num_threads = 2;
   std::function<void(const OuterIterationContext&)> on_outer_iteration;
 };
 
@@ -217,6 +219,7 @@ struct IterationReport {
   int linear_iterations = 0;     // factorisations, CG iterations or L-BFGS iterations
   double damping = 0;            // Levenberg-Marquardt μ after the step
   bool step_accepted = false;
+  int threads = 1;               // OpenMP threads used (fewer than asked when other work is running)
 };
 
 struct SolveReport {

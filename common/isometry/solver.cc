@@ -19,6 +19,7 @@
 #include <Eigen/Sparse>
 #include <LBFGS.h>
 
+#include "common/cpu_share.h"
 #include "common/isometry/block_matrix.h"
 #include "common/isometry/isometry.h"
 #include "common/isometry/mesh_index.h"
@@ -387,6 +388,7 @@ class GaussNewton {
     mu_ = o.initial_damping;
   }
   bool direct() const { return direct_; }
+  void set_threads(int threads) { threads_ = std::max(1, threads); }
   double damping() const { return mu_; }
 
   // One damped Gauss-Newton step with the data held fixed; returns whether
@@ -678,6 +680,13 @@ bool LbfgsStep(State& s, const StepData& data, const Weights& w, const SolveOpti
   return true;
 }
 
+// One for the process, so optimize's successive rounds go on measuring
+// where the previous one stopped.
+CpuShare& ProcessCpuShare() {
+  static CpuShare share;
+  return share;
+}
+
 Json IterationJson(const IterationReport& it) {
   Json j;
   j["iteration"] = it.iteration;
@@ -693,6 +702,7 @@ Json IterationJson(const IterationReport& it) {
   j["linear_iterations"] = it.linear_iterations;
   j["damping"] = it.damping;
   j["step_accepted"] = it.step_accepted;
+  j["threads"] = it.threads;
   if (std::isfinite(it.F_after_step)) j["F_after_step"] = it.F_after_step;
   return j;
 }
@@ -733,14 +743,12 @@ Evaluation Evaluate(const Problem& problem, const SolveOptions& options) {
 Result Solve(const Problem& problem, const SolveOptions& o) {
   const auto start = Clock::now();
 #ifdef _OPENMP
-  // On a busy machine (load average above the core count) libgomp then runs
-  // fewer threads: oversubscribed barriers in the CG loop cost far more
-  // than the parallel work saves.
-  omp_set_dynamic(1);
+  // The thread count is ours to choose (ProcessCpuShare), not libgomp's
+  // from the 15-minute load average.
+  omp_set_dynamic(0);
 #endif
   Validate(problem);
   Work w = Normalise(problem, o);
-  const int threads = std::max(1, o.num_threads);
   std::unique_ptr<GaussNewton> gn;
   SolveReport report;
   if (o.method == Method::kGaussNewton) {
@@ -760,6 +768,10 @@ Result Solve(const Problem& problem, const SolveOptions& o) {
     IterationReport ir;
     ir.iteration = it;
     auto t0 = Clock::now();
+    // Re-decided every outer iteration: other work may start or end.
+    const int threads = ProcessCpuShare().Threads(o.num_threads);
+    if (gn) gn->set_threads(threads);
+    ir.threads = threads;
     UpdateFootpoints(w.state, w.data, o.outlier_distance, threads);
     // Where the points are is decided once per solve: re-deciding it as
     // footpoints move would change F's weights under the iterations.
