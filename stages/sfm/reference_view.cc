@@ -346,7 +346,7 @@ std::vector<ViewScore> ScoreReferenceViews(const ColmapModel& model,
     scores.push_back(s);
   }
   for (ViewScore& s : scores)
-    s.score = std::pow(s.coverage, 4) * s.resolution / max_resolution;
+    s.score = std::pow(s.coverage, 4) * s.resolution / max_resolution * s.frontality;
   std::stable_sort(scores.begin(), scores.end(),
                    [](const ViewScore& a, const ViewScore& b) {
                      if (a.score != b.score) return a.score > b.score;
