@@ -109,7 +109,9 @@ int main(int argc, char** argv) {
                  "stop when |dF/F| between outer iterations is below this (epsilon)")
       ->capture_default_str()->check(CLI::Range(0.0, 1.0));
   app.add_option("--threads", o.refine.num_threads,
-                 "solver threads at most; each outer iteration runs fewer while other processes keep the cores busy")->capture_default_str()
+                 "solver threads at most; each outer iteration runs fewer "
+                 "while other processes keep the cores busy")
+      ->capture_default_str()
       ->check(CLI::Range(1, 256));
   app.add_flag("--no-upright", no_upright, "keep M' as unfolded (do not turn it upright)");
   bool no_regrid = false;

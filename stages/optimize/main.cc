@@ -109,7 +109,8 @@ int main(int argc, char** argv) {
                  "turn M' when the segments run at least this many degrees off its axes")
       ->capture_default_str()->check(CLI::Range(0.0, 45.0));
   app.add_option("--threads", o.threads,
-                 "solver threads at most; each outer iteration runs fewer while other processes keep the cores busy")
+                 "solver threads at most; each outer iteration runs fewer "
+                 "while other processes keep the cores busy")
       ->capture_default_str();
   app.add_flag("--no-scene", no_scene, "do not write scene.glb");
   return RunStage("optimize", app, argc, argv, [&] {

@@ -1,13 +1,12 @@
 #include "common/cpu_share.h"
 
+#include <gtest/gtest.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
 #include <filesystem>
-
-#include <gtest/gtest.h>
 
 namespace docunfold {
 namespace {
@@ -32,10 +31,12 @@ void Spin(double seconds) {
 }
 
 TEST(CpuShare, OthersAreTheBusyTimeNotSpentByThisProcess) {
-  // 3 s of CPU in 2 s of wall time, 1 s of it this process's: others used 1 core.
+  // 3 s of CPU in 2 s of wall time, 1 s of it this process's: others used 1
+  // core.
   EXPECT_DOUBLE_EQ(OthersCores(Sample(10, 100, 5), Sample(12, 103, 6)), 1.0);
   // Counters are coarser than this process's own clock: never below 0.
-  EXPECT_DOUBLE_EQ(OthersCores(Sample(10, 100, 5), Sample(11, 100.5, 5.9)), 0.0);
+  EXPECT_DOUBLE_EQ(OthersCores(Sample(10, 100, 5), Sample(11, 100.5, 5.9)),
+                   0.0);
   // Unreadable /proc/stat, or no time passed: nothing known.
   CpuSample invalid = Sample(12, 103, 6);
   invalid.valid = false;
@@ -43,7 +44,7 @@ TEST(CpuShare, OthersAreTheBusyTimeNotSpentByThisProcess) {
   EXPECT_DOUBLE_EQ(OthersCores(Sample(10, 100, 5), Sample(10, 103, 6)), 0.0);
 }
 
-TEST(CpuShare, SamplesCountThisProcessesWork) {
+TEST(CpuShare, SamplesCountThisProcessWork) {
   if (!std::filesystem::exists("/proc/stat")) GTEST_SKIP() << "no /proc/stat";
   const CpuSample before = SampleCpu();
   ASSERT_TRUE(before.valid);
@@ -56,7 +57,7 @@ TEST(CpuShare, SamplesCountThisProcessesWork) {
   EXPECT_GE(AvailableCores(), 1);
 }
 
-TEST(CpuShare, SeesAnotherProcessesLoad) {
+TEST(CpuShare, SeesAnotherProcessLoad) {
   if (!std::filesystem::exists("/proc/stat")) GTEST_SKIP() << "no /proc/stat";
   CpuShare share(0.05);
   const auto start = Clock::now();
@@ -69,10 +70,12 @@ TEST(CpuShare, SeesAnotherProcessesLoad) {
   int status = 0;
   rusage child_usage{};
   ASSERT_EQ(wait4(child, &status, 0, &child_usage), child);
-  const double wall = std::chrono::duration<double>(Clock::now() - start).count();
-  const double child_cores = (child_usage.ru_utime.tv_sec + child_usage.ru_stime.tv_sec +
-                              1e-6 * (child_usage.ru_utime.tv_usec + child_usage.ru_stime.tv_usec)) /
-                             wall;
+  const double wall =
+      std::chrono::duration<double>(Clock::now() - start).count();
+  const double child_cores =
+      (child_usage.ru_utime.tv_sec + child_usage.ru_stime.tv_sec +
+       1e-6 * (child_usage.ru_utime.tv_usec + child_usage.ru_stime.tv_usec)) /
+      wall;
   const int threads = share.Threads(64);
   // Whatever else runs on this machine adds to the child's share, never less.
   EXPECT_GE(share.others(), child_cores - 0.15);
