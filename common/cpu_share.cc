@@ -14,6 +14,12 @@
 namespace docunfold {
 namespace {
 
+// The CPUs this process may run on; false when the kernel does not say.
+bool Affinity(cpu_set_t* set) {
+  CPU_ZERO(set);
+  return sched_getaffinity(0, sizeof(*set), set) == 0;
+}
+
 bool InAffinity(int cpu, const cpu_set_t& set) {
   return cpu >= 0 && cpu < CPU_SETSIZE && CPU_ISSET(cpu, &set);
 }
@@ -22,8 +28,7 @@ bool InAffinity(int cpu, const cpu_set_t& set) {
 
 int AvailableCores() {
   cpu_set_t set;
-  CPU_ZERO(&set);
-  if (sched_getaffinity(0, sizeof(set), &set) != 0) return 1;
+  if (!Affinity(&set)) return 1;
   return std::max(1, CPU_COUNT(&set));
 }
 
@@ -35,8 +40,7 @@ CpuSample SampleCpu() {
     s.self_seconds = usage.ru_utime.tv_sec + usage.ru_stime.tv_sec +
                      1e-6 * (usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
   cpu_set_t set;
-  CPU_ZERO(&set);
-  const bool have_set = sched_getaffinity(0, sizeof(set), &set) == 0;
+  const bool have_set = Affinity(&set);
   const long ticks_per_second = sysconf(_SC_CLK_TCK);
   std::ifstream in("/proc/stat");
   if (!in || ticks_per_second <= 0) return s;
