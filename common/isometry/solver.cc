@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <array>
 #include <cstdio>
 #include <cstdlib>
 #include <chrono>
@@ -49,31 +50,52 @@ void AddSquares(const Row* rows, int n, double* sum) {
   for (int i = 0; i < n; ++i) *sum += rows[i].value * rows[i].value;
 }
 
+// Items per chunk of OrderedSums. Chunks, not threads, fix the order in
+// which floating-point sums are added, so F, and with it every step Levenberg-
+// Marquardt accepts, is the same whatever number of threads runs (the solver
+// re-decides that number every outer iteration from the machine's load).
+constexpr int kSumChunk = 1024;
+
+// Per chunk of [0, n): add(i, acc) for its items in order, into acc[0..K).
+// Returns the chunks' sums added in chunk order.
+template <int K, class Add>
+std::array<double, K> OrderedSums(int n, int threads, Add&& add) {
+  const int chunks = (n + kSumChunk - 1) / kSumChunk;
+  std::vector<std::array<double, K>> part(static_cast<size_t>(chunks));
+#pragma omp parallel for num_threads(threads) schedule(static) if (threads > 1 && chunks > 1)
+  for (int c = 0; c < chunks; ++c) {
+    std::array<double, K> acc{};
+    Row rows[kMaxRowsPerItem];
+    for (int i = c * kSumChunk; i < std::min(n, (c + 1) * kSumChunk); ++i) add(i, rows, acc);
+    part[size_t(c)] = acc;
+  }
+  std::array<double, K> total{};
+  for (const auto& acc : part)
+    for (int k = 0; k < K; ++k) total[size_t(k)] += acc[size_t(k)];
+  return total;
+}
+
 }  // namespace
 
 TermValues EvaluateTerms(const State& s, const StepData& data, int threads) {
-  double iso = 0, dist = 0, fair3d = 0, fair2d = 0, line = 0, ray = 0;
   const int quads = s.grid.NumQuads(), points = int(data.points.size());
   const int triplets = NumFairTriplets(s.grid), markers = int(data.markers.size());
-  const bool parallel = threads > 1 && quads > 2000;
-#pragma omp parallel num_threads(threads) if (parallel)
-  {
-    Row rows[kMaxRowsPerItem];
-#pragma omp for schedule(static) reduction(+ : iso) nowait
-    for (int q = 0; q < quads; ++q) AddSquares(rows, IsoRows(s, data, q, rows), &iso);
-#pragma omp for schedule(static) reduction(+ : dist) nowait
-    for (int p = 0; p < points; ++p) AddSquares(rows, DistRows(s, data, p, rows), &dist);
-#pragma omp for schedule(static) reduction(+ : fair3d, fair2d) nowait
-    for (int t = 0; t < triplets; ++t) {
-      AddSquares(rows, FairRows(s, data, t, false, rows), &fair3d);
-      AddSquares(rows, FairRows(s, data, t, true, rows), &fair2d);
-    }
-#pragma omp for schedule(static) reduction(+ : line, ray) nowait
-    for (int m = 0; m < markers; ++m) {
-      AddSquares(rows, LineRows(s, data, m, rows), &line);
-      AddSquares(rows, RayRows(s, data, m, rows), &ray);
-    }
-  }
+  threads = quads > 2000 ? threads : 1;
+  const double iso = OrderedSums<1>(quads, threads, [&](int q, Row* rows, auto& acc) {
+    AddSquares(rows, IsoRows(s, data, q, rows), &acc[0]);
+  })[0];
+  const double dist = OrderedSums<1>(points, threads, [&](int p, Row* rows, auto& acc) {
+    AddSquares(rows, DistRows(s, data, p, rows), &acc[0]);
+  })[0];
+  const auto fair = OrderedSums<2>(triplets, threads, [&](int t, Row* rows, auto& acc) {
+    AddSquares(rows, FairRows(s, data, t, false, rows), &acc[0]);
+    AddSquares(rows, FairRows(s, data, t, true, rows), &acc[1]);
+  });
+  const auto feature = OrderedSums<2>(markers, threads, [&](int m, Row* rows, auto& acc) {
+    AddSquares(rows, LineRows(s, data, m, rows), &acc[0]);
+    AddSquares(rows, RayRows(s, data, m, rows), &acc[1]);
+  });
+  const double fair3d = fair[0], fair2d = fair[1], line = feature[0], ray = feature[1];
   TermValues t;
   t.iso = iso;
   t.dist = dist;
@@ -448,18 +470,24 @@ class GaussNewton {
       return value * value;
     };
     double f = 0;
+    // Per grid row or line, then added in order: F does not depend on the
+    // number of threads (see kSumChunk).
+    std::vector<double> part(size_t(std::max(grid.nx, grid.ny)), 0.0);
     if (w.iso > 0)
       for (int colour = 0; colour < 4; ++colour) {
         const int r0 = colour / 2, c0 = colour % 2;
-#pragma omp parallel for num_threads(threads_) schedule(static) reduction(+ : f) if (parallel)
+#pragma omp parallel for num_threads(threads_) schedule(static) if (parallel)
         for (int r = r0; r < grid.ny - 1; r += 2) {
           Row rows[internal::kMaxRowsPerItem];
+          double sum = 0;
           for (int c = c0; c < grid.nx - 1; c += 2) {
             const int q = r * (grid.nx - 1) + c;
             const int m = internal::IsoRows(s, data, q, rows);
-            for (int i = 0; i < m; ++i) f += add(w.iso, rows[i]);
+            for (int i = 0; i < m; ++i) sum += add(w.iso, rows[i]);
           }
+          part[size_t(r)] = sum;
         }
+        for (int r = r0; r < grid.ny - 1; r += 2) f += part[size_t(r)];
       }
     // Fairness: triplets along rows come first, then along columns (see
     // FairTriplet); centres three apart along the line share no vertex.
@@ -470,21 +498,24 @@ class GaussNewton {
       const int per_line = phase == 0 ? grid.nx - 2 : grid.ny - 2;
       if (per_line <= 0 || (w.fair3d <= 0 && w.fair2d <= 0)) continue;
       for (int colour = 0; colour < 3; ++colour) {
-#pragma omp parallel for num_threads(threads_) schedule(static) reduction(+ : f) if (parallel)
+#pragma omp parallel for num_threads(threads_) schedule(static) if (parallel)
         for (int l = 0; l < lines; ++l) {
           Row rows[3];
+          double sum = 0;
           for (int k = colour; k < per_line; k += 3) {
             const int t = (phase == 0 ? 0 : along_rows) + l * per_line + k;
             if (w.fair3d > 0) {
               const int m = internal::FairRows(s, data, t, false, rows);
-              for (int i = 0; i < m; ++i) f += add(w.fair3d, rows[i]);
+              for (int i = 0; i < m; ++i) sum += add(w.fair3d, rows[i]);
             }
             if (w.fair2d > 0) {
               const int m = internal::FairRows(s, data, t, true, rows);
-              for (int i = 0; i < m; ++i) f += add(w.fair2d, rows[i]);
+              for (int i = 0; i < m; ++i) sum += add(w.fair2d, rows[i]);
             }
           }
+          part[size_t(l)] = sum;
         }
+        for (int l = 0; l < lines; ++l) f += part[size_t(l)];
       }
     }
     (void)along_cols;
