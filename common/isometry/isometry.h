@@ -75,6 +75,9 @@ struct FeatureLine {
   // parallel or perpendicular to each other, which straightness alone does
   // not ask (the paper's E_line leaves M' free to shear).
   bool axis_aligned = false;
+  // A row of text: with SolveOptions::line_spacing > 0 it is drawn toward
+  // the middle of its neighbouring rows (see there).
+  bool text_row = false;
   Eigen::Vector2d Normal() const { return {std::cos(theta), std::sin(theta)}; }
   double SignedDistance(const Eigen::Vector2d& p) const { return Normal().dot(p) - offset; }
 };
@@ -185,6 +188,16 @@ struct SolveOptions {
   // every marker's p' onto its line and keep the face and barycentrics of
   // the moved point (found in M') as the marker's new surface point.
   bool project_markers = false;
+  // Rows of text in a block are evenly spaced on the page. Where a fold runs
+  // along the rows, straightness does not constrain how far apart M' puts
+  // them, and a fold M does not open far enough (no points on a panel seen
+  // obliquely) squeezes the rows there. After the lines are fitted, each
+  // text row with a parallel, overlapping neighbouring row on both sides
+  // whose two gaps differ by at most max_spacing_ratio is moved this
+  // fraction of the way to the middle of its neighbours (before the markers
+  // are projected, so E_ray then carries the spacing to M). 0 = off.
+  double line_spacing = 0;
+  double max_spacing_ratio = 1.35;
 
   // OpenMP threads for footpoints, assembly and CG at most; each outer
   // iteration runs fewer while other processes keep cores busy (CpuShare).
@@ -213,6 +226,7 @@ struct IterationReport {
   int outliers = 0;
   int markers = 0;
   int lines = 0;
+  int spaced_rows = 0;  // text rows moved toward their neighbours' middle (line_spacing)
   double seconds = 0;            // wall time since the solve started, at the end of this iteration
   double footpoint_seconds = 0;  // footpoints + outliers + lines
   double step_seconds = 0;       // assembly + linear solves (or L-BFGS batch)

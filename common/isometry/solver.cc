@@ -362,6 +362,83 @@ void FitLines(State& s, const StepData& data) {
   }
 }
 
+// SolveOptions::line_spacing: each text row whose nearest parallel rows on
+// both sides overlap it along its length, with gaps within max_ratio of each
+// other, moves `strength` of the way to their middle (all from the offsets
+// as fitted). Returns how many rows moved.
+int EvenTextRowSpacing(State& s, const StepData& data, double strength, double max_ratio) {
+  const int n = int(s.lines.size());
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  std::vector<double> lo(n, kInf), hi(n, -kInf);
+  std::vector<int> count(n, 0);
+  // Lines are axis-aligned: vertical_axis[l] says whether the normal is ±y
+  // (a horizontal row); position along the row is then x.
+  auto along = [&](int l, const Eigen::Vector2d& p) {
+    return std::abs(s.lines[l].Normal().y()) > std::abs(s.lines[l].Normal().x()) ? p.x() : p.y();
+  };
+  for (const Marker& m : data.markers) {
+    if (m.line < 0) continue;
+    const double t = along(m.line, FlatPoint(s, m.where));
+    lo[m.line] = std::min(lo[m.line], t);
+    hi[m.line] = std::max(hi[m.line], t);
+    ++count[m.line];
+  }
+  // Offset along the positive axis (x or y), whatever the normal's sign.
+  auto axis_offset = [&](int l) {
+    const Eigen::Vector2d nrm = s.lines[l].Normal();
+    return s.lines[l].offset * (std::abs(nrm.y()) > std::abs(nrm.x()) ? nrm.y() : nrm.x());
+  };
+  auto horizontal = [&](int l) {
+    return std::abs(s.lines[l].Normal().y()) > std::abs(s.lines[l].Normal().x());
+  };
+  auto overlapping = [&](int a, int b) {
+    const double overlap = std::min(hi[a], hi[b]) - std::max(lo[a], lo[b]);
+    return overlap > 0.5 * std::min(hi[a] - lo[a], hi[b] - lo[b]);
+  };
+  std::vector<int> rows;
+  for (int l = 0; l < n; ++l)
+    if (s.lines[l].text_row && s.lines[l].axis_aligned && count[l] >= 2 && hi[l] > lo[l])
+      rows.push_back(l);
+  // Nearest parallel, overlapping rows on either side of each row.
+  std::vector<int> below(n, -1), above(n, -1);
+  std::vector<double> nearest;  // per row: its smaller gap, for the typical pitch
+  for (const int b : rows) {
+    const double cb = axis_offset(b);
+    double ca = -kInf, cc = kInf;
+    for (const int x : rows) {
+      if (x == b || horizontal(x) != horizontal(b) || !overlapping(x, b)) continue;
+      const double cx = axis_offset(x);
+      if (cx < cb && cx > ca) ca = cx, below[b] = x;
+      if (cx > cb && cx < cc) cc = cx, above[b] = x;
+    }
+    const double g = std::min(cb - ca, cc - cb);
+    if (std::isfinite(g)) nearest.push_back(g);
+  }
+  if (nearest.empty()) return 0;
+  std::nth_element(nearest.begin(), nearest.begin() + nearest.size() / 2, nearest.end());
+  // The page's row pitch: rows farther apart than max_ratio of it are no
+  // consecutive rows (a sparse table column, a paragraph break).
+  const double pitch = nearest[nearest.size() / 2];
+  std::vector<double> target(n, kInf);
+  for (const int b : rows) {
+    if (below[b] < 0 || above[b] < 0) continue;
+    const double ca = axis_offset(below[b]), cb = axis_offset(b), cc = axis_offset(above[b]);
+    const double g1 = cb - ca, g2 = cc - cb;
+    if (std::max(g1, g2) > max_ratio * std::min(g1, g2) || std::max(g1, g2) > max_ratio * pitch)
+      continue;
+    target[b] = cb + strength * (0.5 * (ca + cc) - cb);
+  }
+  int moved = 0;
+  for (const int b : rows) {
+    if (!std::isfinite(target[b])) continue;
+    const Eigen::Vector2d nrm = s.lines[b].Normal();
+    const double sign = std::abs(nrm.y()) > std::abs(nrm.x()) ? nrm.y() : nrm.x();
+    s.lines[b].offset = target[b] * sign;
+    ++moved;
+  }
+  return moved;
+}
+
 // Feature line projection: p' onto its line, then the new face and
 // barycentrics of the moved point in M'.
 void ProjectMarkers(const State& s, StepData& data) {
@@ -727,6 +804,7 @@ Json IterationJson(const IterationReport& it) {
   j["outliers"] = it.outliers;
   j["markers"] = it.markers;
   j["lines"] = it.lines;
+  j["spaced_rows"] = it.spaced_rows;
   j["seconds"] = it.seconds;
   j["footpoint_seconds"] = it.footpoint_seconds;
   j["step_seconds"] = it.step_seconds;
@@ -832,6 +910,8 @@ Result Solve(const Problem& problem, const SolveOptions& o) {
       for (FeatureLine& l : w.state.lines)  // the caller's may be slanted
         if (l.axis_aligned) l.theta = NearestAxisTheta(l.theta);
       if (o.refit_lines) FitLines(w.state, w.data);
+      if (o.line_spacing > 0)
+        ir.spaced_rows = EvenTextRowSpacing(w.state, w.data, o.line_spacing, o.max_spacing_ratio);
       if (o.project_markers) ProjectMarkers(w.state, w.data);
     }
     ir.terms = internal::EvaluateTerms(w.state, w.data, threads);

@@ -335,9 +335,11 @@ std::vector<isometry::FeatureLine> AssignLines(const MeshPair& meshes, const Gro
     lines[l].theta = std::atan2(normal.y(), normal.x());
     lines[l].offset = normal.dot(mean);
   }
-  for (int l = 0; l < n; ++l)
+  for (int l = 0; l < n; ++l) {
     lines[l].axis_aligned = axis_lines == AxisLines::kAll ||
                             (axis_lines == AxisLines::kFeatures && grouping.line_kind[l] != "boundary");
+    lines[l].text_row = grouping.line_kind[l] == "text";
+  }
   return lines;
 }
 

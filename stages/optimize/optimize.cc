@@ -119,6 +119,8 @@ OptimizeResult Run(const OptimizeInputs& in, const OptimizeOptions& o) {
     so.unsupported_fairness = o.unsupported_fairness;
     so.support_radius = o.support_radius;
     so.iso_edges = o.iso_edges;
+    so.line_spacing = o.line_spacing;
+    so.max_spacing_ratio = o.max_spacing_ratio;
     so.relative_tolerance = o.relative_tolerance;
     so.converged_iterations = r < o.rises_from_round ? o.converged_iterations : 1;
     so.max_outer_iterations = o.max_outer_iterations;

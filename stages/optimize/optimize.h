@@ -49,6 +49,8 @@ struct OptimizeOptions {
   double unsupported_fairness = 1;
   double support_radius = 0.03;       // fraction of the model size
   double iso_edges = 0;               // isometry::SolveOptions::iso_edges
+  double line_spacing = 0;            // isometry::SolveOptions::line_spacing
+  double max_spacing_ratio = 1.35;    // isometry::SolveOptions::max_spacing_ratio
   isometry::Method method = isometry::Method::kGaussNewton;
   isometry::LinearSolver linear_solver = isometry::LinearSolver::kAuto;
   bool features = true;        // false: no feature lines at all (--no-features)

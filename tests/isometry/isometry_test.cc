@@ -504,6 +504,60 @@ TEST(Isometry, SolveIsTheSameForAnyNumberOfThreads) {
   EXPECT_TRUE(one.meshes.mesh2d == two.meshes.mesh2d);
 }
 
+// Three horizontal rows of text on a curled sheet, their markers' rays
+// through the true sheet; M' starts as the truth.
+Problem ThreeTextRows(const std::vector<double>& rows, bool text) {
+  const MeshPair truth = CurledSheet(17, 13, 0.8, 0.6, 0.8);
+  isometry::FlatMeshLocator locator(truth);
+  Problem p;
+  p.meshes = truth;
+  for (size_t l = 0; l < rows.size(); ++l) {
+    isometry::FeatureLine line;
+    line.theta = M_PI / 2;
+    line.offset = rows[l];
+    line.axis_aligned = true;
+    line.text_row = text;
+    p.lines.push_back(line);
+    for (int k = 0; k <= 30; ++k) {
+      const auto where = locator.Locate(Eigen::Vector2d(0.1 + 0.02 * k, rows[l]));
+      if (!where) continue;
+      isometry::Marker m;
+      m.where = *where;
+      m.line = int(l);
+      m.ray_origin = Eigen::Vector3d::Zero();
+      m.ray_direction = PointOnMesh3d(truth, *where).normalized();
+      p.markers.push_back(m);
+    }
+  }
+  return p;
+}
+
+TEST(Isometry, TextRowsMoveTowardTheMiddleOfTheirNeighbours) {
+  SolveOptions o;
+  o.weights.dist = 0;
+  o.project_markers = true;
+  o.line_spacing = 1;
+  o.max_outer_iterations = 30;
+  // The middle row 0.01 below the middle (gaps 0.09 and 0.11): it moves
+  // most of the way there, M' stretching between it and the first row.
+  const auto spaced = isometry::Solve(ThreeTextRows({0.1, 0.19, 0.3}, true), o);
+  EXPECT_EQ(spaced.report.iterations.front().spaced_rows, 1);
+  EXPECT_NEAR(spaced.lines[1].offset, 0.2, 0.004);
+  EXPECT_NEAR(spaced.lines[0].offset, 0.1, 0.004);
+  EXPECT_NEAR(spaced.lines[2].offset, 0.3, 0.004);
+  // Off, not text, or gaps too different (0.07 and 0.13: a paragraph
+  // break): the rows stay where the rays hold them.
+  o.line_spacing = 0;
+  EXPECT_NEAR(isometry::Solve(ThreeTextRows({0.1, 0.19, 0.3}, true), o).lines[1].offset, 0.19,
+              0.001);
+  o.line_spacing = 1;
+  EXPECT_NEAR(isometry::Solve(ThreeTextRows({0.1, 0.19, 0.3}, false), o).lines[1].offset, 0.19,
+              0.001);
+  const auto uneven = isometry::Solve(ThreeTextRows({0.1, 0.17, 0.3}, true), o);
+  EXPECT_EQ(uneven.report.iterations.front().spaced_rows, 0);
+  EXPECT_NEAR(uneven.lines[1].offset, 0.17, 0.001);
+}
+
 // A 6x5 curled sheet started flat, fitted to 300 exact points of it: small,
 // and a few outer iterations from converged.
 Problem FlatStartOfACurledSheet() {
