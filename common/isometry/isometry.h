@@ -226,7 +226,8 @@ struct IterationReport {
   int outliers = 0;
   int markers = 0;
   int lines = 0;
-  int spaced_rows = 0;  // text rows moved toward their neighbours' middle (line_spacing)
+  // Text rows moved toward the middle of their neighbours (line_spacing).
+  int spaced_rows = 0;
   double seconds = 0;            // wall time since the solve started, at the end of this iteration
   double footpoint_seconds = 0;  // footpoints + outliers + lines
   double step_seconds = 0;       // assembly + linear solves (or L-BFGS batch)

@@ -1,11 +1,11 @@
 #include <algorithm>
 #include <array>
-#include <cstdio>
-#include <cstdlib>
 #include <chrono>
 #include <cmath>
-#include <limits>
+#include <cstdio>
+#include <cstdlib>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <queue>
 #include <stdexcept>
@@ -62,11 +62,13 @@ template <int K, class Add>
 std::array<double, K> OrderedSums(int n, int threads, Add&& add) {
   const int chunks = (n + kSumChunk - 1) / kSumChunk;
   std::vector<std::array<double, K>> part(static_cast<size_t>(chunks));
-#pragma omp parallel for num_threads(threads) schedule(static) if (threads > 1 && chunks > 1)
+#pragma omp parallel for num_threads(threads) \
+    schedule(static) if (threads > 1 && chunks > 1)
   for (int c = 0; c < chunks; ++c) {
     std::array<double, K> acc{};
     Row rows[kMaxRowsPerItem];
-    for (int i = c * kSumChunk; i < std::min(n, (c + 1) * kSumChunk); ++i) add(i, rows, acc);
+    for (int i = c * kSumChunk; i < std::min(n, (c + 1) * kSumChunk); ++i)
+      add(i, rows, acc);
     part[size_t(c)] = acc;
   }
   std::array<double, K> total{};
@@ -81,21 +83,26 @@ TermValues EvaluateTerms(const State& s, const StepData& data, int threads) {
   const int quads = s.grid.NumQuads(), points = int(data.points.size());
   const int triplets = NumFairTriplets(s.grid), markers = int(data.markers.size());
   threads = quads > 2000 ? threads : 1;
-  const double iso = OrderedSums<1>(quads, threads, [&](int q, Row* rows, auto& acc) {
-    AddSquares(rows, IsoRows(s, data, q, rows), &acc[0]);
-  })[0];
-  const double dist = OrderedSums<1>(points, threads, [&](int p, Row* rows, auto& acc) {
-    AddSquares(rows, DistRows(s, data, p, rows), &acc[0]);
-  })[0];
-  const auto fair = OrderedSums<2>(triplets, threads, [&](int t, Row* rows, auto& acc) {
-    AddSquares(rows, FairRows(s, data, t, false, rows), &acc[0]);
-    AddSquares(rows, FairRows(s, data, t, true, rows), &acc[1]);
-  });
-  const auto feature = OrderedSums<2>(markers, threads, [&](int m, Row* rows, auto& acc) {
-    AddSquares(rows, LineRows(s, data, m, rows), &acc[0]);
-    AddSquares(rows, RayRows(s, data, m, rows), &acc[1]);
-  });
-  const double fair3d = fair[0], fair2d = fair[1], line = feature[0], ray = feature[1];
+  const double iso =
+      OrderedSums<1>(quads, threads, [&](int q, Row* rows, auto& acc) {
+        AddSquares(rows, IsoRows(s, data, q, rows), &acc[0]);
+      })[0];
+  const double dist =
+      OrderedSums<1>(points, threads, [&](int p, Row* rows, auto& acc) {
+        AddSquares(rows, DistRows(s, data, p, rows), &acc[0]);
+      })[0];
+  const auto fair =
+      OrderedSums<2>(triplets, threads, [&](int t, Row* rows, auto& acc) {
+        AddSquares(rows, FairRows(s, data, t, false, rows), &acc[0]);
+        AddSquares(rows, FairRows(s, data, t, true, rows), &acc[1]);
+      });
+  const auto feature =
+      OrderedSums<2>(markers, threads, [&](int m, Row* rows, auto& acc) {
+        AddSquares(rows, LineRows(s, data, m, rows), &acc[0]);
+        AddSquares(rows, RayRows(s, data, m, rows), &acc[1]);
+      });
+  const double fair3d = fair[0], fair2d = fair[1], line = feature[0],
+               ray = feature[1];
   TermValues t;
   t.iso = iso;
   t.dist = dist;
@@ -366,7 +373,8 @@ void FitLines(State& s, const StepData& data) {
 // both sides overlap it along its length, with gaps within max_ratio of each
 // other, moves `strength` of the way to their middle (all from the offsets
 // as fitted). Returns how many rows moved.
-int EvenTextRowSpacing(State& s, const StepData& data, double strength, double max_ratio) {
+int EvenTextRowSpacing(State& s, const StepData& data, double strength,
+                       double max_ratio) {
   const int n = int(s.lines.size());
   constexpr double kInf = std::numeric_limits<double>::infinity();
   std::vector<double> lo(n, kInf), hi(n, -kInf);
@@ -374,7 +382,9 @@ int EvenTextRowSpacing(State& s, const StepData& data, double strength, double m
   // Lines are axis-aligned: vertical_axis[l] says whether the normal is ±y
   // (a horizontal row); position along the row is then x.
   auto along = [&](int l, const Eigen::Vector2d& p) {
-    return std::abs(s.lines[l].Normal().y()) > std::abs(s.lines[l].Normal().x()) ? p.x() : p.y();
+    return std::abs(s.lines[l].Normal().y()) > std::abs(s.lines[l].Normal().x())
+               ? p.x()
+               : p.y();
   };
   for (const Marker& m : data.markers) {
     if (m.line < 0) continue;
@@ -386,10 +396,12 @@ int EvenTextRowSpacing(State& s, const StepData& data, double strength, double m
   // Offset along the positive axis (x or y), whatever the normal's sign.
   auto axis_offset = [&](int l) {
     const Eigen::Vector2d nrm = s.lines[l].Normal();
-    return s.lines[l].offset * (std::abs(nrm.y()) > std::abs(nrm.x()) ? nrm.y() : nrm.x());
+    return s.lines[l].offset *
+           (std::abs(nrm.y()) > std::abs(nrm.x()) ? nrm.y() : nrm.x());
   };
   auto horizontal = [&](int l) {
-    return std::abs(s.lines[l].Normal().y()) > std::abs(s.lines[l].Normal().x());
+    return std::abs(s.lines[l].Normal().y()) >
+           std::abs(s.lines[l].Normal().x());
   };
   auto overlapping = [&](int a, int b) {
     const double overlap = std::min(hi[a], hi[b]) - std::max(lo[a], lo[b]);
@@ -397,16 +409,19 @@ int EvenTextRowSpacing(State& s, const StepData& data, double strength, double m
   };
   std::vector<int> rows;
   for (int l = 0; l < n; ++l)
-    if (s.lines[l].text_row && s.lines[l].axis_aligned && count[l] >= 2 && hi[l] > lo[l])
+    if (s.lines[l].text_row && s.lines[l].axis_aligned && count[l] >= 2 &&
+        hi[l] > lo[l])
       rows.push_back(l);
   // Nearest parallel, overlapping rows on either side of each row.
   std::vector<int> below(n, -1), above(n, -1);
-  std::vector<double> nearest;  // per row: its smaller gap, for the typical pitch
+  std::vector<double>
+      nearest;  // per row: its smaller gap, for the typical pitch
   for (const int b : rows) {
     const double cb = axis_offset(b);
     double ca = -kInf, cc = kInf;
     for (const int x : rows) {
-      if (x == b || horizontal(x) != horizontal(b) || !overlapping(x, b)) continue;
+      if (x == b || horizontal(x) != horizontal(b) || !overlapping(x, b))
+        continue;
       const double cx = axis_offset(x);
       if (cx < cb && cx > ca) ca = cx, below[b] = x;
       if (cx > cb && cx < cc) cc = cx, above[b] = x;
@@ -415,16 +430,19 @@ int EvenTextRowSpacing(State& s, const StepData& data, double strength, double m
     if (std::isfinite(g)) nearest.push_back(g);
   }
   if (nearest.empty()) return 0;
-  std::nth_element(nearest.begin(), nearest.begin() + nearest.size() / 2, nearest.end());
+  std::nth_element(nearest.begin(), nearest.begin() + nearest.size() / 2,
+                   nearest.end());
   // The page's row pitch: rows farther apart than max_ratio of it are no
   // consecutive rows (a sparse table column, a paragraph break).
   const double pitch = nearest[nearest.size() / 2];
   std::vector<double> target(n, kInf);
   for (const int b : rows) {
     if (below[b] < 0 || above[b] < 0) continue;
-    const double ca = axis_offset(below[b]), cb = axis_offset(b), cc = axis_offset(above[b]);
+    const double ca = axis_offset(below[b]), cb = axis_offset(b),
+                 cc = axis_offset(above[b]);
     const double g1 = cb - ca, g2 = cc - cb;
-    if (std::max(g1, g2) > max_ratio * std::min(g1, g2) || std::max(g1, g2) > max_ratio * pitch)
+    if (std::max(g1, g2) > max_ratio * std::min(g1, g2) ||
+        std::max(g1, g2) > max_ratio * pitch)
       continue;
     target[b] = cb + strength * (0.5 * (ca + cc) - cb);
   }
@@ -432,7 +450,8 @@ int EvenTextRowSpacing(State& s, const StepData& data, double strength, double m
   for (const int b : rows) {
     if (!std::isfinite(target[b])) continue;
     const Eigen::Vector2d nrm = s.lines[b].Normal();
-    const double sign = std::abs(nrm.y()) > std::abs(nrm.x()) ? nrm.y() : nrm.x();
+    const double sign =
+        std::abs(nrm.y()) > std::abs(nrm.x()) ? nrm.y() : nrm.x();
     s.lines[b].offset = target[b] * sign;
     ++moved;
   }
@@ -911,7 +930,8 @@ Result Solve(const Problem& problem, const SolveOptions& o) {
         if (l.axis_aligned) l.theta = NearestAxisTheta(l.theta);
       if (o.refit_lines) FitLines(w.state, w.data);
       if (o.line_spacing > 0)
-        ir.spaced_rows = EvenTextRowSpacing(w.state, w.data, o.line_spacing, o.max_spacing_ratio);
+        ir.spaced_rows = EvenTextRowSpacing(w.state, w.data, o.line_spacing,
+                                            o.max_spacing_ratio);
       if (o.project_markers) ProjectMarkers(w.state, w.data);
     }
     ir.terms = internal::EvaluateTerms(w.state, w.data, threads);

@@ -66,13 +66,15 @@ int main(int argc, char** argv) {
   AddFairnessBoostOptions(app, &o.unsupported_fairness, &o.support_radius);
   AddIsoEdgesOption(app, &o.iso_edges);
   app.add_option("--line-spacing", o.line_spacing,
-                 "each outer iteration, move a text row this fraction of the way to the middle "
-                 "of its neighbouring rows (evenly spaced rows; 0 = off)")
-      ->capture_default_str()->check(CLI::Range(0.0, 1.0));
+                 "each outer iteration, move a text row this fraction of the "
+                 "way to the middle of its neighbouring rows (0 = off)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
   app.add_option("--max-spacing-ratio", o.max_spacing_ratio,
-                 "--line-spacing moves a row only when its two gaps differ by at most this "
-                 "factor (a paragraph break or heading differs more)")
-      ->capture_default_str()->check(CLI::Range(1.0, 10.0));
+                 "--line-spacing moves a row only when its two gaps, and the "
+                 "page's row pitch, differ by at most this factor")
+      ->capture_default_str()
+      ->check(CLI::Range(1.0, 10.0));
   app.add_option("--solver", solver, "gn (Gauss-Newton/LM, sparse Cholesky) or lbfgs")
       ->capture_default_str();
   app.add_option("--linear-solver", linear,

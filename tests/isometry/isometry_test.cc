@@ -489,7 +489,9 @@ TEST(Isometry, SolveIsTheSameForAnyNumberOfThreads) {
   const MeshPair truth = CurledSheet(61, 41, 0.8, 0.6, 0.45);
   Problem p;
   p.meshes = Flattened(truth, 0.6);
-  p.points = SampleSurface(truth, 5000, 0.002 * isometry::ModelSize(truth), 0.02, 5).points;
+  p.points =
+      SampleSurface(truth, 5000, 0.002 * isometry::ModelSize(truth), 0.02, 5)
+          .points;
   SolveOptions o;
   o.max_outer_iterations = 4;
   o.num_threads = 1;
@@ -499,7 +501,8 @@ TEST(Isometry, SolveIsTheSameForAnyNumberOfThreads) {
   EXPECT_EQ(one.report.method, "gauss-newton/cg");
   ASSERT_EQ(one.report.iterations.size(), two.report.iterations.size());
   for (size_t i = 0; i < one.report.iterations.size(); ++i)
-    EXPECT_EQ(one.report.iterations[i].F, two.report.iterations[i].F) << "iteration " << i;
+    EXPECT_EQ(one.report.iterations[i].F, two.report.iterations[i].F)
+        << "iteration " << i;
   EXPECT_TRUE(one.meshes.mesh3d == two.meshes.mesh3d);
   EXPECT_TRUE(one.meshes.mesh2d == two.meshes.mesh2d);
 }
@@ -519,7 +522,8 @@ Problem ThreeTextRows(const std::vector<double>& rows, bool text) {
     line.text_row = text;
     p.lines.push_back(line);
     for (int k = 0; k <= 30; ++k) {
-      const auto where = locator.Locate(Eigen::Vector2d(0.1 + 0.02 * k, rows[l]));
+      const auto where =
+          locator.Locate(Eigen::Vector2d(0.1 + 0.02 * k, rows[l]));
       if (!where) continue;
       isometry::Marker m;
       m.where = *where;
@@ -548,11 +552,14 @@ TEST(Isometry, TextRowsMoveTowardTheMiddleOfTheirNeighbours) {
   // Off, not text, or gaps too different (0.07 and 0.13: a paragraph
   // break): the rows stay where the rays hold them.
   o.line_spacing = 0;
-  EXPECT_NEAR(isometry::Solve(ThreeTextRows({0.1, 0.19, 0.3}, true), o).lines[1].offset, 0.19,
-              0.001);
+  EXPECT_NEAR(
+      isometry::Solve(ThreeTextRows({0.1, 0.19, 0.3}, true), o).lines[1].offset,
+      0.19, 0.001);
   o.line_spacing = 1;
-  EXPECT_NEAR(isometry::Solve(ThreeTextRows({0.1, 0.19, 0.3}, false), o).lines[1].offset, 0.19,
-              0.001);
+  EXPECT_NEAR(isometry::Solve(ThreeTextRows({0.1, 0.19, 0.3}, false), o)
+                  .lines[1]
+                  .offset,
+              0.19, 0.001);
   const auto uneven = isometry::Solve(ThreeTextRows({0.1, 0.17, 0.3}, true), o);
   EXPECT_EQ(uneven.report.iterations.front().spaced_rows, 0);
   EXPECT_NEAR(uneven.lines[1].offset, 0.17, 0.001);
