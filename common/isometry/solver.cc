@@ -371,20 +371,26 @@ void FitLines(State& s, const StepData& data) {
 
 // SolveOptions::line_spacing: each text row whose nearest parallel rows on
 // both sides overlap it along its length, with gaps within max_ratio of each
-// other, moves `strength` of the way to their middle (all from the offsets
-// as fitted). Returns how many rows moved.
+// other and of the page's row pitch, moves `strength` of the way to their
+// middle (all from the offsets as fitted). Returns how many rows moved.
 int EvenTextRowSpacing(State& s, const StepData& data, double strength,
                        double max_ratio) {
   const int n = int(s.lines.size());
   constexpr double kInf = std::numeric_limits<double>::infinity();
   std::vector<double> lo(n, kInf), hi(n, -kInf);
   std::vector<int> count(n, 0);
-  // Lines are axis-aligned: vertical_axis[l] says whether the normal is ±y
-  // (a horizontal row); position along the row is then x.
+  // Lines are axis-aligned: one whose normal is ±y runs along x.
+  auto horizontal = [&](int l) {
+    const Eigen::Vector2d nrm = s.lines[l].Normal();
+    return std::abs(nrm.y()) > std::abs(nrm.x());
+  };
   auto along = [&](int l, const Eigen::Vector2d& p) {
-    return std::abs(s.lines[l].Normal().y()) > std::abs(s.lines[l].Normal().x())
-               ? p.x()
-               : p.y();
+    return horizontal(l) ? p.x() : p.y();
+  };
+  // The sign that turns the normal into +x or +y.
+  auto sign = [&](int l) {
+    const Eigen::Vector2d nrm = s.lines[l].Normal();
+    return horizontal(l) ? nrm.y() : nrm.x();
   };
   for (const Marker& m : data.markers) {
     if (m.line < 0) continue;
@@ -394,15 +400,7 @@ int EvenTextRowSpacing(State& s, const StepData& data, double strength,
     ++count[m.line];
   }
   // Offset along the positive axis (x or y), whatever the normal's sign.
-  auto axis_offset = [&](int l) {
-    const Eigen::Vector2d nrm = s.lines[l].Normal();
-    return s.lines[l].offset *
-           (std::abs(nrm.y()) > std::abs(nrm.x()) ? nrm.y() : nrm.x());
-  };
-  auto horizontal = [&](int l) {
-    return std::abs(s.lines[l].Normal().y()) >
-           std::abs(s.lines[l].Normal().x());
-  };
+  auto axis_offset = [&](int l) { return s.lines[l].offset * sign(l); };
   auto overlapping = [&](int a, int b) {
     const double overlap = std::min(hi[a], hi[b]) - std::max(lo[a], lo[b]);
     return overlap > 0.5 * std::min(hi[a] - lo[a], hi[b] - lo[b]);
@@ -414,8 +412,7 @@ int EvenTextRowSpacing(State& s, const StepData& data, double strength,
       rows.push_back(l);
   // Nearest parallel, overlapping rows on either side of each row.
   std::vector<int> below(n, -1), above(n, -1);
-  std::vector<double>
-      nearest;  // per row: its smaller gap, for the typical pitch
+  std::vector<double> nearest;  // per row: its smaller gap, for the pitch
   for (const int b : rows) {
     const double cb = axis_offset(b);
     double ca = -kInf, cc = kInf;
@@ -449,10 +446,7 @@ int EvenTextRowSpacing(State& s, const StepData& data, double strength,
   int moved = 0;
   for (const int b : rows) {
     if (!std::isfinite(target[b])) continue;
-    const Eigen::Vector2d nrm = s.lines[b].Normal();
-    const double sign =
-        std::abs(nrm.y()) > std::abs(nrm.x()) ? nrm.y() : nrm.x();
-    s.lines[b].offset = target[b] * sign;
+    s.lines[b].offset = target[b] * sign(b);
     ++moved;
   }
   return moved;
