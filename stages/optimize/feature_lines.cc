@@ -9,6 +9,8 @@
 #include <Eigen/Eigenvalues>
 #include <nanoflann.hpp>
 
+#include "common/statistics.h"
+
 namespace docunfold::optimize {
 namespace {
 
@@ -341,6 +343,64 @@ std::vector<isometry::FeatureLine> AssignLines(const MeshPair& meshes, const Gro
     lines[l].text_row = grouping.line_kind[l] == "text";
   }
   return lines;
+}
+
+int DropSideOutliers(const MeshPair& meshes, const Grouping& grouping, double tolerance,
+                     MarkerSet* markers) {
+  const int n = int(grouping.line_kind.size());
+  double diagonal = 0;
+  {
+    Eigen::Vector2d lo = meshes.mesh2d.front(), hi = lo;
+    for (const auto& p : meshes.mesh2d) {
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+    }
+    diagonal = (hi - lo).norm();
+  }
+  std::vector<std::vector<int>> of_line(n);
+  for (size_t i = 0; i < markers->markers.size(); ++i) {
+    const int l = markers->markers[i].line;
+    if (l >= 0 && grouping.line_kind[l] == "boundary") of_line[l].push_back(int(i));
+  }
+  int dropped = 0;
+  for (int l = 0; l < n; ++l) {
+    std::vector<int> kept = of_line[l];
+    // Twice: the first fit is pulled toward the outliers.
+    for (int pass = 0; pass < 2 && kept.size() >= 3; ++pass) {
+      Cluster c;
+      for (const int i : kept) c.points.push_back(PointOnMesh2d(meshes, markers->markers[i].where));
+      c.Update();
+      const Eigen::Vector2d normal(-c.direction.y(), c.direction.x());
+      // Beyond the tolerance and beyond the side's own scatter about its
+      // fitted line (4 sigma, robustly estimated): a side that scatters
+      // evenly keeps its markers, and so does a long run off the line, which
+      // the fit leans toward (a notch is short; a whole flap is not this
+      // function's to judge).
+      std::vector<double> residual;
+      for (const auto& p : c.points) residual.push_back(std::abs((p - c.centre).dot(normal)));
+      const double limit = std::max(tolerance * diagonal, 4 * 1.4826 * Median(residual));
+      // Only inside the side: toward its corners M is least certain, and
+      // there the line is what holds the page's edge straight.
+      const double end = 0.1 * c.Width();
+      std::vector<int> next;
+      for (size_t k = 0; k < kept.size(); ++k) {
+        const double t = (c.points[k] - c.centre).dot(c.direction);
+        if (residual[k] <= limit || t < c.t_min + end || t > c.t_max - end)
+          next.push_back(kept[k]);
+      }
+      if (next.size() < 3) break;
+      kept = std::move(next);
+    }
+    if (kept.size() == of_line[l].size()) continue;
+    std::vector<char> keep(markers->markers.size(), 0);
+    for (const int i : kept) keep[size_t(i)] = 1;
+    for (const int i : of_line[l])
+      if (!keep[size_t(i)]) {
+        markers->markers[i].line = -1;
+        ++dropped;
+      }
+  }
+  return dropped;
 }
 
 }  // namespace docunfold::optimize

@@ -98,4 +98,11 @@ std::vector<isometry::FeatureLine> AssignLines(const MeshPair& meshes, const Gro
                                                MarkerSet* markers,
                                                AxisLines axis_lines = AxisLines::kNone);
 
+// Markers of a real page side farther than `tolerance` (fraction of the
+// diagonal of M') from the line through the side's other markers lose their
+// line (a fold or a flap, not the page's edge, made that part of the
+// outline). Returns how many were dropped.
+int DropSideOutliers(const MeshPair& meshes, const Grouping& grouping, double tolerance,
+                     MarkerSet* markers);
+
 }  // namespace docunfold::optimize

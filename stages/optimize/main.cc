@@ -65,6 +65,12 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   AddFairnessBoostOptions(app, &o.unsupported_fairness, &o.support_radius);
   AddIsoEdgesOption(app, &o.iso_edges);
+  app.add_option("--side-outliers", o.side_outliers,
+                 "take samples inside a real page side off it when farther "
+                 "than this fraction of M's diagonal, and 4 sigma of the "
+                 "side's scatter, from its line (0 = keep all)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
   app.add_option("--line-spacing", o.line_spacing,
                  "each outer iteration, move a text row this fraction of the "
                  "way to the middle of its neighbouring rows (0 = off)")
@@ -162,6 +168,7 @@ int main(int argc, char** argv) {
                                {"unsupported_fairness", o.unsupported_fairness},
                                {"support_radius", o.support_radius},
                                {"iso_edges", o.iso_edges},
+                               {"side_outliers", o.side_outliers},
                                {"line_spacing", o.line_spacing},
                                {"max_spacing_ratio", o.max_spacing_ratio},
                                {"features", o.features},

@@ -140,6 +140,9 @@ OptimizeResult Run(const OptimizeInputs& in, const OptimizeOptions& o) {
         current = CastMarkers(*c.meshes, in.reference, segments, o.cast);
         grouping = GroupSegments(*c.meshes, current, segments, o.grouping);
         *c.lines = AssignLines(*c.meshes, grouping, &current, o.axis_lines);
+        if (o.side_outliers > 0)
+          round.side_markers_dropped =
+              DropSideOutliers(*c.meshes, grouping, o.side_outliers, &current);
         c.markers->clear();
         kept.clear();
         for (size_t i = 0; i < current.markers.size(); ++i)
@@ -171,11 +174,12 @@ OptimizeResult Run(const OptimizeInputs& in, const OptimizeOptions& o) {
     const auto& last = solved.report.iterations.back();
     char buf[256];
     std::snprintf(buf, sizeof buf,
-                  "round %d: %dx%d grid, %zu iterations (%s), F %.4g, %d lines, %d markers, "
-                  "%d/%d points inside, %.1f s",
+                  "round %d: %dx%d grid, %zu iterations (%s), F %.4g, %d lines, %d markers "
+                  "(%d side markers off their side), %d/%d points inside, %.1f s",
                   r, meshes.grid.nx, meshes.grid.ny, solved.report.iterations.size(),
                   solved.report.stop_reason.c_str(), last.F, last.lines, last.markers,
-                  last.inliers, last.inliers + last.outliers, solved.report.seconds);
+                  round.side_markers_dropped, last.inliers, last.inliers + last.outliers,
+                  solved.report.seconds);
     Log(buf);
     result.rounds.push_back(std::move(round));
   }

@@ -105,6 +105,7 @@ Json LogJson(const OptimizeResult& result, const Json& options_json) {
                              {"stop_reason", r.report.stop_reason},
                              {"solver", solver},
                              {"lines", r.lines.size()},
+                             {"side_markers_dropped", r.side_markers_dropped},
                              {"iterations", iterations}});
   }
   return doc;

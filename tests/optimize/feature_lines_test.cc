@@ -84,3 +84,52 @@ TEST(CastMarkers, OutlineSamplesNearACornerKeepToTheirOwnSide) {
 
 }  // namespace
 }  // namespace docunfold::optimize
+
+namespace docunfold::optimize {
+namespace {
+
+// A real left side 5 px inside the sheet's border, with `bumps`: runs of
+// samples pushed 12 px into the page (a fold's notch in the outline).
+MarkerSet SideWithBumps(const Scene& scene, const std::vector<std::pair<int, int>>& bumps,
+                        Grouping* grouping) {
+  Segment side;
+  side.kind = "boundary";
+  side.side = 3;
+  for (int y = 260; y <= 540; y += 4) {
+    bool bumped = false;
+    for (const auto& [from, to] : bumps) bumped = bumped || (y >= from && y <= to);
+    side.pixels.emplace_back(bumped ? 317 : 305, y);
+  }
+  MarkerSet set = CastMarkers(scene.meshes, scene.camera, {side});
+  grouping->line_of_segment = {0};
+  grouping->line_kind = {"boundary"};
+  grouping->line_side = {3};
+  grouping->line_segments = {1};
+  AssignLines(scene.meshes, *grouping, &set, AxisLines::kAll);
+  return set;
+}
+
+TEST(DropSideOutliers, ANotchInsideTheSideLosesItsLineItsEndsDoNot) {
+  const Scene scene;
+  Grouping grouping;
+  // Middle: 5 samples (392..408) off the side; near the start (within a
+  // tenth of the side's length) 3 samples (264..272) that stay.
+  MarkerSet set = SideWithBumps(scene, {{392, 408}, {264, 272}}, &grouping);
+  ASSERT_EQ(set.markers.size(), 71u);
+  EXPECT_EQ(DropSideOutliers(scene.meshes, grouping, 0.005, &set), 5);
+  for (size_t i = 0; i < set.markers.size(); ++i) {
+    const double y = set.pixel[i].y();
+    EXPECT_EQ(set.markers[i].line, y >= 392 && y <= 408 ? -1 : 0) << "y " << y;
+  }
+  // A straight side keeps every marker; so does a notch within tolerance,
+  // and a long run off the line (a third of the side: no notch).
+  MarkerSet straight = SideWithBumps(scene, {}, &grouping);
+  EXPECT_EQ(DropSideOutliers(scene.meshes, grouping, 0.005, &straight), 0);
+  MarkerSet notched = SideWithBumps(scene, {{392, 408}}, &grouping);
+  EXPECT_EQ(DropSideOutliers(scene.meshes, grouping, 0.05, &notched), 0);
+  MarkerSet long_run = SideWithBumps(scene, {{360, 452}}, &grouping);
+  EXPECT_EQ(DropSideOutliers(scene.meshes, grouping, 0.005, &long_run), 0);
+}
+
+}  // namespace
+}  // namespace docunfold::optimize
