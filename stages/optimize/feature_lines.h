@@ -98,10 +98,11 @@ std::vector<isometry::FeatureLine> AssignLines(const MeshPair& meshes, const Gro
                                                MarkerSet* markers,
                                                AxisLines axis_lines = AxisLines::kNone);
 
-// Markers of a real page side farther than `tolerance` (fraction of the
-// diagonal of M') from the line through the side's other markers lose their
-// line (a fold or a flap, not the page's edge, made that part of the
-// outline). Returns how many were dropped.
+// Markers inside a real page side (not in its last tenth at either end)
+// farther than `tolerance` (fraction of the diagonal of M') and 4 robust
+// sigma of the side's scatter from the side's fitted line lose their line:
+// a fold's notch, not the page's edge, made that part of the outline.
+// Returns how many were dropped.
 int DropSideOutliers(const MeshPair& meshes, const Grouping& grouping, double tolerance,
                      MarkerSet* markers);
 
