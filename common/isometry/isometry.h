@@ -193,7 +193,8 @@ struct SolveOptions {
   // them, and a fold M does not open far enough (no points on a panel seen
   // obliquely) squeezes the rows there. After the lines are fitted, each
   // text row with a parallel, overlapping neighbouring row on both sides
-  // whose two gaps differ by at most max_spacing_ratio is moved this
+  // whose two gaps differ by at most max_spacing_ratio from each other and
+  // from the page's typical row pitch (median nearest gap) is moved this
   // fraction of the way to the middle of its neighbours (before the markers
   // are projected, so E_ray then carries the spacing to M). 0 = off.
   double line_spacing = 0;

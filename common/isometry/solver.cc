@@ -25,6 +25,7 @@
 #include "common/isometry/isometry.h"
 #include "common/isometry/mesh_index.h"
 #include "common/isometry/residuals.h"
+#include "common/statistics.h"
 
 namespace docunfold::isometry {
 
@@ -427,11 +428,9 @@ int EvenTextRowSpacing(State& s, const StepData& data, double strength,
     if (std::isfinite(g)) nearest.push_back(g);
   }
   if (nearest.empty()) return 0;
-  std::nth_element(nearest.begin(), nearest.begin() + nearest.size() / 2,
-                   nearest.end());
   // The page's row pitch: rows farther apart than max_ratio of it are no
   // consecutive rows (a sparse table column, a paragraph break).
-  const double pitch = nearest[nearest.size() / 2];
+  const double pitch = Median(nearest);
   std::vector<double> target(n, kInf);
   for (const int b : rows) {
     if (below[b] < 0 || above[b] < 0) continue;

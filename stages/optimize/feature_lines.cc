@@ -16,6 +16,13 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
+// Diagonal of M''s bounding box: the unit of the grouping tolerances.
+double FlatDiagonal(const MeshPair& meshes) {
+  Eigen::Vector2d lo = meshes.mesh2d[0], hi = lo;
+  for (const auto& v : meshes.mesh2d) { lo = lo.cwiseMin(v); hi = hi.cwiseMax(v); }
+  return (hi - lo).norm();
+}
+
 // A candidate line in M': its points and principal axes.
 struct Cluster {
   std::string kind;
@@ -189,9 +196,7 @@ MarkerSet CastMarkers(const MeshPair& meshes, const PinholeCamera& reference,
 
 Grouping GroupSegments(const MeshPair& meshes, const MarkerSet& markers,
                        const std::vector<Segment>& segments, const GroupingOptions& o) {
-  Eigen::Vector2d lo = meshes.mesh2d[0], hi = lo;
-  for (const auto& v : meshes.mesh2d) { lo = lo.cwiseMin(v); hi = hi.cwiseMax(v); }
-  const double diag = (hi - lo).norm();
+  const double diag = FlatDiagonal(meshes);
   const double gap = o.gap * diag, offset = o.offset * diag;
 
   std::vector<std::vector<Eigen::Vector2d>> points(segments.size());
@@ -348,15 +353,7 @@ std::vector<isometry::FeatureLine> AssignLines(const MeshPair& meshes, const Gro
 int DropSideOutliers(const MeshPair& meshes, const Grouping& grouping, double tolerance,
                      MarkerSet* markers) {
   const int n = int(grouping.line_kind.size());
-  double diagonal = 0;
-  {
-    Eigen::Vector2d lo = meshes.mesh2d.front(), hi = lo;
-    for (const auto& p : meshes.mesh2d) {
-      lo = lo.cwiseMin(p);
-      hi = hi.cwiseMax(p);
-    }
-    diagonal = (hi - lo).norm();
-  }
+  const double diagonal = FlatDiagonal(meshes);
   std::vector<std::vector<int>> of_line(n);
   for (size_t i = 0; i < markers->markers.size(); ++i) {
     const int l = markers->markers[i].line;

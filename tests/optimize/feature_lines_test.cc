@@ -82,12 +82,6 @@ TEST(CastMarkers, OutlineSamplesNearACornerKeepToTheirOwnSide) {
     EXPECT_NEAR(PointOnMesh2d(scene.meshes, m.where).x(), -0.5, 1e-9);
 }
 
-}  // namespace
-}  // namespace docunfold::optimize
-
-namespace docunfold::optimize {
-namespace {
-
 // A real left side 5 px inside the sheet's border, with `bumps`: runs of
 // samples pushed 12 px into the page (a fold's notch in the outline).
 MarkerSet SideWithBumps(const Scene& scene, const std::vector<std::pair<int, int>>& bumps,
