@@ -2,55 +2,75 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
+#include <limits>
 #include <tuple>
 
 namespace docunfold {
 
 DepthField::DepthField(std::vector<Eigen::Vector2d> pixels,
                        std::vector<double> depths, int k, double scale,
-                       DepthModel model, int planar_k)
+                       DepthModel model, int planar_k, double planar_guard)
     : pixels_(std::move(pixels)),
       depths_(std::move(depths)),
       k_(k),
       scale_(scale),
       model_(model),
       planar_k_(planar_k),
+      planar_guard_(planar_guard),
       index_(std::make_unique<PointIndex2d>(pixels_)) {}
 
 DepthField::~DepthField() = default;
 
 double DepthField::At(const Eigen::Vector2d& px) const {
-  const int want = model_ == DepthModel::kPlanar ? std::max(k_, planar_k_) : k_;
-  const std::vector<std::pair<int, double>> nearest = index_->Nearest(px, want);
-  const size_t found = nearest.size();
-  std::vector<int> idx(found);
-  std::vector<double> d2(found);
-  for (size_t i = 0; i < found; ++i) std::tie(idx[i], d2[i]) = nearest[i];
-  auto weight = [&](size_t i) { return 1 / (1 + d2[i] / (scale_ * scale_)); };
+  const bool planar = model_ == DepthModel::kPlanar;
+  const int fit_k = planar_guard_ > 0 ? 2 * planar_k_ : planar_k_;
+  const std::vector<std::pair<int, double>> nearest =
+      index_->Nearest(px, planar ? std::max(k_, fit_k) : k_);
   double sw = 0, sz = 0;
-  for (size_t i = 0; i < std::min<size_t>(found, size_t(k_)); ++i) {
-    sw += weight(i);
-    sz += weight(i) * depths_[idx[i]];
+  for (size_t i = 0; i < std::min<size_t>(nearest.size(), size_t(k_)); ++i) {
+    const double weight = 1 / (1 + nearest[i].second / (scale_ * scale_));
+    sw += weight;
+    sz += weight * depths_[nearest[i].first];
   }
   const double average = sz / sw;
-  if (model_ != DepthModel::kPlanar || found < 6) return average;
+  if (!planar) return average;
+  double inv = PlanarInverseDepth(
+      px, nearest, std::min<size_t>(nearest.size(), size_t(planar_k_)));
+  if (planar_guard_ > 0 && nearest.size() > size_t(planar_k_)) {
+    const double wide = PlanarInverseDepth(
+        px, nearest, std::min<size_t>(nearest.size(), size_t(fit_k)));
+    // Compared as depths: |1/inv - 1/wide| > guard / wide.
+    if (std::isfinite(wide) &&
+        (!std::isfinite(inv) || std::abs(wide / inv - 1) > planar_guard_))
+      inv = wide;
+  }
+  return std::isfinite(inv) ? 1 / inv : average;
+}
+
+double DepthField::PlanarInverseDepth(
+    const Eigen::Vector2d& px,
+    const std::vector<std::pair<int, double>>& nearest, size_t n) const {
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  if (n < 6) return kNaN;
   // 1/z = c + a·du + b·dv around px (weighted normal equations). The
   // weights' unit is at least the farthest neighbour's distance: with the
   // points' spacing as unit (often ~1 px where text is dense) the nearest
   // two or three would decide the slope alone and extrapolate it wildly.
-  const double unit2 = std::max(scale_ * scale_, d2[found - 1]);
-  auto planar_weight = [&](size_t i) { return 1 / (1 + d2[i] / unit2); };
+  const double unit2 = std::max(scale_ * scale_, nearest[n - 1].second);
   const double unit = std::sqrt(unit2);
   Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
   Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
   double lo = 1e300, hi = 0;
-  for (size_t i = 0; i < found; ++i) {
-    const Eigen::Vector2d d = (pixels_[idx[i]] - px) / unit;
+  for (size_t i = 0; i < n; ++i) {
+    const auto& [index, d2] = nearest[i];
+    const double weight = 1 / (1 + d2 / unit2);
+    const Eigen::Vector2d d = (pixels_[index] - px) / unit;
     const Eigen::Vector3d row(1, d.x(), d.y());
-    const double inv = 1 / depths_[idx[i]];
-    A += planar_weight(i) * row * row.transpose();
-    rhs += planar_weight(i) * inv * row;
+    const double inv = 1 / depths_[index];
+    A += weight * row * row.transpose();
+    rhs += weight * inv * row;
     lo = std::min(lo, inv);
     hi = std::max(hi, inv);
   }
@@ -60,15 +80,14 @@ double DepthField::At(const Eigen::Vector2d& px) const {
   const Eigen::Matrix2d covariance =
       A.bottomRightCorner<2, 2>() / A(0, 0) - mean * mean.transpose();
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> spread(covariance);
-  if (!(spread.eigenvalues()(0) >= 1e-2 * spread.eigenvalues()(1)))
-    return average;
+  if (!(spread.eigenvalues()(0) >= 1e-2 * spread.eigenvalues()(1))) return kNaN;
   const double inv = A.ldlt().solve(rhs)(0);
   // Far from every point a slope would run away: stay within the
   // neighbours' range (measured on set08, whose page leaves the picture:
   // widening it by half on each side put M 14 % of the diagonal off the
   // true surface where the border cuts the page, 5 % without).
-  if (!(inv > 0)) return average;
-  return 1 / std::clamp(inv, lo, hi);
+  if (!(inv > 0)) return kNaN;
+  return std::clamp(inv, lo, hi);
 }
 
 }  // namespace docunfold
