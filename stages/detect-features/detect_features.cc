@@ -52,7 +52,9 @@ Json FeaturesOptions::ToJson() const {
               {"max_gap", max_gap},
               {"min_text_length", min_text_length},
               {"min_length_px", min_length_px},
-              {"step_edges", step_edges}};
+              {"step_edges", step_edges},
+              {"join_gap", join_gap},
+              {"lsd_upscale", lsd_upscale}};
 }
 
 FeaturesResult DetectFeatures(const cv::Mat& image, const cv::Mat& mask_in,

@@ -46,6 +46,14 @@ struct FeaturesOptions {
   // Edge: keep single step edges too (not only the centre lines of thin dark
   // lines).
   bool step_edges = false;
+  // Edge: LSD pieces of one straight edge separated by up to this many
+  // pixels (or half a text height if larger) are joined first: a table's
+  // column rules are cut at every row rule. 0 = off.
+  double join_gap = 6.0;
+  // Edge: LSD runs on the document region enlarged this many times; 0 =
+  // automatic: 2 when the text is under 12 px high and the region's box
+  // under 4 megapixels, else 1.
+  double lsd_upscale = 0;
   // Log each step and its time.
   bool verbose = false;
 

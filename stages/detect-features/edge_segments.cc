@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
-
 #include <opencv2/imgproc.hpp>
 
 #include "common/cli.h"
@@ -36,11 +35,15 @@ bool ClipToRegion(const cv::Mat1b& region, cv::Point2d* a, cv::Point2d* b) {
     if (k <= steps) {
       const cv::Point2d p = *a + (*b - *a) * (double(k) / steps);
       const int x = int(std::lround(p.x)), y = int(std::lround(p.y));
-      inside = x >= 0 && y >= 0 && x < region.cols && y < region.rows && region(y, x);
+      inside = x >= 0 && y >= 0 && x < region.cols && y < region.rows &&
+               region(y, x);
     }
     if (inside && first < 0) first = k;
     if (!inside && first >= 0) {
-      if (k - 1 - first > best_last - best_first) { best_first = first; best_last = k - 1; }
+      if (k - 1 - first > best_last - best_first) {
+        best_first = first;
+        best_last = k - 1;
+      }
       first = -1;
     }
   }
@@ -52,19 +55,107 @@ bool ClipToRegion(const cv::Mat1b& region, cv::Point2d* a, cv::Point2d* b) {
   return true;
 }
 
+// A centre line found between two LSD edges.
+struct Piece {
+  cv::Point2d a, b;
+  bool joined = false;  // taken into another piece
+  std::vector<std::pair<cv::Point2d, cv::Point2d>>
+      parts;  // as found, when joined
+};
+
+// LSD ends an edge wherever another line crosses it, so a table's column
+// rules come out as pieces one row high, each too short to keep. Joins the
+// centre lines of pieces of one straight rule (parallel within 2 degrees,
+// every end within `max_offset` px of the joined line) across gaps up to
+// `max_gap` px. A curved rule stays in pieces that are straight.
+std::vector<Piece> JoinCollinear(std::vector<Piece> pieces, double max_gap,
+                                 double max_offset) {
+  const double max_sin = std::sin(2.0 * CV_PI / 180);
+  auto offset = [](const cv::Point2d& a, const cv::Point2d& b,
+                   const cv::Point2d& p) {
+    const cv::Point2d d = b - a;
+    return std::abs(d.x * (p.y - a.y) - d.y * (p.x - a.x)) / cv::norm(d);
+  };
+  for (bool joined = true; joined;) {
+    joined = false;
+    for (size_t i = 0; i < pieces.size(); ++i) {
+      Piece& s = pieces[i];
+      if (s.joined) continue;
+      for (size_t j = 0; j < pieces.size(); ++j) {
+        const Piece& t = pieces[j];
+        if (j == i || t.joined) continue;
+        const double length = cv::norm(s.b - s.a);
+        const cv::Point2d dir = (s.b - s.a) * (1.0 / length);
+        const cv::Point2d t_dir = (t.b - t.a) * (1.0 / cv::norm(t.b - t.a));
+        if (std::abs(dir.x * t_dir.y - dir.y * t_dir.x) > max_sin) continue;
+        if (offset(s.a, s.b, t.a) > max_offset ||
+            offset(s.a, s.b, t.b) > max_offset)
+          continue;
+        const double ua = (t.a - s.a).dot(dir), ub = (t.b - s.a).dot(dir);
+        const double u0 = std::min(ua, ub), u1 = std::max(ua, ub);
+        if (std::max(u0 - length, -u1) > max_gap) continue;
+        // The joined piece runs between the outermost ends.
+        const cv::Point2d a = u0 < 0 ? (ua < ub ? t.a : t.b) : s.a;
+        const cv::Point2d b = u1 > length ? (ua > ub ? t.a : t.b) : s.b;
+        if (cv::norm(b - a) < length) continue;
+        if (offset(a, b, s.a) > max_offset || offset(a, b, s.b) > max_offset ||
+            offset(a, b, t.a) > max_offset || offset(a, b, t.b) > max_offset)
+          continue;
+        if (s.parts.empty()) s.parts.push_back({s.a, s.b});
+        if (t.parts.empty()) s.parts.push_back({t.a, t.b});
+        s.parts.insert(s.parts.end(), t.parts.begin(), t.parts.end());
+        s.a = a;
+        s.b = b;
+        pieces[j].joined = true;
+        joined = true;
+      }
+    }
+  }
+  std::vector<Piece> kept;
+  for (const Piece& p : pieces)
+    if (!p.joined) kept.push_back(p);
+  return kept;
+}
+
 }  // namespace
 
-std::vector<Segment> DetectEdgeSegments(const cv::Mat1b& grey, const cv::Mat1b& ink,
+std::vector<Segment> DetectEdgeSegments(const cv::Mat1b& grey,
+                                        const cv::Mat1b& ink,
                                         const InkComponents& components,
-                                        const TextResult& text, const cv::Mat1b& region,
+                                        const TextResult& text,
+                                        const cv::Mat1b& region,
                                         const FeaturesOptions& options) {
   std::vector<cv::Vec4f> lines;
-  cv::Ptr<cv::LineSegmentDetector> lsd = cv::createLineSegmentDetector(cv::LSD_REFINE_STD);
-  lsd->detect(grey, lines);
+  cv::Ptr<cv::LineSegmentDetector> lsd =
+      cv::createLineSegmentDetector(cv::LSD_REFINE_STD);
+  // LSD smooths before it looks for gradients, which wipes out rules one
+  // pixel wide (a table's column rules, seen obliquely): with small text it
+  // runs on the region's box enlarged.
+  const cv::Rect box =
+      cv::boundingRect(region) & cv::Rect(0, 0, grey.cols, grey.rows);
+  double upscale = options.lsd_upscale;
+  if (upscale <= 0)
+    upscale = text.height > 0 && text.height < 12 && box.area() <= 4e6 ? 2 : 1;
+  if (upscale > 1 && !box.empty()) {
+    cv::Mat1b enlarged;
+    cv::resize(grey(box), enlarged, cv::Size(), upscale, upscale,
+               cv::INTER_CUBIC);
+    lsd->detect(enlarged, lines);
+    for (cv::Vec4f& l : lines)
+      for (int k = 0; k < 4; k += 2) {
+        // Pixel centres: enlarged u is at (u + 0.5) / upscale - 0.5.
+        l[k] = float((l[k] + 0.5) / upscale - 0.5 + box.x);
+        l[k + 1] = float((l[k + 1] + 0.5) / upscale - 0.5 + box.y);
+      }
+  } else {
+    lsd->detect(grey, lines);
+  }
   // Character strokes are shorter than a few text heights.
-  const double min_length =
-      std::max(options.min_length_px, text.height > 0 ? 3.0 * text.height : 0.0);
+  const double min_length = std::max(options.min_length_px,
+                                     text.height > 0 ? 3.0 * text.height : 0.0);
   const double max_width = std::max(4.0, 0.6 * text.height);
+  // Pieces shorter than this are pixel noise even where a gap is bridged.
+  constexpr double kShortestPiece = 4.0;
   std::vector<Edge> edges;
   for (const cv::Vec4f& l : lines) {
     Edge e;
@@ -72,7 +163,7 @@ std::vector<Segment> DetectEdgeSegments(const cv::Mat1b& grey, const cv::Mat1b& 
     e.b = {l[2], l[3]};
     if (!ClipToRegion(region, &e.a, &e.b)) continue;
     e.length = cv::norm(e.b - e.a);
-    if (e.length < min_length) continue;
+    if (e.length < kShortestPiece) continue;
     e.dir = (e.b - e.a) * (1.0 / e.length);
     e.normal = {-e.dir.y, e.dir.x};
     // Which side is darker, a little off the middle of the edge.
@@ -90,9 +181,11 @@ std::vector<Segment> DetectEdgeSegments(const cv::Mat1b& grey, const cv::Mat1b& 
             [](const Edge& p, const Edge& q) { return p.length > q.length; });
 
   std::vector<Segment> out;
+  std::vector<Piece> pieces;
   // The ink a line runs along: none (a faint rule), or one component that
   // is not a character and is line-like (long and thin, or a large grid).
-  auto along_printed_line = [&](const cv::Point2d& a, const cv::Point2d& b, double length) {
+  auto along_printed_line = [&](const cv::Point2d& a, const cv::Point2d& b,
+                                double length) {
     std::map<int, int> votes;
     const int steps = std::max(2, int(length / 3.0));
     for (int k = 0; k <= steps; ++k) {
@@ -102,18 +195,23 @@ std::vector<Segment> DetectEdgeSegments(const cv::Mat1b& grey, const cv::Mat1b& 
       for (int dy = -1; dy <= 1 && !label; ++dy)
         for (int dx = -1; dx <= 1 && !label; ++dx) {
           const int xx = x + dx, yy = y + dy;
-          if (xx >= 0 && yy >= 0 && xx < ink.cols && yy < ink.rows && ink(yy, xx))
+          if (xx >= 0 && yy >= 0 && xx < ink.cols && yy < ink.rows &&
+              ink(yy, xx))
             label = components.labels(yy, xx);
         }
       ++votes[label];
     }
     int best = 0, best_votes = 0;
     for (auto [label, n] : votes)
-      if (n > best_votes) { best = label; best_votes = n; }
+      if (n > best_votes) {
+        best = label;
+        best_votes = n;
+      }
     // A faint rule may be too light to count as ink; text never is.
     if (best == 0) return true;
     if (best_votes < 0.8 * (steps + 1)) return false;
-    if (best < int(text.is_character.size()) && text.is_character[size_t(best)]) return false;
+    if (best < int(text.is_character.size()) && text.is_character[size_t(best)])
+      return false;
     // Longer than the line found (a grid, a frame), or thin: for a line of
     // length L and width w the box's diagonal is about L and the area L w,
     // so diagonal^2 / area is about L / w, whatever the line's slant.
@@ -125,57 +223,100 @@ std::vector<Segment> DetectEdgeSegments(const cv::Mat1b& grey, const cv::Mat1b& 
   };
 
   int paired = 0, rejected = 0;
-  for (size_t i = 0; i < edges.size(); ++i) {
-    Edge& s = edges[i];
-    if (s.used) continue;
-    // Its partner: the other side of the same dark line, parallel, close,
-    // dark side facing this one, overlapping along it.
-    int partner = -1;
-    double best_overlap = 0;
-    for (size_t j = 0; j < edges.size(); ++j) {
-      if (j == i || edges[j].used) continue;
-      const Edge& t = edges[j];
-      if (std::abs(s.dir.x * t.dir.y - s.dir.y * t.dir.x) > std::sin(4.0 * CV_PI / 180)) continue;
-      const cv::Point2d tm = 0.5 * (t.a + t.b);
-      const double offset = (tm - s.a).dot(s.normal);  // > 0: on s's dark side
-      if (offset < 0.5 || offset > max_width) continue;
-      if (t.normal.dot(s.normal) > -0.9) continue;  // dark sides face each other
-      const double u0 = std::max(0.0, std::min((t.a - s.a).dot(s.dir), (t.b - s.a).dot(s.dir)));
-      const double u1 = std::min(s.length, std::max((t.a - s.a).dot(s.dir), (t.b - s.a).dot(s.dir)));
-      const double overlap = u1 - u0;
-      if (overlap < 0.5 * std::min(s.length, t.length)) continue;
-      if (overlap > best_overlap) { best_overlap = overlap; partner = int(j); }
-    }
-    if (partner >= 0) {
-      const Edge& t = edges[size_t(partner)];
-      const double u0 = std::max(0.0, std::min((t.a - s.a).dot(s.dir), (t.b - s.a).dot(s.dir)));
-      const double u1 = std::min(s.length, std::max((t.a - s.a).dot(s.dir), (t.b - s.a).dot(s.dir)));
-      // Centre line: halfway between s and t's line, over their overlap.
-      const cv::Point2d tn(-t.dir.y, t.dir.x);
-      auto midpoint = [&](double u) {
-        const cv::Point2d p = s.a + s.dir * u;
-        const double dist = (p - t.a).dot(tn);  // signed distance to t's line
-        return p - tn * (0.5 * dist);
-      };
-      const cv::Point2d p0 = midpoint(u0), p1 = midpoint(u1);
-      ++paired;
-      if (cv::norm(p1 - p0) >= min_length && along_printed_line(p0, p1, cv::norm(p1 - p0))) {
-        out.push_back({"edge", {p0, p1}, 0});
-        s.used = true;
-        edges[size_t(partner)].used = true;
-        continue;
+  // First the edges long enough to give a segment on their own, then (to be
+  // joined) the pieces, so that a piece never takes a long edge's partner.
+  std::vector<double> shortest{min_length};
+  if (options.join_gap > 0) shortest.push_back(kShortestPiece);
+  for (const double shortest_edge : shortest)
+    for (size_t i = 0; i < edges.size(); ++i) {
+      Edge& s = edges[i];
+      if (s.used || s.length < shortest_edge) continue;
+      // Its partner: the other side of the same dark line, parallel, close,
+      // dark side facing this one, overlapping along it.
+      int partner = -1;
+      double best_overlap = 0;
+      for (size_t j = 0; j < edges.size(); ++j) {
+        if (j == i || edges[j].used || edges[j].length < shortest_edge)
+          continue;
+        const Edge& t = edges[j];
+        if (std::abs(s.dir.x * t.dir.y - s.dir.y * t.dir.x) >
+            std::sin(4.0 * CV_PI / 180))
+          continue;
+        const cv::Point2d tm = 0.5 * (t.a + t.b);
+        const double offset =
+            (tm - s.a).dot(s.normal);  // > 0: on s's dark side
+        if (offset < 0.5 || offset > max_width) continue;
+        if (t.normal.dot(s.normal) > -0.9)
+          continue;  // dark sides face each other
+        const double u0 = std::max(
+            0.0, std::min((t.a - s.a).dot(s.dir), (t.b - s.a).dot(s.dir)));
+        const double u1 = std::min(
+            s.length, std::max((t.a - s.a).dot(s.dir), (t.b - s.a).dot(s.dir)));
+        const double overlap = u1 - u0;
+        if (overlap < 0.5 * std::min(s.length, t.length)) continue;
+        if (overlap > best_overlap) {
+          best_overlap = overlap;
+          partner = int(j);
+        }
       }
-      ++rejected;
+      if (partner >= 0) {
+        const Edge& t = edges[size_t(partner)];
+        const double u0 = std::max(
+            0.0, std::min((t.a - s.a).dot(s.dir), (t.b - s.a).dot(s.dir)));
+        const double u1 = std::min(
+            s.length, std::max((t.a - s.a).dot(s.dir), (t.b - s.a).dot(s.dir)));
+        // Centre line: halfway between s and t's line, over their overlap.
+        const cv::Point2d tn(-t.dir.y, t.dir.x);
+        auto midpoint = [&](double u) {
+          const cv::Point2d p = s.a + s.dir * u;
+          const double dist = (p - t.a).dot(tn);  // signed distance to t's line
+          return p - tn * (0.5 * dist);
+        };
+        const cv::Point2d p0 = midpoint(u0), p1 = midpoint(u1);
+        ++paired;
+        if (cv::norm(p1 - p0) >= std::max(shortest_edge, kShortestPiece) &&
+            along_printed_line(p0, p1, cv::norm(p1 - p0))) {
+          pieces.push_back({p0, p1, false, {}});
+          s.used = true;
+          edges[size_t(partner)].used = true;
+          continue;
+        }
+        ++rejected;
+      }
     }
-    if (options.step_edges) {
-      out.push_back({"edge", {s.a, s.b}, 0});
-      s.used = true;
-    }
+  if (options.step_edges)
+    for (Edge& s : edges)
+      if (!s.used && s.length >= min_length) {
+        out.push_back({"edge", {s.a, s.b}, 0});
+        s.used = true;
+      }
+  const size_t paired_pieces = pieces.size();
+  if (options.join_gap > 0) {
+    const double max_gap =
+        std::max(options.join_gap, text.height > 0 ? 0.5 * text.height : 0.0);
+    pieces = JoinCollinear(std::move(pieces), max_gap, 1.0);
   }
+  int kept_lines = 0;
+  // A joined line must run along a printed line as a whole, as its pieces
+  // do; where it does not, its pieces stand as found.
+  auto keep = [&](const cv::Point2d& a, const cv::Point2d& b) {
+    const double length = cv::norm(b - a);
+    if (length < min_length || !along_printed_line(a, b, length)) return false;
+    out.push_back({"edge", {a, b}, 0});
+    ++kept_lines;
+    return true;
+  };
+  for (const Piece& p : pieces)
+    if (!keep(p.a, p.b))
+      for (const auto& [a, b] : p.parts) keep(a, b);
   if (options.verbose)
-    Log("LSD: " + std::to_string(lines.size()) + " edges, " + std::to_string(edges.size()) +
-        " long enough inside the region, " + std::to_string(paired) + " pairs, " +
-        std::to_string(rejected) + " of them not along a printed line");
+    Log("LSD: " + std::to_string(lines.size()) + " edges, " +
+        std::to_string(edges.size()) + " inside the region, " +
+        std::to_string(paired_pieces) + " lines between them, " +
+        std::to_string(pieces.size()) + " after joining, " +
+        std::to_string(kept_lines) + " long enough; " + std::to_string(paired) +
+        " pairs, " + std::to_string(rejected) +
+        " of them not along a printed line");
   return out;
 }
 

@@ -42,6 +42,14 @@ int main(int argc, char** argv) {
       ->capture_default_str()->check(CLI::Range(0.0, 1000.0));
   app.add_option("--min-length", opt.min_length_px, "shortest segment of any kind (px)")
       ->capture_default_str()->check(CLI::Range(0.0, 10000.0));
+  app.add_option("--join-gap", opt.join_gap,
+                 "join LSD pieces of one straight edge across gaps up to this many px (or "
+                 "half a text height); 0 = off")
+      ->capture_default_str()->check(CLI::Range(0.0, 1000.0));
+  app.add_option("--lsd-upscale", opt.lsd_upscale,
+                 "run LSD on the region enlarged this many times (thin rules); 0 = 2 when "
+                 "the text is under 12 px high and the region under 4 MP, else 1")
+      ->capture_default_str()->check(CLI::Range(0.0, 4.0));
   app.add_flag("--step-edges", opt.step_edges,
                "also keep single step edges (colour fields, shading), not only thin lines");
   app.add_flag("--verbose", opt.verbose, "log each step and its time");
