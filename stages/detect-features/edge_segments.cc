@@ -222,6 +222,12 @@ std::vector<Segment> DetectEdgeSegments(const cv::Mat1b& grey,
     return diagonal >= 1.5 * length || diagonal * diagonal / area >= 10.0;
   };
 
+  // Where t lies along s: the range of s (distances from s.a) it overlaps.
+  auto overlap_along = [](const Edge& s, const Edge& t) {
+    const double ua = (t.a - s.a).dot(s.dir), ub = (t.b - s.a).dot(s.dir);
+    return std::pair(std::max(0.0, std::min(ua, ub)),
+                     std::min(s.length, std::max(ua, ub)));
+  };
   int paired = 0, rejected = 0;
   // First the edges long enough to give a segment on their own, then (to be
   // joined) the pieces, so that a piece never takes a long edge's partner.
@@ -248,10 +254,7 @@ std::vector<Segment> DetectEdgeSegments(const cv::Mat1b& grey,
         if (offset < 0.5 || offset > max_width) continue;
         if (t.normal.dot(s.normal) > -0.9)
           continue;  // dark sides face each other
-        const double u0 = std::max(
-            0.0, std::min((t.a - s.a).dot(s.dir), (t.b - s.a).dot(s.dir)));
-        const double u1 = std::min(
-            s.length, std::max((t.a - s.a).dot(s.dir), (t.b - s.a).dot(s.dir)));
+        const auto [u0, u1] = overlap_along(s, t);
         const double overlap = u1 - u0;
         if (overlap < 0.5 * std::min(s.length, t.length)) continue;
         if (overlap > best_overlap) {
@@ -261,10 +264,7 @@ std::vector<Segment> DetectEdgeSegments(const cv::Mat1b& grey,
       }
       if (partner >= 0) {
         const Edge& t = edges[size_t(partner)];
-        const double u0 = std::max(
-            0.0, std::min((t.a - s.a).dot(s.dir), (t.b - s.a).dot(s.dir)));
-        const double u1 = std::min(
-            s.length, std::max((t.a - s.a).dot(s.dir), (t.b - s.a).dot(s.dir)));
+        const auto [u0, u1] = overlap_along(s, t);
         // Centre line: halfway between s and t's line, over their overlap.
         const cv::Point2d tn(-t.dir.y, t.dir.x);
         auto midpoint = [&](double u) {
@@ -297,18 +297,19 @@ std::vector<Segment> DetectEdgeSegments(const cv::Mat1b& grey,
     pieces = JoinCollinear(std::move(pieces), max_gap, 1.0);
   }
   int kept_lines = 0;
-  // A joined line must run along a printed line as a whole, as its pieces
-  // do; where it does not, its pieces stand as found.
-  auto keep = [&](const cv::Point2d& a, const cv::Point2d& b) {
+  // Every piece ran along a printed line when it was paired; a joined line
+  // must do so as a whole, and where it does not, its pieces stand as found.
+  auto keep = [&](const cv::Point2d& a, const cv::Point2d& b, bool joined) {
     const double length = cv::norm(b - a);
-    if (length < min_length || !along_printed_line(a, b, length)) return false;
+    if (length < min_length || (joined && !along_printed_line(a, b, length)))
+      return false;
     out.push_back({"edge", {a, b}, 0});
     ++kept_lines;
     return true;
   };
   for (const Piece& p : pieces)
-    if (!keep(p.a, p.b))
-      for (const auto& [a, b] : p.parts) keep(a, b);
+    if (!keep(p.a, p.b, !p.parts.empty()))
+      for (const auto& [a, b] : p.parts) keep(a, b, false);
   if (options.verbose)
     Log("LSD: " + std::to_string(lines.size()) + " edges, " +
         std::to_string(edges.size()) + " inside the region, " +
