@@ -56,9 +56,8 @@ struct Options {
   // the depth, the wider fit is taken (0 = off). It repaired one front end of
   // set06 (a few short text lines tilted the fit at the curl, M 0.43 % off
   // the true surface: MS-SSIM 0.606, 0.892 with 0.01) but, over four front
-  // ends, moved the
-  // other sets either way by a few hundredths (README, "Depth of blank
-  // paper"), so it is off.
+  // ends, moved the other sets either way by a few hundredths (README,
+  // "Depth of blank paper"), so it is off.
   double planar_guard = 0;
   // Points whose depth differs by more than this fraction from the median
   // depth of their 8 nearest image neighbours are not used for the depth
