@@ -378,6 +378,25 @@ double PolylineLength(const std::vector<cv::Point2d>& p) {
   return l;
 }
 
+// Drops the points next to either end of a side that lie behind its corner:
+// a sharpened corner of a shallow turn (150 degrees and more) moves along
+// the outline's rounding, and the points of the rounding past it would make
+// the side hook back (init-mesh's Coons patch then folds over there).
+std::vector<cv::Point2d> TrimBehindCorners(std::vector<cv::Point2d> p) {
+  constexpr double kAhead = 20;  // px: the side's direction at a corner
+  for (int end = 0; end < 2 && p.size() > 2; ++end) {
+    const cv::Point2d corner = p.front();
+    size_t far = 1;
+    while (far + 1 < p.size() && cv::norm(p[far] - corner) < kAhead) ++far;
+    const cv::Point2d direction = p[far] - corner;
+    size_t keep = 1;
+    while (keep < far && (p[keep] - corner).dot(direction) <= 0) ++keep;
+    p.erase(p.begin() + 1, p.begin() + long(keep));
+    std::reverse(p.begin(), p.end());
+  }
+  return p;
+}
+
 }  // namespace
 
 namespace detail {
@@ -513,15 +532,117 @@ std::array<int, 4> FindCornerIndices(const std::vector<cv::Point>& contour,
   return best;
 }
 
+std::array<int, 4> MoveBorderCornersToPageCorners(
+    const std::vector<cv::Point>& contour, std::array<int, 4> idx,
+    const std::function<bool(const cv::Point&)>& on_border, double min_turn_deg,
+    double max_arm_fraction) {
+  const int n = int(contour.size());
+  if (n < 16) return idx;
+  const int reach = CornerReach(contour.size());
+  const std::vector<double> angle = TurningAngles(contour, reach);
+  const double min_turn = min_turn_deg * CV_PI / 180;
+  auto wrap = [n](int k) { return ((k % n) + n) % n; };
+  const std::array<int, 4> found = idx;
+  for (int i = 0; i < 4; ++i) {
+    const int corner = found[i];
+    if (!on_border(contour[corner])) continue;
+    // Arms in outline steps: forward to the next corner, back to the previous.
+    const int forward = wrap(found[(i + 1) % 4] - corner);
+    const int backward = wrap(corner - found[(i + 3) % 4]);
+    auto arm_on_border = [&](int direction, int length) {
+      return on_border(contour[wrap(corner + direction * std::min(reach, length / 2))]);
+    };
+    const bool forward_cut = arm_on_border(+1, forward), backward_cut = arm_on_border(-1, backward);
+    // Only an exit: one arm along the border, the other into the image (a
+    // real corner that merely touches the border has both arms inside).
+    if (forward_cut == backward_cut) continue;
+    const int direction = forward_cut ? -1 : +1;
+    const int length = forward_cut ? backward : forward;
+    // Past the exit's own turning window, the sharpest convex turn that is a
+    // local maximum of the turning.
+    int best = -1;
+    double best_angle = min_turn;
+    for (int s = reach; s <= int(max_arm_fraction * length); ++s) {
+      const int k = wrap(corner + direction * s);
+      if (on_border(contour[k])) break;
+      if (angle[k] < best_angle) continue;
+      bool is_max = true;
+      for (int j = -reach / 2; j <= reach / 2 && is_max; ++j)
+        if (s + j * direction >= reach && j != 0)
+          is_max = angle[wrap(k + j)] <= angle[k];
+      if (is_max) {
+        best = k;
+        best_angle = angle[k];
+      }
+    }
+    if (best >= 0) idx[i] = best;
+  }
+  return idx;
+}
+
+std::array<int, 4> MoveFoldEndsToPageCorners(const std::vector<cv::Point>& contour,
+                                             std::array<int, 4> idx,
+                                             const std::function<bool(const cv::Point&)>& on_border,
+                                             const FoldTest& is_fold, double min_turn_deg,
+                                             double max_arm_fraction) {
+  const int n = int(contour.size());
+  if (n < 32 || !is_fold) return idx;
+  const int reach = CornerReach(contour.size());
+  const int fine = std::max(2, reach / 4);
+  const std::vector<double> angle = TurningAngles(contour, fine);
+  const double min_turn = min_turn_deg * CV_PI / 180;
+  const double max_fold_turn = 60 * CV_PI / 180;
+  auto wrap = [n](int k) { return ((k % n) + n) % n; };
+  const std::array<int, 4> found = idx;
+  for (int i = 0; i < 4; ++i) {
+    const int corner = found[i];
+    if (on_border(contour[corner])) continue;
+    // The sharpest fine turn on each arm, past the corner's own turning.
+    std::array<int, 2> turn{{-1, -1}};
+    for (int a = 0; a < 2; ++a) {
+      const int direction = a == 0 ? +1 : -1;
+      const int length =
+          a == 0 ? wrap(found[(i + 1) % 4] - corner) : wrap(corner - found[(i + 3) % 4]);
+      double best = min_turn;
+      for (int s = 2 * fine; s <= int(max_arm_fraction * length); ++s) {
+        const int k = wrap(corner + direction * s);
+        if (on_border(contour[k])) break;
+        if (angle[k] < best) continue;
+        bool is_max = true;
+        for (int j = -fine; j <= fine && is_max; ++j)
+          if (j != 0) is_max = angle[wrap(k + j)] <= angle[k];
+        if (is_max) {
+          turn[a] = k;
+          best = angle[k];
+        }
+      }
+    }
+    if ((turn[0] >= 0) == (turn[1] >= 0)) continue;  // none, or one on each arm
+    // A fold's end turns less than a page corner does, and the corner it
+    // hides less than it (else the outline's turning would have found it).
+    const int beside = turn[0] >= 0 ? turn[0] : turn[1];
+    if (angle[corner] >= max_fold_turn || angle[beside] >= angle[corner]) continue;
+    // The crease must start at the corner found, not at the turn beside it
+    // (there the corner found may be the page's, the turn the crease's end).
+    auto crease_from = [&](int from) {
+      for (int s = n / 8; s <= n - n / 8; s += fine)
+        if (is_fold(contour[from], contour[wrap(from + s)])) return true;
+      return false;
+    };
+    if (crease_from(corner) && !crease_from(beside)) idx[i] = beside;
+  }
+  return idx;
+}
+
 bool IsShadingStep(const cv::Mat1f& grey, const cv::Mat1b& mask, double scale,
-                   const cv::Point& a, const cv::Point& b) {
+                   const cv::Point& a, const cv::Point& b, double offset_px) {
   const cv::Point2d p = cv::Point2d(a) * scale, q = cv::Point2d(b) * scale;
   const double length = cv::norm(q - p);
   if (length < 20) return false;
   const cv::Point2d along = (q - p) / length, normal(-along.y, along.x);
   // Far enough from the line to leave a crease's own shading ramp, near
   // enough to stay on the two panels next to it.
-  const double offset = std::max(4.0, 0.02 * length);
+  const double offset = offset_px > 0 ? offset_px : std::max(4.0, 0.02 * length);
   auto inside = [&](const cv::Point2d& x) {
     const int ix = int(std::lround(x.x)), iy = int(std::lround(x.y));
     return ix >= 0 && iy >= 0 && ix < mask.cols && iy < mask.rows && mask(iy, ix) > 0;
@@ -704,7 +825,21 @@ BoundaryResult SegmentBoundary(const cv::Mat& image, const BoundaryOptions& opti
   const auto is_fold = [&](const cv::Point& a, const cv::Point& b) {
     return detail::IsShadingStep(grey, small_mask, double(small.cols) / full.cols, a, b);
   };
-  std::array<int, 4> idx = detail::FindCornerIndices(contour, is_fold);
+  const double tol = options.border_tolerance_px;
+  auto on_border = [&](const cv::Point& p) {
+    return p.x <= tol || p.y <= tol || p.x >= mask.cols - 1 - tol ||
+           p.y >= mask.rows - 1 - tol;
+  };
+  // A fold's crease a little way from a page corner, along a side: sampled
+  // close to the crease, as the panel beyond it may be narrow.
+  const auto is_crease = [&](const cv::Point& a, const cv::Point& b) {
+    return detail::IsShadingStep(grey, small_mask, double(small.cols) / full.cols, a, b, 4.0);
+  };
+  std::array<int, 4> idx = detail::MoveFoldEndsToPageCorners(
+      contour,
+      detail::MoveBorderCornersToPageCorners(contour, detail::FindCornerIndices(contour, is_fold),
+                                             on_border),
+      on_border, is_crease);
   std::array<cv::Point2d, 4> corners;
   for (int i = 0; i < 4; ++i) corners[i] = contour[idx[i]];
   step("corners");
@@ -729,11 +864,6 @@ BoundaryResult SegmentBoundary(const cv::Mat& image, const BoundaryOptions& opti
   }
 
   // 4. Sides along the outline, and which parts of them lie on the image border.
-  const double tol = options.border_tolerance_px;
-  auto on_border = [&](const cv::Point& p) {
-    return p.x <= tol || p.y <= tol || p.x >= mask.cols - 1 - tol ||
-           p.y >= mask.rows - 1 - tol;
-  };
   for (int i = 0; i < 4; ++i) result.corner_in_image[i] = !on_border(contour[idx[i]]);
   const int n = int(contour.size());
   for (int i = 0; i < 4; ++i) {
@@ -772,6 +902,7 @@ BoundaryResult SegmentBoundary(const cv::Mat& image, const BoundaryOptions& opti
     // A side runs from corner to corner, sharpened as the corners are.
     side.points.front() = result.corners[reversed ? (i + 1) % 4 : i];
     side.points.back() = result.corners[reversed ? i : (i + 1) % 4];
+    side.points = TrimBehindCorners(std::move(side.points));
     if (side.real) side.real_parts = {side.points};
     result.sides[i] = std::move(side);
   }

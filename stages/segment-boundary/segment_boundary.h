@@ -126,8 +126,41 @@ std::array<int, 4> FindCornerIndices(const std::vector<cv::Point>& contour,
 // separates two differently shaded parts of it along most of its length, as
 // a fold does (text is blurred away first). `grey` is the page image at
 // `scale` work pixels per full pixel; `mask` the page region at that size.
+// `offset_px` (work pixels) is how far either side of the segment the two
+// panels are sampled; 0: 2 % of its length, at least 4.
 bool IsShadingStep(const cv::Mat1f& grey, const cv::Mat1b& mask, double scale,
-                   const cv::Point& a, const cv::Point& b);
+                   const cv::Point& a, const cv::Point& b, double offset_px = 0);
+// Where a corner in the image is the end of a fold's crease that meets a
+// side a short way from the page's corner, moves the corner there: with the
+// narrow panel beyond the crease seen foreshortened, the crease's end turns
+// the outline more than the corner does (set08's reference view: 45 degrees
+// at a quarter of the corner reach, the corner 65 px further on 33). It
+// moves when, at that finer scale, exactly one of its arms turns by
+// `min_turn_deg` or more within `max_arm_fraction` of the arm, by less than
+// the corner found turns, which turns by under 60 degrees (a page corner
+// turns more); and when `is_fold` joins the corner found, but not that turn,
+// to an outline point at least an eighth of the outline away (else the
+// corner found may be the page's and the turn the crease's end: r03's
+// view_03).
+std::array<int, 4> MoveFoldEndsToPageCorners(const std::vector<cv::Point>& contour,
+                                             std::array<int, 4> idx,
+                                             const std::function<bool(const cv::Point&)>& on_border,
+                                             const FoldTest& is_fold, double min_turn_deg = 20,
+                                             double max_arm_fraction = 0.15);
+// Where a corner is the point at which the outline meets the image border
+// (the page runs out of the image there), moves it to a sharp convex turn
+// (>= `min_turn_deg`) on its real arm within `max_arm_fraction` of that
+// arm's length, when there is one: the page's own corner, with the short
+// piece from it to the border belonging to the next, cut side (set08's
+// reference view: the border exit turns 67 degrees, the true corner 39,
+// 16 % up the arm). Taking a crease kink there instead costs little: the
+// piece joins a cut side, which is never straightened, while a real side
+// running on past its corner would be straightened through it.
+// `on_border` says whether an outline point lies on the image border.
+std::array<int, 4> MoveBorderCornersToPageCorners(
+    const std::vector<cv::Point>& contour, std::array<int, 4> idx,
+    const std::function<bool(const cv::Point&)>& on_border, double min_turn_deg = 20,
+    double max_arm_fraction = 0.25);
 // Sharpens a corner found on the outline: the intersection of straight lines
 // fitted to the outline just before and just after it (a corner the mask
 // rounds off, or a ragged outline, moves the point of sharpest turn away).

@@ -217,6 +217,93 @@ TEST(CornerHelpers, ASideAlongAShadedFlapIsNoFold) {
     EXPECT_LE(cv::norm(contour[idx[i]] - expected[i]), 3.0) << i << " " << contour[idx[i]];
 }
 
+// A page cut off by the image's bottom border (y = 399) as in set08's
+// reference view: its bottom-left corner (100,330) lies in the image, but the
+// outline turns more where its bottom side leaves the image at (150,399),
+// 20 % of the way from there to the top-left corner.
+std::vector<cv::Point> PageLeavingTheImage(const cv::Point& bottom_left) {
+  std::vector<cv::Point> contour;
+  auto edge = [&](cv::Point a, cv::Point b) {
+    const int n = std::max(std::abs(b.x - a.x), std::abs(b.y - a.y));
+    for (int k = 0; k < n; ++k) contour.emplace_back(a + (b - a) * (double(k) / n));
+  };
+  edge({130, 60}, {560, 80});
+  edge({560, 80}, {600, 399});  // right side, leaves the image
+  edge({600, 399}, {150, 399});  // along the image border
+  edge({150, 399}, bottom_left);
+  edge(bottom_left, {130, 60});
+  return contour;
+}
+
+TEST(CornerHelpers, APageCornerNearWhereItsSideLeavesTheImageIsTheCorner) {
+  const auto on_border = [](const cv::Point& p) { return p.y >= 397; };
+  const std::vector<cv::Point> contour = PageLeavingTheImage({100, 330});
+  const auto found = detail::FindCornerIndices(contour);
+  // The outline alone picks the border exit...
+  int exits = 0;
+  for (int i = 0; i < 4; ++i) exits += cv::norm(contour[found[i]] - cv::Point(150, 399)) <= 3;
+  ASSERT_EQ(exits, 1);
+  // ...and the page corner up the side replaces it; the exit of the
+  // right side, with no turn before it, stays.
+  const auto moved = detail::MoveBorderCornersToPageCorners(contour, found, on_border);
+  const std::vector<cv::Point> expected = {{130, 60}, {560, 80}, {600, 399}, {100, 330}};
+  for (int i = 0; i < 4; ++i)
+    EXPECT_LE(cv::norm(contour[moved[i]] - expected[i]), 3.0) << i << " " << contour[moved[i]];
+  // A straight side into the border keeps its exit as the corner.
+  const std::vector<cv::Point> straight = PageLeavingTheImage({145, 314});
+  const auto kept = detail::FindCornerIndices(straight);
+  EXPECT_EQ(detail::MoveBorderCornersToPageCorners(straight, kept, on_border), kept);
+  // Nor does a corner in the image move.
+  const auto nowhere = [](const cv::Point&) { return false; };
+  EXPECT_EQ(detail::MoveBorderCornersToPageCorners(contour, found, nowhere), found);
+}
+
+// A page whose top-left corner (250,153) lies 73 px past the end (300,100)
+// of a fold's crease that meets its top side, as in set08's reference view:
+// the crease's end turns 45 degrees, the corner 38.
+std::vector<cv::Point> PageWithACreaseNextToACorner() {
+  std::vector<cv::Point> contour;
+  auto edge = [&](cv::Point a, cv::Point b) {
+    const int n = std::max(std::abs(b.x - a.x), std::abs(b.y - a.y));
+    for (int k = 0; k < n; ++k) contour.emplace_back(a + (b - a) * (double(k) / n));
+  };
+  edge({300, 100}, {850, 80});
+  edge({850, 80}, {820, 720});
+  edge({820, 720}, {200, 700});
+  edge({200, 700}, {250, 153});
+  edge({250, 153}, {300, 100});
+  return contour;
+}
+
+TEST(CornerHelpers, ACreaseEndNextToACornerGivesWayToIt) {
+  const std::vector<cv::Point> contour = PageWithACreaseNextToACorner();
+  const auto near = [](const cv::Point& p, const cv::Point& q) { return cv::norm(p - q) <= 3; };
+  const auto nowhere = [](const cv::Point&) { return false; };
+  const auto found = detail::FindCornerIndices(contour);
+  int at_crease = 0;
+  for (int i = 0; i < 4; ++i) at_crease += near(contour[found[i]], {300, 100});
+  ASSERT_EQ(at_crease, 1) << "the outline's turning alone should take the crease's end";
+  // A crease runs from the crease's end across the page: the corner moves.
+  const detail::FoldTest crease = [&](const cv::Point& a, const cv::Point&) {
+    return near(a, {300, 100});
+  };
+  const auto moved = detail::MoveFoldEndsToPageCorners(contour, found, nowhere, crease);
+  const std::vector<cv::Point> expected = {{250, 153}, {850, 80}, {820, 720}, {200, 700}};
+  for (int i = 0; i < 4; ++i) {
+    double nearest = 1e9;
+    for (const auto& e : expected) nearest = std::min(nearest, cv::norm(contour[moved[i]] - e));
+    EXPECT_LE(nearest, 4.0) << i << " " << contour[moved[i]];
+  }
+  // No crease, or one from the turn beside it too (then the corner found may
+  // be the page's and the turn the crease's end): nothing moves.
+  const detail::FoldTest none = [](const cv::Point&, const cv::Point&) { return false; };
+  EXPECT_EQ(detail::MoveFoldEndsToPageCorners(contour, found, nowhere, none), found);
+  const detail::FoldTest both = [&](const cv::Point& a, const cv::Point&) {
+    return near(a, {300, 100}) || cv::norm(a - cv::Point(250, 153)) <= 12;
+  };
+  EXPECT_EQ(detail::MoveFoldEndsToPageCorners(contour, found, nowhere, both), found);
+}
+
 TEST(CornerHelpers, ShadingStepTellsAFoldFromAFlatPageAndASide) {
   // The folded page of FoldedPageOutline: panel above y = 140 darker.
   cv::Mat1b mask = cv::Mat1b::zeros(560, 700);
