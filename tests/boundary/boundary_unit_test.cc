@@ -136,18 +136,22 @@ TEST(SegmentBoundary, EmptyTableIsNoDocument) {
   EXPECT_THROW(SegmentBoundary(cv::Mat3b(600, 800, cv::Vec3b(128, 128, 128)), {}), InputError);
 }
 
-TEST(CornerHelpers, FourSharpestTurnsWinOverAFoldKink) {
-  // A clockwise square with a shallow kink (a fold) in its top side.
+// The outline through `vertices` and back to the first, one point per pixel
+// step along the longer axis of each edge (as findContours gives it).
+std::vector<cv::Point> ClosedOutline(const std::vector<cv::Point>& vertices) {
   std::vector<cv::Point> contour;
-  auto edge = [&](cv::Point a, cv::Point b) {
+  for (size_t i = 0; i < vertices.size(); ++i) {
+    const cv::Point a = vertices[i], b = vertices[(i + 1) % vertices.size()];
     const int n = std::max(std::abs(b.x - a.x), std::abs(b.y - a.y));
     for (int k = 0; k < n; ++k) contour.emplace_back(a + (b - a) * (double(k) / n));
-  };
-  edge({0, 0}, {200, -25});
-  edge({200, -25}, {400, 0});
-  edge({400, 0}, {400, 400});
-  edge({400, 400}, {0, 400});
-  edge({0, 400}, {0, 0});
+  }
+  return contour;
+}
+
+TEST(CornerHelpers, FourSharpestTurnsWinOverAFoldKink) {
+  // A clockwise square with a shallow kink (a fold) in its top side.
+  const std::vector<cv::Point> contour =
+      ClosedOutline({{0, 0}, {200, -25}, {400, 0}, {400, 400}, {0, 400}});
   const auto idx = detail::FindCornerIndices(contour);
   const std::vector<cv::Point> expected = {{0, 0}, {400, 0}, {400, 400}, {0, 400}};
   for (int i = 0; i < 4; ++i) EXPECT_LE(cv::norm(contour[idx[i]] - expected[i]), 2.0) << i;
@@ -157,18 +161,10 @@ TEST(CornerHelpers, FourSharpestTurnsWinOverAFoldKink) {
 // (as in samples/set01): a hexagon whose fold kinks turn more sharply than
 // the panel's own corners.
 std::vector<cv::Point> FoldedPageOutline() {
-  std::vector<cv::Point> contour;
-  auto edge = [&](cv::Point a, cv::Point b) {
-    const int n = std::max(std::abs(b.x - a.x), std::abs(b.y - a.y));
-    for (int k = 0; k < n; ++k) contour.emplace_back(a + (b - a) * (double(k) / n));
-  };
-  edge({220, 60}, {480, 60});    // top side of the folded panel
-  edge({480, 60}, {600, 140});   // right side, panel part
-  edge({600, 140}, {600, 500});  // right side below the fold kink
-  edge({600, 500}, {100, 500});
-  edge({100, 500}, {100, 140});  // left side below the fold kink
-  edge({100, 140}, {220, 60});   // left side, panel part
-  return contour;
+  // The folded panel's top side, the right side's panel part, the right side
+  // below the fold kink, the bottom, the left side below the kink and the
+  // left side's panel part.
+  return ClosedOutline({{220, 60}, {480, 60}, {600, 140}, {600, 500}, {100, 500}, {100, 140}});
 }
 
 TEST(CornerHelpers, FoldKinksAreNotCornersWhenTheFoldIsSeen) {
@@ -195,17 +191,8 @@ TEST(CornerHelpers, ASideAlongAShadedFlapIsNoFold) {
   // bulges out over a flap (kinks of 27 degrees at (40,220) and (40,380),
   // 8 % of the area) whose shading differs, so the shading test calls the
   // chord between the two left corners a fold (set05's reference view).
-  std::vector<cv::Point> contour;
-  auto edge = [&](cv::Point a, cv::Point b) {
-    const int n = std::max(std::abs(b.x - a.x), std::abs(b.y - a.y));
-    for (int k = 0; k < n; ++k) contour.emplace_back(a + (b - a) * (double(k) / n));
-  };
-  edge({100, 100}, {600, 100});
-  edge({600, 100}, {600, 500});
-  edge({600, 500}, {100, 500});
-  edge({100, 500}, {40, 380});
-  edge({40, 380}, {40, 220});
-  edge({40, 220}, {100, 100});
+  const std::vector<cv::Point> contour =
+      ClosedOutline({{100, 100}, {600, 100}, {600, 500}, {100, 500}, {40, 380}, {40, 220}});
   const auto near = [](const cv::Point& p, const cv::Point& q) { return cv::norm(p - q) <= 3; };
   const detail::FoldTest shaded_chord = [&](const cv::Point& a, const cv::Point& b) {
     return (near(a, {100, 100}) && near(b, {100, 500})) ||
@@ -222,17 +209,9 @@ TEST(CornerHelpers, ASideAlongAShadedFlapIsNoFold) {
 // outline turns more where its bottom side leaves the image at (150,399),
 // 20 % of the way from there to the top-left corner.
 std::vector<cv::Point> PageLeavingTheImage(const cv::Point& bottom_left) {
-  std::vector<cv::Point> contour;
-  auto edge = [&](cv::Point a, cv::Point b) {
-    const int n = std::max(std::abs(b.x - a.x), std::abs(b.y - a.y));
-    for (int k = 0; k < n; ++k) contour.emplace_back(a + (b - a) * (double(k) / n));
-  };
-  edge({130, 60}, {560, 80});
-  edge({560, 80}, {600, 399});  // right side, leaves the image
-  edge({600, 399}, {150, 399});  // along the image border
-  edge({150, 399}, bottom_left);
-  edge(bottom_left, {130, 60});
-  return contour;
+  // The right side leaves the image at (600,399); the outline runs along the
+  // image border to (150,399).
+  return ClosedOutline({{130, 60}, {560, 80}, {600, 399}, {150, 399}, bottom_left});
 }
 
 TEST(CornerHelpers, APageCornerNearWhereItsSideLeavesTheImageIsTheCorner) {
@@ -262,17 +241,7 @@ TEST(CornerHelpers, APageCornerNearWhereItsSideLeavesTheImageIsTheCorner) {
 // of a fold's crease that meets its top side, as in set08's reference view:
 // the crease's end turns 45 degrees, the corner 38.
 std::vector<cv::Point> PageWithACreaseNextToACorner() {
-  std::vector<cv::Point> contour;
-  auto edge = [&](cv::Point a, cv::Point b) {
-    const int n = std::max(std::abs(b.x - a.x), std::abs(b.y - a.y));
-    for (int k = 0; k < n; ++k) contour.emplace_back(a + (b - a) * (double(k) / n));
-  };
-  edge({300, 100}, {850, 80});
-  edge({850, 80}, {820, 720});
-  edge({820, 720}, {200, 700});
-  edge({200, 700}, {250, 153});
-  edge({250, 153}, {300, 100});
-  return contour;
+  return ClosedOutline({{300, 100}, {850, 80}, {820, 720}, {200, 700}, {250, 153}});
 }
 
 TEST(CornerHelpers, ACreaseEndNextToACornerGivesWayToIt) {
