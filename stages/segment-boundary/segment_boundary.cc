@@ -397,6 +397,41 @@ std::vector<cv::Point2d> TrimBehindCorners(std::vector<cv::Point2d> p) {
   return p;
 }
 
+// Outline steps from corner `i` of `corners` to the next corner
+// (`direction` +1) or back to the previous one (-1).
+int ArmLength(const std::array<int, 4>& corners, int i, int direction, int n) {
+  const int steps = direction > 0 ? corners[(i + 1) % 4] - corners[i]
+                                  : corners[i] - corners[(i + 3) % 4];
+  return ((steps % n) + n) % n;
+}
+
+// Along the outline from `corner` in `direction`, steps `first` to `last`:
+// the point that turns most (by `min_turn` at least) and most of its
+// neighbours within `window` steps that lie `compared_from` or more steps
+// from the corner; -1 if none. Stops at the image border.
+int SharpestTurnOnArm(const std::vector<cv::Point>& contour, const std::vector<double>& angle,
+                      int corner, int direction, int first, int last, int window,
+                      int compared_from, double min_turn,
+                      const std::function<bool(const cv::Point&)>& on_border) {
+  const int n = int(contour.size());
+  auto wrap = [n](int k) { return ((k % n) + n) % n; };
+  int best = -1;
+  double best_angle = min_turn;
+  for (int s = first; s <= last; ++s) {
+    const int k = wrap(corner + direction * s);
+    if (on_border(contour[k])) break;
+    if (angle[k] < best_angle) continue;
+    bool is_max = true;
+    for (int j = -window; j <= window && is_max; ++j)
+      if (j != 0 && s + j * direction >= compared_from) is_max = angle[wrap(k + j)] <= angle[k];
+    if (is_max) {
+      best = k;
+      best_angle = angle[k];
+    }
+  }
+  return best;
+}
+
 }  // namespace
 
 namespace detail {
@@ -540,17 +575,13 @@ std::array<int, 4> MoveBorderCornersToPageCorners(
   if (n < 16) return idx;
   const int reach = CornerReach(contour.size());
   const std::vector<double> angle = TurningAngles(contour, reach);
-  const double min_turn = min_turn_deg * CV_PI / 180;
-  auto wrap = [n](int k) { return ((k % n) + n) % n; };
   const std::array<int, 4> found = idx;
   for (int i = 0; i < 4; ++i) {
     const int corner = found[i];
     if (!on_border(contour[corner])) continue;
-    // Arms in outline steps: forward to the next corner, back to the previous.
-    const int forward = wrap(found[(i + 1) % 4] - corner);
-    const int backward = wrap(corner - found[(i + 3) % 4]);
+    const int forward = ArmLength(found, i, +1, n), backward = ArmLength(found, i, -1, n);
     auto arm_on_border = [&](int direction, int length) {
-      return on_border(contour[wrap(corner + direction * std::min(reach, length / 2))]);
+      return on_border(contour[((corner + direction * std::min(reach, length / 2)) % n + n) % n]);
     };
     const bool forward_cut = arm_on_border(+1, forward), backward_cut = arm_on_border(-1, backward);
     // Only an exit: one arm along the border, the other into the image (a
@@ -558,23 +589,10 @@ std::array<int, 4> MoveBorderCornersToPageCorners(
     if (forward_cut == backward_cut) continue;
     const int direction = forward_cut ? -1 : +1;
     const int length = forward_cut ? backward : forward;
-    // Past the exit's own turning window, the sharpest convex turn that is a
-    // local maximum of the turning.
-    int best = -1;
-    double best_angle = min_turn;
-    for (int s = reach; s <= int(max_arm_fraction * length); ++s) {
-      const int k = wrap(corner + direction * s);
-      if (on_border(contour[k])) break;
-      if (angle[k] < best_angle) continue;
-      bool is_max = true;
-      for (int j = -reach / 2; j <= reach / 2 && is_max; ++j)
-        if (s + j * direction >= reach && j != 0)
-          is_max = angle[wrap(k + j)] <= angle[k];
-      if (is_max) {
-        best = k;
-        best_angle = angle[k];
-      }
-    }
+    // Past the exit's own turning window, and compared only with points past it.
+    const int best = SharpestTurnOnArm(contour, angle, corner, direction, reach,
+                                       int(max_arm_fraction * length), reach / 2, reach,
+                                       min_turn_deg * CV_PI / 180, on_border);
     if (best >= 0) idx[i] = best;
   }
   return idx;
@@ -590,32 +608,18 @@ std::array<int, 4> MoveFoldEndsToPageCorners(const std::vector<cv::Point>& conto
   const int reach = CornerReach(contour.size());
   const int fine = std::max(2, reach / 4);
   const std::vector<double> angle = TurningAngles(contour, fine);
-  const double min_turn = min_turn_deg * CV_PI / 180;
   const double max_fold_turn = 60 * CV_PI / 180;
-  auto wrap = [n](int k) { return ((k % n) + n) % n; };
   const std::array<int, 4> found = idx;
   for (int i = 0; i < 4; ++i) {
     const int corner = found[i];
     if (on_border(contour[corner])) continue;
     // The sharpest fine turn on each arm, past the corner's own turning.
-    std::array<int, 2> turn{{-1, -1}};
+    std::array<int, 2> turn;
     for (int a = 0; a < 2; ++a) {
       const int direction = a == 0 ? +1 : -1;
-      const int length =
-          a == 0 ? wrap(found[(i + 1) % 4] - corner) : wrap(corner - found[(i + 3) % 4]);
-      double best = min_turn;
-      for (int s = 2 * fine; s <= int(max_arm_fraction * length); ++s) {
-        const int k = wrap(corner + direction * s);
-        if (on_border(contour[k])) break;
-        if (angle[k] < best) continue;
-        bool is_max = true;
-        for (int j = -fine; j <= fine && is_max; ++j)
-          if (j != 0) is_max = angle[wrap(k + j)] <= angle[k];
-        if (is_max) {
-          turn[a] = k;
-          best = angle[k];
-        }
-      }
+      turn[a] = SharpestTurnOnArm(contour, angle, corner, direction, 2 * fine,
+                                  int(max_arm_fraction * ArmLength(found, i, direction, n)), fine,
+                                  0, min_turn_deg * CV_PI / 180, on_border);
     }
     if ((turn[0] >= 0) == (turn[1] >= 0)) continue;  // none, or one on each arm
     // A fold's end turns less than a page corner does, and the corner it
@@ -626,7 +630,7 @@ std::array<int, 4> MoveFoldEndsToPageCorners(const std::vector<cv::Point>& conto
     // (there the corner found may be the page's, the turn the crease's end).
     auto crease_from = [&](int from) {
       for (int s = n / 8; s <= n - n / 8; s += fine)
-        if (is_fold(contour[from], contour[wrap(from + s)])) return true;
+        if (is_fold(contour[from], contour[(from + s) % n])) return true;
       return false;
     };
     if (crease_from(corner) && !crease_from(beside)) idx[i] = beside;
@@ -822,8 +826,9 @@ BoundaryResult SegmentBoundary(const cv::Mat& image, const BoundaryOptions& opti
   cv::Mat1b small_mask;
   cv::resize(mask, small_mask, small.size(), 0, 0, cv::INTER_AREA);
   small_mask = small_mask > 127;
+  const double work_scale = double(small.cols) / full.cols;
   const auto is_fold = [&](const cv::Point& a, const cv::Point& b) {
-    return detail::IsShadingStep(grey, small_mask, double(small.cols) / full.cols, a, b);
+    return detail::IsShadingStep(grey, small_mask, work_scale, a, b);
   };
   const double tol = options.border_tolerance_px;
   auto on_border = [&](const cv::Point& p) {
@@ -833,7 +838,7 @@ BoundaryResult SegmentBoundary(const cv::Mat& image, const BoundaryOptions& opti
   // A fold's crease a little way from a page corner, along a side: sampled
   // close to the crease, as the panel beyond it may be narrow.
   const auto is_crease = [&](const cv::Point& a, const cv::Point& b) {
-    return detail::IsShadingStep(grey, small_mask, double(small.cols) / full.cols, a, b, 4.0);
+    return detail::IsShadingStep(grey, small_mask, work_scale, a, b, 4.0);
   };
   std::array<int, 4> idx = detail::MoveFoldEndsToPageCorners(
       contour,
