@@ -90,11 +90,17 @@ Orientation FindOrientation(const cv::Mat& image, const OrientationOptions& o) {
   api.SetVariable("debug_file", "/dev/null");
   // Lines of text run across the rows or the columns: read only the two
   // turns that make them horizontal, unless that is unclear.
-  const double contrast = RowOverColumnContrast(centre);
+  using Lines = OrientationOptions::Lines;
+  Lines lines = o.lines;
+  if (lines == Lines::kUnknown) {
+    const double contrast = RowOverColumnContrast(centre);
+    if (contrast > o.line_direction_ratio) lines = Lines::kAlongRows;
+    if (contrast < 1 / o.line_direction_ratio) lines = Lines::kAlongColumns;
+  }
   for (int k = 0; k < 4; ++k) {
     const bool sideways = k % 2 == 1;
-    if (contrast > o.line_direction_ratio && sideways) continue;
-    if (contrast < 1 / o.line_direction_ratio && !sideways) continue;
+    if (lines == Lines::kAlongRows && sideways) continue;
+    if (lines == Lines::kAlongColumns && !sideways) continue;
     cv::Mat1b turned = Turn(centre, k);
     r.words[k] = ReadableWords(&api, turned);
   }
@@ -107,6 +113,13 @@ Orientation FindOrientation(const cv::Mat& image, const OrientationOptions& o) {
     r.decided = true;
   } else {
     r.note = "too little readable text to tell which way up the page is";
+    if (o.lines == Lines::kAlongColumns) {
+      // Known to run down the page: a quarter turn at least makes them run
+      // across it (the one with more words read, else clockwise).
+      r.quarter_turns = r.words[3] > r.words[1] ? 3 : 1;
+      r.note += "; its text lines (lines.json) ran down the page: turned " +
+                std::to_string(90 * r.quarter_turns) + " degrees so that they run across";
+    }
   }
   return r;
 }

@@ -574,6 +574,21 @@ std::optional<Eigen::Vector2d> DownInFlat(const RenderInputs& in, const PixelToS
   return CarryDirection(pixels, flat, down_image);
 }
 
+// Which way the text lines of M' run in the output (M' turned by `angle`
+// radians): along its rows or columns when their lengths agree by 3 to 1.
+OrientationOptions OrientationHint(const std::vector<DirectionVote>& text_lines, double angle) {
+  OrientationOptions o;
+  double across = 0, down = 0;
+  for (const DirectionVote& line : text_lines) {
+    const double a = line.angle_deg * M_PI / 180 + angle;
+    across += line.length * std::abs(std::cos(a));
+    down += line.length * std::abs(std::sin(a));
+  }
+  if (across > 3 * down) o.lines = OrientationOptions::Lines::kAlongRows;
+  if (down > 3 * across) o.lines = OrientationOptions::Lines::kAlongColumns;
+  return o;
+}
+
 }  // namespace
 
 RenderResult Run(const RenderOptions& options, const RenderInputs& in) {
@@ -775,7 +790,7 @@ RenderResult Run(const RenderOptions& options, const RenderInputs& in) {
   timer.Mark("fill_and_grid");
   Json orientation = {{"checked", options.orient}};
   if (options.orient) {
-    Orientation o = FindOrientation(r.rectified);
+    Orientation o = FindOrientation(r.rectified, OrientationHint(in.text_lines, angle));
     // The reader's down in M': lines.json's, else features.json's carried
     // into M' here; (0, 0) when neither is known.
     Eigen::Vector2d down = in.text_down.value_or(Eigen::Vector2d::Zero());

@@ -125,6 +125,9 @@ struct RenderInputs {
   // Directions and lengths in M' of the lines in lines.json beside the
   // meshes (optimize's); empty when there is none (init-mesh's meshes).
   std::vector<DirectionVote> lines;
+  // Of those, the text lines, each by its direction along the line (not
+  // its normal): which way the page's text runs in M'.
+  std::vector<DirectionVote> text_lines;
   // The reader's down in M' (lines.json text_down_flat), when known: which
   // way up the page is when Tesseract cannot read its print.
   std::optional<Eigen::Vector2d> text_down;

@@ -75,8 +75,11 @@ RenderInputs ReadRenderInputs(const fs::path& sfm_dir,
         lo = std::min(lo, t);
         hi = std::max(hi, t);
       }
-      if (hi > lo && std::isfinite(hi - lo))
+      if (hi > lo && std::isfinite(hi - lo)) {
         in.lines.push_back({std::atan2(n.y(), n.x()) * 180 / M_PI, hi - lo});
+        if (doc["lines"][i].value("kind", "") == "text")
+          in.text_lines.push_back({std::atan2(along.y(), along.x()) * 180 / M_PI, hi - lo});
+      }
     }
   }
   if (!features_file.empty() && !in.text_down) {

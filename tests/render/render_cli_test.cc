@@ -164,6 +164,23 @@ TEST_F(RenderCli, DeskewFollowsTheLinesOfLinesJson) {
     EXPECT_EQ(o["quarter_turns_clockwise"], turns) << o.dump();
     EXPECT_EQ(o["by"], "baselines") << o.dump();
   }
+  // Text lines running down the page in M' and no down known: a quarter
+  // turn makes them run across it (a receipt from another detector's file
+  // was left sideways before).
+  {
+    Json doc = ReadJsonFile(work / "40_init/lines.json");
+    doc.erase("text_down_flat");
+    for (Json& line : doc["lines"]) {
+      for (Json& p : line["flat"]) p = {p[1].get<double>(), p[0].get<double>()};
+      line["normal"] = {line["normal"][1].get<double>(), line["normal"][0].get<double>()};
+    }
+    WriteJsonAtomic(work / "40_init/lines.json", doc);
+    ASSERT_EQ(Render(work, dir_ / "sideways", "--width 100").exit_code, 0);
+    const Json o = ReadJsonFile(dir_ / "sideways" / "render.json")["orientation"];
+    ASSERT_FALSE(o["decided"].get<bool>()) << o.dump();
+    EXPECT_EQ(o["quarter_turns_clockwise"].get<int>() % 2, 1) << o.dump();
+    EXPECT_NE(o.value("note", "").find("ran down the page"), std::string::npos) << o.dump();
+  }
   // Without lines.json (init-mesh's meshes), features.json's down in the
   // reference image, carried into M' through the text segments, does it.
   fs::remove(work / "40_init/lines.json");
