@@ -113,13 +113,6 @@ Orientation FindOrientation(const cv::Mat& image, const OrientationOptions& o) {
     r.decided = true;
   } else {
     r.note = "too little readable text to tell which way up the page is";
-    if (o.lines == Lines::kAlongColumns) {
-      // Known to run down the page: a quarter turn at least makes them run
-      // across it (the one with more words read, else clockwise).
-      r.quarter_turns = r.words[3] > r.words[1] ? 3 : 1;
-      r.note += "; its text lines (lines.json) ran down the page: turned " +
-                std::to_string(90 * r.quarter_turns) + " degrees so that they run across";
-    }
   }
   return r;
 }

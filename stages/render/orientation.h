@@ -28,8 +28,7 @@ struct OrientationOptions {
   double line_direction_ratio = 1.4;
   // Which way the text lines run in the image when already known (from
   // optimize's lines in M'): then that, not the ink, says which two turns
-  // are read, and with too little readable text the page still turns so
-  // that its lines run across (which way up is then a guess).
+  // are read.
   enum class Lines { kUnknown, kAlongRows, kAlongColumns };
   Lines lines = Lines::kUnknown;
 };

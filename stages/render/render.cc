@@ -790,7 +790,8 @@ RenderResult Run(const RenderOptions& options, const RenderInputs& in) {
   timer.Mark("fill_and_grid");
   Json orientation = {{"checked", options.orient}};
   if (options.orient) {
-    Orientation o = FindOrientation(r.rectified, OrientationHint(in.text_lines, angle));
+    const OrientationOptions hint = OrientationHint(in.text_lines, angle);
+    Orientation o = FindOrientation(r.rectified, hint);
     // The reader's down in M': lines.json's, else features.json's carried
     // into M' here; (0, 0) when neither is known.
     Eigen::Vector2d down = in.text_down.value_or(Eigen::Vector2d::Zero());
@@ -811,6 +812,14 @@ RenderResult Run(const RenderOptions& options, const RenderInputs& in) {
       o.quarter_turns = turns;
       o.note += "; turned by the side the text's baselines lie on (" + down_from + ")";
       orientation["by"] = "baselines";
+    } else if (!o.decided && hint.lines == OrientationOptions::Lines::kAlongColumns) {
+      // Nothing says which way up, but the text lines run down the page: a
+      // quarter turn at least makes them run across it (the one with more
+      // words read, else clockwise).
+      o.quarter_turns = o.words[3] > o.words[1] ? 3 : 1;
+      o.note += "; its text lines (lines.json) ran down the page: turned " +
+                std::to_string(90 * o.quarter_turns) + " degrees so that they run across";
+      orientation["by"] = "text lines";
     }
     orientation["readable_words"] = o.words;
     orientation["decided"] = o.decided;

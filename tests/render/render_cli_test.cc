@@ -180,6 +180,7 @@ TEST_F(RenderCli, DeskewFollowsTheLinesOfLinesJson) {
     ASSERT_FALSE(o["decided"].get<bool>()) << o.dump();
     EXPECT_EQ(o["quarter_turns_clockwise"].get<int>() % 2, 1) << o.dump();
     EXPECT_NE(o.value("note", "").find("ran down the page"), std::string::npos) << o.dump();
+    EXPECT_EQ(o["by"], "text lines") << o.dump();
   }
   // Without lines.json (init-mesh's meshes), features.json's down in the
   // reference image, carried into M' through the text segments, does it.
