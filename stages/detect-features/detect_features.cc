@@ -49,6 +49,7 @@ Json FeaturesOptions::ToJson() const {
               {"sauvola_k", sauvola_k},
               {"straightness_px", straightness_px},
               {"straightness_rel", straightness_rel},
+              {"straightness_window", straightness_window},
               {"max_gap", max_gap},
               {"min_text_length", min_text_length},
               {"min_length_px", min_length_px},

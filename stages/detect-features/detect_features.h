@@ -38,6 +38,9 @@ struct FeaturesOptions {
   // than this many pixels, or this fraction of the text height if larger.
   double straightness_px = 1.2;
   double straightness_rel = 0.12;
+  // Text: whether a baseline bends is judged on its running median over
+  // this many text heights either way (0 = on the raw samples).
+  double straightness_window = 1.0;
   // Text: neighbours are chained across gaps up to this many text heights.
   double max_gap = 1.0;
   // Shortest segment kept, in text heights (text) or pixels (both).

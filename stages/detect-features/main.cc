@@ -35,6 +35,10 @@ int main(int argc, char** argv) {
   app.add_option("--straightness-rel", opt.straightness_rel,
                  "...or by this fraction of the text height, if larger")
       ->capture_default_str()->check(CLI::Range(0.0, 1.0));
+  app.add_option("--straightness-window", opt.straightness_window,
+                 "text: judge the bend on the baseline's running median over this many text "
+                 "heights either way (0 = on every sample)")
+      ->capture_default_str()->check(CLI::Range(0.0, 10.0));
   app.add_option("--max-gap", opt.max_gap, "text: largest gap chained, in text heights")
       ->capture_default_str()->check(CLI::Range(0.1, 10.0));
   app.add_option("--min-text-length", opt.min_text_length,

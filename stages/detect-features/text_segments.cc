@@ -316,12 +316,10 @@ TextResult DetectTextSegments(const InkComponents& ink, const FeaturesOptions& o
     std::sort(samples.begin(), samples.end(), [](const Sample& p, const Sample& q) { return p.a < q.a; });
     return samples;
   };
-  // Which samples of an outline lie on its line: within a band of the
-  // median of their neighbours (three text heights either way), the chain's
-  // overall tilt removed. Descenders, or ascenders, stick out.
-  // Each sample's offset from the median of its neighbours (three text
-  // heights either way), the chain's overall tilt removed.
-  auto offsets = [&](const std::vector<Sample>& samples) {
+  // Each sample's offset from the median of its neighbours within
+  // `half_window` pixels either way, the chain's overall tilt removed.
+  // Descenders, or ascenders, stick out.
+  auto offsets = [&](const std::vector<Sample>& samples, double half_window) {
     std::vector<double> out(samples.size(), 0.0);
     if (samples.size() < 3) return out;
     std::vector<cv::Point2d> raw;
@@ -332,8 +330,8 @@ TextResult DetectTextSegments(const InkComponents& ink, const FeaturesOptions& o
     for (size_t k = 0; k < samples.size(); ++k)
       e[k] = samples[k].c - (tilt.point.y + slope * (samples[k].a - tilt.point.x));
     for (size_t k = 0, lo = 0, hi = 0; k < samples.size(); ++k) {
-      while (samples[lo].a < samples[k].a - 3 * x_height) ++lo;
-      while (hi < samples.size() && samples[hi].a <= samples[k].a + 3 * x_height) ++hi;
+      while (samples[lo].a < samples[k].a - half_window) ++lo;
+      while (hi < samples.size() && samples[hi].a <= samples[k].a + half_window) ++hi;
       out[k] = e[k] - Median(std::vector<double>(e.begin() + long(lo), e.begin() + long(hi)));
     }
     return out;
@@ -354,7 +352,7 @@ TextResult DetectTextSegments(const InkComponents& ink, const FeaturesOptions& o
   for (const auto& chain : chains) {
     if (chain.size() < 3) continue;
     for (double side : {1.0, -1.0})
-      for (double o : offsets(outline(chain, side)))
+      for (double o : offsets(outline(chain, side), 3 * x_height))
         (side > 0 ? stray_plus : stray_minus) += std::min(std::abs(o), 0.6 * x_height);
   }
   std::vector<Mark> small;
@@ -436,20 +434,37 @@ TextResult DetectTextSegments(const InkComponents& ink, const FeaturesOptions& o
     if (!result.orientation_known) continue;
     const std::vector<Sample> samples = outline(chain, sign);
     if (samples.size() < 5) continue;
-    const std::vector<double> off = offsets(samples);
+    const std::vector<double> off = offsets(samples, 3 * x_height);
     const double band = 0.2 * x_height + 0.5;
     std::vector<char> keep(samples.size());
     for (size_t k = 0; k < samples.size(); ++k) keep[k] = std::abs(off[k]) <= band;
-    std::vector<cv::Point2d> kept;
+    std::vector<Sample> kept_samples;
+    for (size_t k = 0; k < samples.size(); ++k)
+      if (keep[k]) kept_samples.push_back(samples[k]);
+    // Where to cut is decided on the running median of the baseline: single
+    // samples a pixel off (the pixel grid, serifs, JPEG) would otherwise cut
+    // a straight line into pieces too short to keep, while a crease bends it
+    // over more than the window and still cuts it. The pieces are fitted to
+    // the samples themselves.
+    const std::vector<double> noise =
+        options.straightness_window > 0
+            ? offsets(kept_samples, options.straightness_window * x_height)
+            : std::vector<double>(kept_samples.size(), 0.0);
+    std::vector<cv::Point2d> kept, smooth;
     std::vector<int> kept_mark;
-    for (size_t k = 0; k < samples.size(); ++k) {
-      if (!keep[k]) continue;
-      const double c = sign * samples[k].c;  // back to image pixels
-      kept.emplace_back(samples[k].a * d.x + c * n.x, samples[k].a * d.y + c * n.y);
-      kept_mark.push_back(samples[k].mark);
+    for (size_t k = 0; k < kept_samples.size(); ++k) {
+      const double c = sign * kept_samples[k].c;  // back to image pixels
+      const double cs = sign * (kept_samples[k].c - noise[k]);
+      kept.emplace_back(kept_samples[k].a * d.x + c * n.x, kept_samples[k].a * d.y + c * n.y);
+      smooth.emplace_back(kept_samples[k].a * d.x + cs * n.x, kept_samples[k].a * d.y + cs * n.y);
+      kept_mark.push_back(kept_samples[k].mark);
     }
-    for (auto [first, last] : SplitWhereBent(kept, tolerance)) {
-      std::vector<cv::Point2d> piece(kept.begin() + first, kept.begin() + last + 1);
+    for (auto [first, last] : SplitWhereBent(smooth, tolerance)) {
+      // The line is fitted to the samples near the running median; the few
+      // that stray from it (serifs, a descender's stub) would tilt it.
+      std::vector<cv::Point2d> piece;
+      for (int k = first; k <= last; ++k)
+        if (std::abs(noise[size_t(k)]) <= 0.5 * tolerance) piece.push_back(kept[size_t(k)]);
       int characters = 0;
       for (int k = first; k <= last; ++k) characters += k == first || kept_mark[size_t(k)] != kept_mark[size_t(k - 1)];
       if (piece.size() < 5 || characters < 3) continue;
@@ -458,7 +473,7 @@ TextResult DetectTextSegments(const InkComponents& ink, const FeaturesOptions& o
       auto project = [&](const cv::Point2d& p) {
         return fit.point + fit.direction * (p - fit.point).dot(fit.direction);
       };
-      const cv::Point2d p0 = project(piece.front()), p1 = project(piece.back());
+      const cv::Point2d p0 = project(kept[size_t(first)]), p1 = project(kept[size_t(last)]);
       if (cv::norm(p1 - p0) < min_length) continue;
       result.segments.push_back({"text", {p0, p1}, characters});
     }
