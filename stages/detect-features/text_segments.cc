@@ -436,16 +436,13 @@ TextResult DetectTextSegments(const InkComponents& ink, const FeaturesOptions& o
     if (samples.size() < 5) continue;
     const std::vector<double> off = offsets(samples, 3 * x_height);
     const double band = 0.2 * x_height + 0.5;
-    std::vector<char> keep(samples.size());
-    for (size_t k = 0; k < samples.size(); ++k) keep[k] = std::abs(off[k]) <= band;
     std::vector<Sample> kept_samples;
     for (size_t k = 0; k < samples.size(); ++k)
-      if (keep[k]) kept_samples.push_back(samples[k]);
+      if (std::abs(off[k]) <= band) kept_samples.push_back(samples[k]);
     // Where to cut is decided on the running median of the baseline: single
     // samples a pixel off (the pixel grid, serifs, JPEG) would otherwise cut
     // a straight line into pieces too short to keep, while a crease bends it
-    // over more than the window and still cuts it. The pieces are fitted to
-    // the samples themselves.
+    // over more than the window and still cuts it.
     const std::vector<double> noise =
         options.straightness_window > 0
             ? offsets(kept_samples, options.straightness_window * x_height)
@@ -460,8 +457,9 @@ TextResult DetectTextSegments(const InkComponents& ink, const FeaturesOptions& o
       kept_mark.push_back(kept_samples[k].mark);
     }
     for (auto [first, last] : SplitWhereBent(smooth, tolerance)) {
-      // The line is fitted to the samples near the running median; the few
-      // that stray from it (serifs, a descender's stub) would tilt it.
+      // Each piece's line is fitted to its samples within half the tolerance
+      // of the running median: the few farther off (serifs, a descender's
+      // stub) would tilt it.
       std::vector<cv::Point2d> piece;
       for (int k = first; k <= last; ++k)
         if (std::abs(noise[size_t(k)]) <= 0.5 * tolerance) piece.push_back(kept[size_t(k)]);
