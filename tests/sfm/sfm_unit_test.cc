@@ -426,6 +426,18 @@ TEST(UndistortTest, DistortedPixelMovesToThePinholeProjection) {
   EXPECT_EQ(cv::norm(sfm::UndistortPhoto(photo, plain), photo, cv::NORM_INF), 0);
 }
 
+TEST(UndistortTest, LeavesNoDarkFrameAtTheBorder) {
+  // A slight distortion (set08's sfm estimated k = 0.00077) maps the last row
+  // and column a fraction of a pixel past the photo: they must stay paper.
+  const cv::Mat photo(480, 640, CV_8UC3, cv::Scalar(200, 200, 200));
+  for (const double k : {0.0008, -0.0008, 0.05}) {
+    const cv::Mat out = sfm::UndistortPhoto(photo, SimpleRadial(500, 640, 480, k));
+    double darkest = 0;
+    cv::minMaxLoc(out.reshape(1), &darkest);
+    EXPECT_GE(darkest, 195) << "k " << k;
+  }
+}
+
 TEST(SubprocessTest, CapturesLinesExitCodeAndLog) {
   TempDir tmp;
   std::vector<std::string> lines;
