@@ -31,8 +31,9 @@ int Boundary::RealSides() const {
   return n;
 }
 
-Boundary ReadBoundary(const fs::path& file) {
-  const Json doc = ReadJsonFile(file);
+Boundary ReadBoundary(const fs::path& file) { return ParseBoundary(ReadJsonFile(file), file); }
+
+Boundary ParseBoundary(const Json& doc, const fs::path& file) {
   CheckFormat(doc, file, "docunfold.boundary", 1);
   JsonReader r(doc, file);
   Boundary b;
@@ -50,6 +51,14 @@ Boundary ReadBoundary(const fs::path& file) {
     if (!real.is_boolean()) r.Fail(p + "/real", "expected true or false");
     b.sides[i].real = real.get<bool>();
     b.sides[i].points = Polyline(r, p + "/points", 2);
+    if (b.sides[i].real) {
+      b.sides[i].real_parts = {b.sides[i].points};
+    } else if (r.Has(p + "/real_parts")) {
+      const Json& parts = r.At(p + "/real_parts");
+      if (!parts.is_array()) r.Fail(p + "/real_parts", "expected an array of polylines");
+      for (size_t k = 0; k < parts.size(); ++k)
+        b.sides[i].real_parts.push_back(Polyline(r, p + "/real_parts/" + std::to_string(k), 2));
+    }
   }
   return b;
 }

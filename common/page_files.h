@@ -15,6 +15,7 @@
 #include <opencv2/core.hpp>
 
 #include "common/camera.h"
+#include "common/json_io.h"
 
 namespace docunfold {
 
@@ -25,6 +26,9 @@ inline const char* const kSideNames[4] = {"top", "right", "bottom", "left"};
 struct BoundarySide {
   std::vector<Eigen::Vector2d> points;  // reference-image pixels
   bool real = false;  // false where the page is cut off by the image border
+  // Pieces of `points` that are page edge: all of it when real; those of a
+  // cut side when the file lists them (real_parts), else none.
+  std::vector<std::vector<Eigen::Vector2d>> real_parts;
 };
 
 struct Boundary {
@@ -38,6 +42,8 @@ struct Boundary {
 };
 
 Boundary ReadBoundary(const fs::path& file);
+// The same from a parsed document; `file` names it in errors.
+Boundary ParseBoundary(const Json& doc, const fs::path& file);
 
 struct FeatureSegment {
   std::string kind;                     // "text" or "edge"

@@ -31,6 +31,8 @@
 #                        further rows: any image the pipeline leaves in the work
 #                        directory, evaluated like the others
 #
+# Per set, the front end (20_boundary/, 30_features/) is measured against the
+# truth in sfm's reference view (evaluate --front-end -> 70_eval/front_end.json).
 # Rows per set: homography and oracle (build/bin/baseline), docunfold
 # (60_render/rectified.png) when render ran, and, when the binaries exist,
 # docunfold-init (render on 40_init), docunfold-nofeatures and
@@ -251,6 +253,14 @@ run_set() {  # run_set <data dir> <work dir>
   fi
   echo "$status" > "$work/bench/pipeline.exit"
   [[ $status -eq 0 ]] || echo "bench: pipeline failed (exit $status; see $work/bench/pipeline.log)" >&2
+  # The front end against the truth in sfm's reference view (issue 3's
+  # figures): boundary IoU, corners, real sides; features precision, recall.
+  if [[ -f $work/10_sfm/cameras.json && -f $data/ground_truth/mesh.ply ]]; then
+    "$timer" "$work/bench/timings.jsonl" "evaluate:front-end" "$bin/evaluate" --front-end \
+      --data "$data" --work "$work" --out "$work/70_eval/front_end.json" \
+      >> "$work/bench/front_end.log" 2>&1 ||
+      echo "bench: evaluate --front-end failed: $(tail -n 1 "$work/bench/front_end.log")" >&2
+  fi
   if [[ ! -f $data/ground_truth/flat.png ]]; then
     record "-" skipped "" "" "" "no ground_truth/flat.png: not evaluated"
     return

@@ -9,8 +9,43 @@
 #include "common/cli.h"
 #include "common/json_io.h"
 #include "stages/evaluate/evaluate.h"
+#include "stages/evaluate/front_end.h"
 
 using namespace docunfold;
+
+namespace {
+
+void RunFrontEnd(const evaluate::EvaluateInputs& in, const fs::path& out) {
+  if (!evaluate::HasTrueSurface(in.data)) {
+    Log("note: " + in.data.string() +
+        " has no true surface (ground_truth/mesh.ply, cameras.json, page.json, flat.png); "
+        "nothing to measure, no metrics written");
+    return;
+  }
+  std::error_code ec;
+  if (!fs::is_regular_file(in.work / "10_sfm" / "cameras.json", ec))
+    throw InputError((in.work / "10_sfm" / "cameras.json").string() + ": no such file");
+  const evaluate::FrontEndResult r = evaluate::RunFrontEnd({in.data, in.work});
+  EnsureDirectory(out.parent_path().empty() ? fs::path(".") : out.parent_path());
+  WriteJsonAtomic(out, r.document);
+  std::string summary = "front end in " + r.reference + ":";
+  char buf[160];
+  if (r.has_boundary) {
+    std::snprintf(buf, sizeof buf,
+                  " boundary IoU %.4f, worst corner %.2f %% of the diagonal, %d side(s) not real;",
+                  r.boundary.iou, 100 * r.boundary.WorstCornerFraction(),
+                  r.boundary.sides_not_real);
+    summary += buf;
+  }
+  if (r.has_lines) {
+    std::snprintf(buf, sizeof buf, " features precision %.3f, recall %.3f", r.lines.precision,
+                  r.lines.recall);
+    summary += buf;
+  }
+  Log(summary + " -> " + out.string());
+}
+
+}  // namespace
 
 
 int main(int argc, char** argv) {
@@ -22,14 +57,23 @@ int main(int argc, char** argv) {
       "surface, the surface distance and isometry error. Writes a "
       "docunfold.metrics JSON file. A data set without ground_truth/flat.png "
       "is skipped with a note (exit 0, nothing written). Tesseract runs "
-      "single-threaded (OMP_THREAD_LIMIT=1 unless set): faster on few cores."};
+      "single-threaded (OMP_THREAD_LIMIT=1 unless set): faster on few cores.\n"
+      "With --front-end it judges the pipeline's front end instead: "
+      "<work>/20_boundary (page region IoU, corners, real sides) and "
+      "<work>/30_features (segment precision and recall against the page's "
+      "true lines) in sfm's reference view, as a docunfold.front-end-metrics "
+      "file (needs the true surface: ground_truth/mesh.ply, cameras.json)."};
   evaluate::EvaluateInputs in;
   evaluate::EvaluateOptions options;
   fs::path out;
   app.add_option("--data", in.data, "data set folder")->required();
   app.add_option("--work", in.work,
                  "work directory (meshes, 10_sfm/cameras.json, OCR cache)");
-  app.add_option("--result", in.result, "rectified image to evaluate")->required();
+  app.add_option("--result", in.result, "rectified image to evaluate (not with --front-end)");
+  bool front_end = false;
+  app.add_flag("--front-end", front_end,
+               "measure 20_boundary/ and 30_features/ of --work against the ground "
+               "truth instead of a rectified image");
   app.add_option("--out", out, "metrics JSON to write")->required();
   app.add_option("--method", options.method, "label of this result (row name)")
       ->capture_default_str();
@@ -59,6 +103,13 @@ int main(int argc, char** argv) {
     std::error_code ec;
     if (!fs::is_directory(in.data, ec))
       throw InputError(in.data.string() + ": no such data set folder");
+    if (front_end) {
+      if (!in.result.empty()) throw UsageError("--result and --front-end exclude each other");
+      if (in.work.empty()) throw UsageError("--front-end needs --work");
+      RunFrontEnd(in, out);
+      return;
+    }
+    if (in.result.empty()) throw UsageError("--result is required (or --front-end)");
     if (!evaluate::HasGroundTruth(in.data)) {
       Log("note: " + in.data.string() +
           " has no ground_truth/flat.png; nothing to evaluate, no metrics written");

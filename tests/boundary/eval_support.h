@@ -1,9 +1,8 @@
 // What the boundary and feature tests share: every data set with ground
-// truth, the views to check in each, crops that cut the page off, and the
-// true page outline in a view.
+// truth, the views to check in each, and crops that cut the page off. The
+// figures themselves are evaluate's (stages/evaluate/front_end.h).
 #pragma once
 
-#include <array>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -29,28 +28,5 @@ int MostFrontalView(const GroundTruth& gt);
 // pinhole camera with its principal point shifted and a smaller image).
 cv::Mat ReadView(const GroundTruth& gt, const PinholeCamera& camera);
 PinholeCamera CropCamera(const PinholeCamera& camera, const cv::Rect& crop);
-
-// The page's outline (the border of flat.png carried by the true surface)
-// projected into `camera`, about every `step_px` flat pixels; points outside
-// the image or hidden by the page are left out, so it may be in pieces.
-std::vector<std::vector<Eigen::Vector2d>> TrueOutlineInView(const GroundTruth& gt,
-                                                            const PinholeCamera& camera,
-                                                            double step_px = 2.0);
-
-// How a view shows each true corner (TrueCorners order): outside the image
-// (or within `margin_px` of its border), visible, or hidden by the page
-// itself (a flap folded over it).
-enum class CornerView { kOutside, kVisible, kHidden };
-std::array<CornerView, 4> TrueCornersInView(const GroundTruth& gt, const PinholeCamera& camera,
-                                            double margin_px = 3.0);
-
-// Mean length of the two diagonals of the true corners in the view.
-double ProjectedDiagonal(const GroundTruth& gt, const PinholeCamera& camera);
-
-// Distance from `p` to the nearest segment of any of `lines`.
-double DistanceToPolylines(const Eigen::Vector2d& p,
-                           const std::vector<std::vector<Eigen::Vector2d>>& lines);
-
-double IntersectionOverUnion(const cv::Mat1b& a, const cv::Mat1b& b);
 
 }  // namespace docunfold::testing

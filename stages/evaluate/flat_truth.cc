@@ -1,4 +1,6 @@
-#include "tests/features/flat_truth.h"
+// LinesFromFlatScan (ground_truth.h): the true lines of a page read off its
+// flat scan.
+#include "stages/evaluate/ground_truth.h"
 
 #include <algorithm>
 #include <cmath>
@@ -6,7 +8,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-namespace docunfold::testing {
+namespace docunfold::evaluate {
 namespace {
 
 double Median(std::vector<double> v) {
@@ -100,4 +102,4 @@ std::vector<TrueLine> LinesFromFlatScan(const GroundTruth& gt) {
   return out;
 }
 
-}  // namespace docunfold::testing
+}  // namespace docunfold::evaluate
