@@ -179,10 +179,16 @@ $(RENDER_OUT) &: $(BIN)/render $(WORK)/.flags/render $(WORK)/$(MESH_STAGE)/mesh3
 	$(call timed,render) $(BIN)/render --sfm $(WORK)/10_sfm --boundary $(WORK)/20_boundary --meshes $(WORK)/$(MESH_STAGE) --out $(WORK)/60_render --images $(DATA_DIR)/images --features $(WORK)/30_features/features.json $(RENDER_FLAGS)
 
 EVAL_OUT := $(WORK)/70_eval/metrics.json
-evaluate: check-data render $(EVAL_OUT)
+# The front end (20_boundary/, 30_features/) against the truth in the
+# reference view, where the data set has a true surface.
+HAS_TRUE_SURFACE := $(wildcard $(DATA_DIR)/ground_truth/mesh.ply)
+FRONT_END_OUT := $(if $(HAS_TRUE_SURFACE),$(WORK)/70_eval/front_end.json)
+evaluate: check-data render $(EVAL_OUT) $(FRONT_END_OUT)
 $(EVAL_OUT): $(BIN)/evaluate $(WORK)/.flags/evaluate $(WORK)/60_render/rectified.png
 	@test -n "$(HAS_GT)" || { echo "pipeline.mk: $(DATA_DIR): no ground_truth/flat.png to evaluate against" >&2; exit 3; }
 	$(call timed,evaluate) $(BIN)/evaluate --data $(DATA_DIR) --work $(WORK) --result $(WORK)/60_render/rectified.png --out $@ $(EVAL_FLAGS)
+$(WORK)/70_eval/front_end.json: $(BIN)/evaluate $(SFM_IN) $(BOUNDARY_IN) $(WORK)/30_features/features.json
+	$(call timed,evaluate-front-end) $(BIN)/evaluate --front-end --data $(DATA_DIR) --work $(WORK) --out $@
 
 # The report is redrawn whenever a stage's output is newer.
 REPORT_OUT := $(WORK)/report.html
@@ -190,7 +196,7 @@ report: check-data $(REPORT_OUT)
 STAGE_OUTPUTS := sfm:SFM_OUT boundary:BOUNDARY_OUT points:POINTS_OUT features:FEATURES_OUT init:INIT_OUT \
   optimize:OPTIMIZE_OUT render:RENDER_OUT
 REPORT_IN := $(foreach s,$(STAGE_OUTPUTS),$(if $(filter $(word 1,$(subst :, ,$(s))),$(IMPLEMENTED)),$($(word 2,$(subst :, ,$(s)))))) \
-  $(if $(and $(HAS_GT),$(wildcard $(ROOT)/stages/evaluate)),$(EVAL_OUT))
+  $(if $(and $(HAS_GT),$(wildcard $(ROOT)/stages/evaluate)),$(EVAL_OUT) $(FRONT_END_OUT))
 $(REPORT_OUT): $(BIN)/report $(REPORT_IN) | check-data
 	$(BIN)/report --data $(DATA_DIR) --work $(WORK) --out $@
 
@@ -221,7 +227,8 @@ help:
 	@echo "  init           initial 3D mesh M and flat mesh M' -> 40_init/"
 	@echo "  optimize       joint isometric optimisation with feature lines -> 50_optimize/"
 	@echo "  render         the rectified, cropped page -> 60_render/"
-	@echo "  evaluate       metrics against ground truth -> 70_eval/ (sets with ground_truth/)"
+	@echo "  evaluate       metrics against ground truth -> 70_eval/ (sets with ground_truth/;"
+	@echo "                 front_end.json: boundary and features in the reference view)"
 	@echo "  report         one HTML page with every stage's output -> work/<name>/report.html"
 	@echo "  test           build, then run all tests (ctest)"
 	@echo "  build          configure and build build/bin/*"

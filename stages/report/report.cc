@@ -311,6 +311,33 @@ std::string MetricsRow(const Json& m) {
          cell("isometry_mean", "%.4f") + "</tr>";
 }
 
+// evaluate --front-end's figures in one sentence, misses marked.
+std::string FrontEndParagraph(const Json& f) {
+  auto number = [](const Json& o, const char* key, const char* format, double scale = 1) {
+    return o.contains(key) && o[key].is_number() ? Fmt(scale * o[key].get<double>(), format)
+                                                 : std::string("–");
+  };
+  auto miss = [](const Json& o, const char* key) {
+    return o.contains("holds") && !o["holds"].value(key, true) ? std::string(" ✗") : "";
+  };
+  std::string p = "<p>Front end against the ground truth in " +
+                  Escape(f.value("reference", "?")) + ": ";
+  const Json& b = f.value("boundary", Json::object());
+  if (b.contains("iou"))
+    p += "boundary IoU " + number(b, "iou", "%.4f") + miss(b, "iou") +
+         ", worst visible corner " + number(b, "worst_corner_fraction", "%.2f", 100) +
+         " % of the page diagonal" + miss(b, "corners") + ", " +
+         std::to_string(b.value("sides_not_real", 0)) + " side(s) flagged cut" +
+         (b.value("page_cut", false) ? " (the page is cut)" : "") + miss(b, "cut_flags") +
+         "; ";
+  const Json& l = f.value("features", Json::object());
+  if (l.contains("precision"))
+    p += "feature segments: precision " + number(l, "precision", "%.3f") +
+         miss(l, "precision") + ", recall " + number(l, "recall", "%.3f") + miss(l, "recall") +
+         (l.value("recall_required", false) ? "" : " (not required on this kind of page)");
+  return p + ". ✗ = short of issue 3's threshold (evaluate --front-end).</p>";
+}
+
 // The final feature lines of 50_optimize/lines.json (polylines in M') drawn
 // over rectified.png, through the map render used: the deskew rotation, the
 // crop, the scale and the quarter turns of render.json. Empty when render did
@@ -420,10 +447,14 @@ void ResultSection(const ReportOptions& o, const DataSet& data, const fs::path& 
     page->Add(t + "</table><p>MS-SSIM as on the DocUNet benchmark; LD and Li-D from DeepFlow; "
                   "CER and WER from Tesseract against the OCR of flat.png; surface: mean "
                   "distance of M to the true surface in % of the page diagonal.</p>");
-  } else if (data.has_ground_truth) {
-    page->Add(Missing("evaluate has not run yet."));
-  } else {
-    page->Add("<p>This data set has no ground truth, so nothing is measured.</p>");
+  }
+  const Json front = TryJson(o.work / "70_eval" / "front_end.json");
+  if (front.is_object() && front.value("format", "") == "docunfold.front-end-metrics")
+    page->Add(FrontEndParagraph(front));
+  if (metrics.empty()) {
+    page->Add(data.has_ground_truth
+                  ? Missing("evaluate has not run yet.")
+                  : "<p>This data set has no ground truth, so nothing is measured.</p>");
   }
   page->End();
 }

@@ -10,9 +10,9 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "stages/segment-boundary/segment_boundary.h"
 #include "common/page_files.h"
 #include "stages/evaluate/front_end.h"
+#include "stages/segment-boundary/segment_boundary.h"
 #include "tests/boundary/eval_support.h"
 #include "tests/support/test_support.h"
 
