@@ -255,6 +255,12 @@ std::vector<bool> PagePoints(const ColmapModel& model,
   return page;
 }
 
+double ReferenceScore(const ViewScore& s, double max_resolution,
+                      const ReferenceOptions& options) {
+  return std::pow(s.coverage, 4) * s.resolution / max_resolution * s.frontality *
+         std::max(0.0, 1.0 - options.hidden_penalty * s.hidden);
+}
+
 std::vector<ViewScore> ScoreReferenceViews(const ColmapModel& model,
                                            const std::map<std::string, cv::Mat1b>& masks,
                                            const ReferenceOptions& options) {
@@ -345,8 +351,7 @@ std::vector<ViewScore> ScoreReferenceViews(const ColmapModel& model,
     max_resolution = std::max(max_resolution, s.resolution);
     scores.push_back(s);
   }
-  for (ViewScore& s : scores)
-    s.score = std::pow(s.coverage, 4) * s.resolution / max_resolution * s.frontality;
+  for (ViewScore& s : scores) s.score = ReferenceScore(s, max_resolution, options);
   std::stable_sort(scores.begin(), scores.end(),
                    [](const ViewScore& a, const ViewScore& b) {
                      if (a.score != b.score) return a.score > b.score;
