@@ -120,6 +120,18 @@ Eigen::Vector2d JsonReader::Vector2(const std::string& pointer) const {
   return v;
 }
 
+std::vector<Eigen::Vector2d> JsonReader::Points(const std::string& pointer,
+                                                size_t min_points) const {
+  const Json& points = At(pointer);
+  if (!points.is_array() || points.size() < min_points)
+    Fail(pointer, "expected at least " + std::to_string(min_points) + " points");
+  std::vector<Eigen::Vector2d> out;
+  for (size_t k = 0; k < points.size(); ++k) out.push_back(Vector2(pointer + "/" + std::to_string(k)));
+  return out;
+}
+
+Json NumberOrNull(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
+
 Json ToJson(const Eigen::Matrix3d& m) {
   Json a = Json::array();
   for (int i = 0; i < 3; ++i) a.push_back({m(i, 0), m(i, 1), m(i, 2)});

@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include <Eigen/Core>
 #include <nlohmann/json.hpp>
@@ -42,6 +43,8 @@ class JsonReader {
   Eigen::Vector3d Vector3(const std::string& pointer) const;
   // [x, y], both finite numbers.
   Eigen::Vector2d Vector2(const std::string& pointer) const;
+  // An array of at least `min_points` [x, y] (a polyline).
+  std::vector<Eigen::Vector2d> Points(const std::string& pointer, size_t min_points) const;
   // Throws InputError for `pointer` with the given problem.
   [[noreturn]] void Fail(const std::string& pointer,
                          const std::string& problem) const;
@@ -51,6 +54,9 @@ class JsonReader {
   const Json& doc_;
   fs::path file_;
 };
+
+// `v`, or null where it is NaN or infinite (JSON has neither).
+Json NumberOrNull(double v);
 
 Json ToJson(const Eigen::Matrix3d& m);
 Json ToJson(const Eigen::Vector3d& v);

@@ -10,20 +10,6 @@
 #include "common/json_io.h"
 
 namespace docunfold {
-namespace {
-
-std::vector<Eigen::Vector2d> Polyline(const JsonReader& r, const std::string& pointer,
-                                      size_t min_points) {
-  const Json& points = r.At(pointer);
-  if (!points.is_array() || points.size() < min_points)
-    r.Fail(pointer, "expected at least " + std::to_string(min_points) + " points");
-  std::vector<Eigen::Vector2d> out;
-  for (size_t k = 0; k < points.size(); ++k)
-    out.push_back(r.Vector2(pointer + "/" + std::to_string(k)));
-  return out;
-}
-
-}  // namespace
 
 int Boundary::RealSides() const {
   int n = 0;
@@ -41,7 +27,7 @@ Boundary ParseBoundary(const Json& doc, const fs::path& file) {
   b.width = r.Integer("/width");
   b.height = r.Integer("/height");
   if (b.width <= 0 || b.height <= 0) r.Fail("/width", "image size must be positive");
-  b.contour = Polyline(r, "/contour", 3);
+  b.contour = r.Points("/contour", 3);
   const Json& corners = r.At("/corners");
   if (!corners.is_array() || corners.size() != 4) r.Fail("/corners", "expected 4 points");
   for (int i = 0; i < 4; ++i) b.corners[i] = r.Vector2("/corners/" + std::to_string(i));
@@ -50,14 +36,14 @@ Boundary ParseBoundary(const Json& doc, const fs::path& file) {
     const Json& real = r.At(p + "/real");
     if (!real.is_boolean()) r.Fail(p + "/real", "expected true or false");
     b.sides[i].real = real.get<bool>();
-    b.sides[i].points = Polyline(r, p + "/points", 2);
+    b.sides[i].points = r.Points(p + "/points", 2);
     if (b.sides[i].real) {
       b.sides[i].real_parts = {b.sides[i].points};
     } else if (r.Has(p + "/real_parts")) {
       const Json& parts = r.At(p + "/real_parts");
       if (!parts.is_array()) r.Fail(p + "/real_parts", "expected an array of polylines");
       for (size_t k = 0; k < parts.size(); ++k)
-        b.sides[i].real_parts.push_back(Polyline(r, p + "/real_parts/" + std::to_string(k), 2));
+        b.sides[i].real_parts.push_back(r.Points(p + "/real_parts/" + std::to_string(k), 2));
     }
   }
   return b;
@@ -86,7 +72,7 @@ FeatureFile ReadFeatures(const fs::path& file) {
     s.kind = r.String(p + "/kind");
     if (s.kind != "text" && s.kind != "edge")
       r.Fail(p + "/kind", "expected \"text\" or \"edge\", found \"" + s.kind + "\"");
-    s.points = Polyline(r, p + "/points", 2);
+    s.points = r.Points(p + "/points", 2);
     f.segments.push_back(std::move(s));
   }
   return f;

@@ -46,8 +46,6 @@ std::string CacheKey(const fs::path& file, const std::string& settings) {
   return hex;
 }
 
-Json Number(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
-
 Json SizeJson(cv::Size s) { return Json::array({s.width, s.height}); }
 
 Json Skipped(const std::string& why) { return Json{{"skipped", why}}; }
@@ -78,10 +76,10 @@ Json ScoresJson(const TextScores& s) {
   return Json{{"ed", s.ed},
               {"reference_chars", s.reference_chars},
               {"result_chars", s.result_chars},
-              {"cer", Number(s.cer)},
+              {"cer", NumberOrNull(s.cer)},
               {"word_ed", s.word_ed},
               {"reference_words", s.reference_words},
-              {"wer", Number(s.wer)}};
+              {"wer", NumberOrNull(s.wer)}};
 }
 
 Json EvaluateOcr(const EvaluateInputs& in, const EvaluateOptions& options,
@@ -127,8 +125,8 @@ Json EvaluateOcr(const EvaluateInputs& in, const EvaluateOptions& options,
     m->wer_text = t.wer;
     Json tj = ScoresJson(t);
     tj["reference"] = "ground_truth/text.txt, whitespace collapsed";
-    tj["flat_cer"] = Number(f.cer);  // what OCR achieves on the flat scan
-    tj["flat_wer"] = Number(f.wer);
+    tj["flat_cer"] = NumberOrNull(f.cer);  // what OCR achieves on the flat scan
+    tj["flat_wer"] = NumberOrNull(f.wer);
     out["text_txt"] = tj;
   } else {
     out["text_txt"] = nullptr;
@@ -190,8 +188,8 @@ Json EvaluateGeometry(const EvaluateInputs& in, const EvaluateOptions& options,
         {"cameras", alignment->cameras},
         {"scale", alignment->truth_from_sfm.scale},
         {"residual_pct", 100 * alignment->rms_residual / diagonal}};
-    out["surface_distance"] = {{"mean_pct", Number(m->surface_mean_pct)},
-                               {"max_pct", Number(m->surface_max_pct)},
+    out["surface_distance"] = {{"mean_pct", NumberOrNull(m->surface_mean_pct)},
+                               {"max_pct", NumberOrNull(m->surface_max_pct)},
                                {"vertices", d.samples}};
   }
   if (fs::is_regular_file(mesh_dir / "mesh2d.ply", ec)) {
@@ -290,18 +288,18 @@ EvaluateResult Run(const EvaluateInputs& in, const EvaluateOptions& options) {
   doc["ground_truth"] = flat_path.string();
   doc["result_size"] = SizeJson(result.size());
   doc["ground_truth_size"] = SizeJson(flat.size());
-  doc["metrics"] = {{"ms_ssim", Number(m.ms_ssim)},
-                    {"ld", Number(m.ld)},
-                    {"li_d", Number(m.li_d)},
-                    {"cer", Number(m.cer)},
+  doc["metrics"] = {{"ms_ssim", NumberOrNull(m.ms_ssim)},
+                    {"ld", NumberOrNull(m.ld)},
+                    {"li_d", NumberOrNull(m.li_d)},
+                    {"cer", NumberOrNull(m.cer)},
                     {"ed", std::isfinite(m.ed) ? Json(int64_t(m.ed)) : Json(nullptr)},
-                    {"wer", Number(m.wer)},
-                    {"cer_text", Number(m.cer_text)},
-                    {"wer_text", Number(m.wer_text)},
-                    {"surface_mean_pct", Number(m.surface_mean_pct)},
-                    {"surface_max_pct", Number(m.surface_max_pct)},
-                    {"isometry_mean", Number(m.isometry_mean)},
-                    {"isometry_max", Number(m.isometry_max)}};
+                    {"wer", NumberOrNull(m.wer)},
+                    {"cer_text", NumberOrNull(m.cer_text)},
+                    {"wer_text", NumberOrNull(m.wer_text)},
+                    {"surface_mean_pct", NumberOrNull(m.surface_mean_pct)},
+                    {"surface_max_pct", NumberOrNull(m.surface_max_pct)},
+                    {"isometry_mean", NumberOrNull(m.isometry_mean)},
+                    {"isometry_max", NumberOrNull(m.isometry_max)}};
   doc["ms_ssim"] = ms_json;
   doc["flow"] = flow_json;
   doc["ocr"] = ocr_json;

@@ -31,7 +31,10 @@ double DistanceToPolylines(const Eigen::Vector2d& p,
   return best;
 }
 
-// Calls `visit(point, length)` about every pixel along a polyline.
+// Calls `visit(point, length)` about every `step_px` along a polyline, each
+// piece of it standing for `length`; with step_px = kEverySegment, once per
+// segment at its midpoint.
+constexpr double kEverySegment = std::numeric_limits<double>::infinity();
 template <typename Visit>
 void WalkPolyline(const Polyline& line, double step_px, Visit visit) {
   for (size_t k = 0; k + 1 < line.size(); ++k) {
@@ -42,6 +45,11 @@ void WalkPolyline(const Polyline& line, double step_px, Visit visit) {
   }
 }
 
+// part / whole, or `if_empty` when there is nothing to share.
+double Share(double part, double whole, double if_empty) {
+  return whole > 0 ? part / whole : if_empty;
+}
+
 cv::Mat ToCvK(const Eigen::Matrix3d& K) {
   cv::Mat out(3, 3, CV_64F);
   for (int r = 0; r < 3; ++r)
@@ -49,9 +57,11 @@ cv::Mat ToCvK(const Eigen::Matrix3d& K) {
   return out;
 }
 
-Json Number(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
-
 }  // namespace
+
+void SegmentIndex::AddPolyline(const std::vector<Eigen::Vector2d>& points) {
+  for (size_t k = 0; k + 1 < points.size(); ++k) Add(points[k], points[k + 1]);
+}
 
 void SegmentIndex::Add(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
   const int id = int(segments_.size());
@@ -163,7 +173,7 @@ BoundaryFigures MeasureBoundary(const TruthInView& truth, const cv::Mat1b& mask,
   const cv::Mat1b detected = mask > 0;
   const double inter = cv::countNonZero(detected & truth.page);
   const double uni = cv::countNonZero(detected | truth.page);
-  f.iou = uni > 0 ? inter / uni : 0.0;
+  f.iou = Share(inter, uni, 0);
   f.diagonal_px = truth.diagonal;
   f.page_cut = truth.page_cut;
   int nearest_to_tl = -1;
@@ -205,14 +215,13 @@ BoundaryFigures MeasureBoundary(const TruthInView& truth, const cv::Mat1b& mask,
   }
   double covered = 0, total = 0;
   for (const Polyline& piece : truth.outline)
-    for (size_t k = 0; k + 1 < piece.size(); ++k) {
-      const double l = (piece[k + 1] - piece[k]).norm();
-      total += l;
-      if (DistanceToPolylines(0.5 * (piece[k] + piece[k + 1]), real) <=
-          kCornerTolerance * f.diagonal_px)
-        covered += l;
-    }
-  f.edge_recall = total > 0 ? covered / total : 0;
+    WalkPolyline(
+        piece, kEverySegment, [&](const Eigen::Vector2d& m, double length) {
+          total += length;
+          if (DistanceToPolylines(m, real) <= kCornerTolerance * f.diagonal_px)
+            covered += length;
+        });
+  f.edge_recall = Share(covered, total, 0);
   return f;
 }
 
@@ -220,16 +229,13 @@ LineFigures MeasureLines(const TruthInView& truth,
                          const std::vector<FeatureSegment>& segments) {
   SegmentIndex true_text(8), true_edge(8), found_text(8), found_edge(8);
   for (const TrueLine& l : truth.lines)
-    for (size_t k = 0; k + 1 < l.points.size(); ++k)
-      (l.kind == "text" ? true_text : true_edge)
-          .Add(l.points[k], l.points[k + 1]);
+    (l.kind == "text" ? true_text : true_edge).AddPolyline(l.points);
   LineFigures f;
   double good_text = 0, all_text = 0, good_edge = 0, all_edge = 0;
   for (const FeatureSegment& s : segments) {
     const bool text = s.kind == "text";
     (text ? f.text_segments : f.edge_segments)++;
-    for (size_t k = 0; k + 1 < s.points.size(); ++k)
-      (text ? found_text : found_edge).Add(s.points[k], s.points[k + 1]);
+    (text ? found_text : found_edge).AddPolyline(s.points);
     WalkPolyline(s.points, 1.0, [&](const Eigen::Vector2d& p, double length) {
       const bool good =
           (text ? true_text : true_edge).Distance(p) <= kLineTolerancePx;
@@ -238,10 +244,9 @@ LineFigures MeasureLines(const TruthInView& truth,
     });
   }
   f.detected_length = all_text + all_edge;
-  f.precision_text = all_text > 0 ? good_text / all_text : 1.0;
-  f.precision_edge = all_edge > 0 ? good_edge / all_edge : 1.0;
-  f.precision =
-      f.detected_length > 0 ? (good_text + good_edge) / f.detected_length : 1.0;
+  f.precision_text = Share(good_text, all_text, 1);
+  f.precision_edge = Share(good_edge, all_edge, 1);
+  f.precision = Share(good_text + good_edge, f.detected_length, 1);
   // Recall inside the region detect-features searches by default: the page
   // less a margin of 0.6 % of the image diagonal (at least 4 px).
   const int margin = std::max(
@@ -254,38 +259,36 @@ LineFigures MeasureLines(const TruthInView& truth,
   for (const TrueLine& l : truth.lines) {
     if (l.kind == "border") continue;
     const bool text = l.kind == "text";
-    for (size_t k = 0; k + 1 < l.points.size(); ++k) {
-      const Eigen::Vector2d m = 0.5 * (l.points[k] + l.points[k + 1]);
-      const int x = int(std::lround(m.x())), y = int(std::lround(m.y()));
-      if (x < 0 || y < 0 || x >= region.cols || y >= region.rows ||
-          !region(y, x))
-        continue;
-      const double length = (l.points[k + 1] - l.points[k]).norm();
-      const bool covered =
-          (text ? found_text : found_edge).Distance(m) <= kLineTolerancePx;
-      (text ? length_text : length_rule) += length;
-      (text ? covered_text : covered_rule) += covered ? length : 0.0;
-    }
+    WalkPolyline(
+        l.points, kEverySegment, [&](const Eigen::Vector2d& m, double length) {
+          const int x = int(std::lround(m.x())), y = int(std::lround(m.y()));
+          if (x < 0 || y < 0 || x >= region.cols || y >= region.rows ||
+              !region(y, x))
+            return;
+          const bool covered =
+              (text ? found_text : found_edge).Distance(m) <= kLineTolerancePx;
+          (text ? length_text : length_rule) += length;
+          (text ? covered_text : covered_rule) += covered ? length : 0.0;
+        });
   }
   f.true_length = length_text + length_rule;
-  f.recall_text = length_text > 0 ? covered_text / length_text : 0;
-  f.recall_rule = length_rule > 0 ? covered_rule / length_rule : 0;
-  f.recall =
-      f.true_length > 0 ? (covered_text + covered_rule) / f.true_length : 0;
+  f.recall_text = Share(covered_text, length_text, 0);
+  f.recall_rule = Share(covered_rule, length_rule, 0);
+  f.recall = Share(covered_text + covered_rule, f.true_length, 0);
   return f;
 }
 
 Json ToJson(const BoundaryFigures& f) {
-  return {{"iou", Number(f.iou)},
-          {"diagonal_px", Number(f.diagonal_px)},
-          {"worst_corner_px", Number(f.worst_corner_px)},
-          {"worst_corner_fraction", Number(f.WorstCornerFraction())},
+  return {{"iou", NumberOrNull(f.iou)},
+          {"diagonal_px", NumberOrNull(f.diagonal_px)},
+          {"worst_corner_px", NumberOrNull(f.worst_corner_px)},
+          {"worst_corner_fraction", NumberOrNull(f.WorstCornerFraction())},
           {"corners_seen", f.corners_seen},
           {"corner_hidden", f.corner_hidden},
           {"corners_in_order", f.corners_in_order},
-          {"real_off_edge_px", Number(f.real_off_edge_px)},
-          {"real_off_edge_max_px", Number(f.real_off_edge_max_px)},
-          {"edge_recall", Number(f.edge_recall)},
+          {"real_off_edge_px", NumberOrNull(f.real_off_edge_px)},
+          {"real_off_edge_max_px", NumberOrNull(f.real_off_edge_max_px)},
+          {"edge_recall", NumberOrNull(f.edge_recall)},
           {"page_cut", f.page_cut},
           {"sides_not_real", f.sides_not_real},
           {"holds",
@@ -296,14 +299,14 @@ Json ToJson(const BoundaryFigures& f) {
 }
 
 Json ToJson(const LineFigures& f) {
-  return {{"precision", Number(f.precision)},
-          {"precision_text", Number(f.precision_text)},
-          {"precision_edge", Number(f.precision_edge)},
-          {"recall", Number(f.recall)},
-          {"recall_text", Number(f.recall_text)},
-          {"recall_rule", Number(f.recall_rule)},
-          {"detected_length_px", Number(f.detected_length)},
-          {"true_length_px", Number(f.true_length)},
+  return {{"precision", NumberOrNull(f.precision)},
+          {"precision_text", NumberOrNull(f.precision_text)},
+          {"precision_edge", NumberOrNull(f.precision_edge)},
+          {"recall", NumberOrNull(f.recall)},
+          {"recall_text", NumberOrNull(f.recall_text)},
+          {"recall_rule", NumberOrNull(f.recall_rule)},
+          {"detected_length_px", NumberOrNull(f.detected_length)},
+          {"true_length_px", NumberOrNull(f.true_length)},
           {"text_segments", f.text_segments},
           {"edge_segments", f.edge_segments}};
 }

@@ -37,6 +37,7 @@ class SegmentIndex {
  public:
   explicit SegmentIndex(double cell) : cell_(cell) {}
   void Add(const Eigen::Vector2d& a, const Eigen::Vector2d& b);
+  void AddPolyline(const std::vector<Eigen::Vector2d>& points);
   // Distance to the nearest segment; +inf beyond about one cell.
   double Distance(const Eigen::Vector2d& p) const;
 

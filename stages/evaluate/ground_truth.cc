@@ -45,10 +45,7 @@ GroundTruth LoadGroundTruth(const fs::path& dataset) {
       const std::string p = "/lines/" + std::to_string(i);
       TrueLine line;
       line.kind = r.String(p + "/kind");
-      const Json& points = r.At(p + "/points");
-      if (!points.is_array()) r.Fail(p + "/points", "expected an array of points");
-      for (size_t k = 0; k < points.size(); ++k)
-        line.points.push_back(r.Vector2(p + "/points/" + std::to_string(k)));
+      line.points = r.Points(p + "/points", 2);
       gt.lines.push_back(std::move(line));
     }
   }

@@ -63,8 +63,9 @@ TEST_P(FrontEndCli, TheTruthScoresPerfectlyAndDefectsAreCaught) {
       << b.dump();
   // The truth front end marks a cut side wholly not real (no real parts), so
   // the true outline is covered only where the page is whole.
-  if (!b["page_cut"].get<bool>())
+  if (!b["page_cut"].get<bool>()) {
     EXPECT_TRUE(b["holds"]["sides"].get<bool>()) << b.dump();
+  }
   const Json& f = doc["features"];
   EXPECT_GE(f["precision"].get<double>(), 0.99);
   EXPECT_GE(f["recall"].get<double>(), 0.85);

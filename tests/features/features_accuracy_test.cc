@@ -108,7 +108,7 @@ TEST_P(FeaturesOnDataSet, FlatScanLinesAgreeWithSynth) {
   if (gt->lines.empty()) GTEST_SKIP() << "no features.json to compare with";
   SegmentIndex synth_index(16), flat_index(16);
   for (const TrueLine& l : gt->lines)
-    for (size_t k = 0; k + 1 < l.points.size(); ++k) synth_index.Add(l.points[k], l.points[k + 1]);
+    synth_index.AddPolyline(l.points);
   double length = 0, good = 0;
   for (const TrueLine& l : LinesFromFlatScan(*gt)) {
     const Eigen::Vector2d a = l.points.front(), b = l.points.back();
