@@ -121,4 +121,14 @@ void AddIsoEdgesOption(CLI::App& app, double* iso_edges) {
       ->capture_default_str()->check(CLI::Range(0.0, 100.0));
 }
 
+void AddFlatFairnessOption(CLI::App& app, bool* bending) {
+  app.add_option_function<std::string>(
+         "--flat-fairness", [bending](const std::string& mode) { *bending = mode == "bending"; },
+         "E_fair(M'): uniform (the paper: both coordinates of every second difference along "
+         "the grid lines) or bending (only its component across the line, so M' spaces "
+         "vertices as unevenly as the isometry asks)")
+      ->check(CLI::IsMember({"uniform", "bending"}))
+      ->default_str(*bending ? "bending" : "uniform");
+}
+
 }  // namespace docunfold

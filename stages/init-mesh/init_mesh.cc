@@ -834,6 +834,8 @@ Json OptionsToJson(const Options& o) {
         {"iso_normalization",
          r.iso_normalization == isometry::IsoNormalization::kStrain ? "strain" : "raw"},
         {"iso_edges", r.iso_edges},
+        {"flat_fairness",
+         r.flat_fairness == isometry::FlatFairness::kBending ? "bending" : "uniform"},
         {"outline_hold", o.outline_hold},
         {"outline_hold_max_angle_deg", o.outline_hold_max_angle_deg},
         {"outline_hold_support", o.outline_hold_support},

@@ -152,7 +152,7 @@ TEST(Isometry, AnalyticJacobianMatchesFiniteDifferencesForEveryTerm) {
     d.markers.push_back(m);
   }
   const double h = 1e-6;
-  for (int term = 0; term < isometry::internal::kNumTerms; ++term) {
+  const auto check = [&](int term) {
     const std::vector<Row> rows = RowsOf(s, d, term);
     ASSERT_FALSE(rows.empty()) << "term " << term;
     double worst = 0;
@@ -194,7 +194,11 @@ TEST(Isometry, AnalyticJacobianMatchesFiniteDifferencesForEveryTerm) {
               << "term " << term << " row " << k << " line " << l;
         }
       }
-  }
+  };
+  for (int term = 0; term < isometry::internal::kNumTerms; ++term) check(term);
+  // E_fair(M') with only the bending across each grid line.
+  d.flat_fairness = isometry::FlatFairness::kBending;
+  check(isometry::internal::kFair2d);
 }
 
 class BlockMatrix : public ::testing::TestWithParam<std::pair<int, int>> {};
