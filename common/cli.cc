@@ -121,14 +121,13 @@ void AddIsoEdgesOption(CLI::App& app, double* iso_edges) {
       ->capture_default_str()->check(CLI::Range(0.0, 100.0));
 }
 
-void AddFlatFairnessOption(CLI::App& app, bool* bending) {
-  app.add_option_function<std::string>(
-         "--flat-fairness", [bending](const std::string& mode) { *bending = mode == "bending"; },
-         "E_fair(M'): uniform (the paper: both coordinates of every second difference along "
-         "the grid lines) or bending (only its component across the line, so M' spaces "
-         "vertices as unevenly as the isometry asks)")
-      ->check(CLI::IsMember({"uniform", "bending"}))
-      ->default_str(*bending ? "bending" : "uniform");
+void AddFair2dAlongOption(CLI::App& app, double* fair2d_along) {
+  app.add_option("--fair2d-along", *fair2d_along,
+                 "weight of E_fair(M') along each grid line against across it (1 = the "
+                 "paper's even spacing; 0 = bending only, so M' spaces vertices as unevenly "
+                 "as the isometry asks)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
 }
 
 }  // namespace docunfold

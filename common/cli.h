@@ -40,10 +40,9 @@ void AddFairnessBoostOptions(CLI::App& app, double* unsupported_fairness,
 // (isometry::SolveOptions::iso_edges documents it).
 void AddIsoEdgesOption(CLI::App& app, double* iso_edges);
 
-// --flat-fairness uniform|bending, the same in every stage that runs the
-// isometric solver (isometry::FlatFairness documents it); *bending is true
-// for "bending".
-void AddFlatFairnessOption(CLI::App& app, bool* bending);
+// --fair2d-along, the same in every stage that runs the isometric solver
+// (isometry::SolveOptions::fair2d_along documents it).
+void AddFair2dAlongOption(CLI::App& app, double* fair2d_along);
 
 // One plain line on stderr: "<program>: <message>".
 void Log(const std::string& message);

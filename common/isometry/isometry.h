@@ -105,11 +105,6 @@ struct Problem {
 };
 
 enum class IsoNormalization { kStrain, kRaw };
-// E_fair(M')'s rows: kUniform is the paper's |v'_i − 2 v'_j + v'_k|² (both
-// coordinates); kBending keeps only the component of the second difference
-// across the grid line (normal to v'_k − v'_i at the current M'), so M' may
-// space its vertices along a grid line as unevenly as the isometry asks.
-enum class FlatFairness { kUniform, kBending };
 enum class Method { kGaussNewton, kLbfgs };
 // How a Gauss-Newton step's normal equations are solved: sparse Cholesky
 // (CHOLMOD supernodal, symbolic analysis reused), block-Jacobi conjugate
@@ -141,12 +136,15 @@ struct SolveOptions {
   // rows per quad (0 = the paper). The diagonals alone leave a quad of M free
   // to twist out of its plane, which lengthens its edges.
   double iso_edges = 0;
-  // What E_fair(M') penalises (see FlatFairness). The paper's uniform rows
-  // also pull the vertices along each grid line toward even spacing, which
-  // the isometry cannot grant where the grid, even in the reference image,
-  // is uneven on the page: a panel seen at a grazing angle spans few grid
-  // rows, each long on the page, and M' shortened it.
-  FlatFairness flat_fairness = FlatFairness::kUniform;
+  // Weight of the part of E_fair(M') along each grid line, against the part
+  // across it (bending). 1 is the paper's |v'_i − 2 v'_j + v'_k|² (both parts
+  // alike); below 1 M' may space its vertices along a grid line as unevenly
+  // as the isometry asks. The paper's even spacing cannot be granted where
+  // the reference image's even grid is uneven on the page (a panel seen at a
+  // grazing angle: few grid rows, each long on the page), and M, held to M'
+  // by the isometry, swings such a panel about its fold where it has few
+  // points to hold it. 0 = bending only.
+  double fair2d_along = 1;
   // λ3 is multiplied by up to this where M has no inlier point within
   // support_radius (fraction of the model size, along M), reaching it at
   // twice that distance: blank paper then continues its panel's plane

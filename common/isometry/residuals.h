@@ -41,7 +41,7 @@ struct StepData {
   std::vector<Marker> markers;        // rays in the normalised frame
   double iso_scale = 1;               // multiplies every c_iso (see IsoNormalization)
   double iso_edge_weight = 0;         // edge rows' share of E_iso (SolveOptions::iso_edges)
-  FlatFairness flat_fairness = FlatFairness::kUniform;
+  double fair2d_along = 1;           // SolveOptions::fair2d_along
   double beta_point = 1;
   double beta_normal = 0.1;
   int num_inliers = 0;
@@ -181,30 +181,39 @@ inline std::array<int, 3> FairTriplet(const QuadGrid& g, int t) {
   const int c = t / (g.ny - 2), r = t % (g.ny - 2) + 1;
   return {g.Index(r - 1, c), g.Index(r, c), g.Index(r + 1, c)};
 }
-// dims 0..2 (M) or 3..4 (M'): one row per coordinate; M' under
-// FlatFairness::kBending one row, n·s with s = v'_i − 2 v'_j + v'_k and n the
-// unit normal of u = v'_k − v'_i. Exact derivatives: with a = t·s (t = u/|u|),
-// ∂(n·s)/∂u = −(a/|u|) n, so ∂/∂v'_i = (1 + a/|u|) n, ∂/∂v'_k = (1 − a/|u|) n.
+// dims 0..2 (M) or 3..4 (M'): one row per coordinate. M' with
+// fair2d_along < 1: s = v'_i − 2 v'_j + v'_k split along u = v'_k − v'_i
+// (t = u/|u|, n its normal): rows n·s and √fair2d_along t·s. Exact
+// derivatives: ∂(n·s)/∂u = −(t·s/|u|) n and ∂(t·s)/∂u = (n·s/|u|) n.
 inline int FairRows(const State& s, const StepData& data, int t, bool flat, Row* rows) {
   const auto v = FairTriplet(s.grid, t);
-  if (flat && data.flat_fairness == FlatFairness::kBending) {
+  if (flat && data.fair2d_along < 1) {
     const Eigen::Vector2d u = s.v2[v[2]] - s.v2[v[0]];
     const Eigen::Vector2d sd = s.v2[v[0]] - 2 * s.v2[v[1]] + s.v2[v[2]];
     const double len = u.norm();
-    Row& r = rows[0];
-    r.Reset();
-    if (!(len > 0)) {  // a collapsed triplet: no direction to bend across
-      r.Add(v[1]);
-      return 1;
+    if (!(len > 0)) {  // a collapsed triplet has no direction to split along
+      rows[0].Reset();
+      rows[0].Add(v[1]);
+      rows[1] = rows[0];
+      return 2;
     }
     const Eigen::Vector2d tangent = u / len;
-    const Eigen::Vector2d normal(-tangent.y(), tangent.x());
-    const double a = tangent.dot(sd) / len;
-    r.value = normal.dot(sd);
-    r.Add(v[0]).tail<2>() = (1 + a) * normal;
-    r.Add(v[1]).tail<2>() = -2 * normal;
-    r.Add(v[2]).tail<2>() = (1 - a) * normal;
-    return 1;
+    const Eigen::Vector2d normal = Eigen::Vector2d(-u.y(), u.x()) / len;
+    const double along = tangent.dot(sd), across = normal.dot(sd);
+    Row& bend = rows[0];
+    bend.Reset();
+    bend.value = across;
+    bend.Add(v[0]).tail<2>() = normal + (along / len) * normal;
+    bend.Add(v[1]).tail<2>() = -2 * normal;
+    bend.Add(v[2]).tail<2>() = normal - (along / len) * normal;
+    const double k = std::sqrt(data.fair2d_along);
+    Row& stretch = rows[1];
+    stretch.Reset();
+    stretch.value = k * along;
+    stretch.Add(v[0]).tail<2>() = k * (tangent - (across / len) * normal);
+    stretch.Add(v[1]).tail<2>() = -2 * k * tangent;
+    stretch.Add(v[2]).tail<2>() = k * (tangent + (across / len) * normal);
+    return 2;
   }
   const int first = flat ? 3 : 0, n = flat ? 2 : 3;
   const double scale =

@@ -226,7 +226,7 @@ Work Normalise(const Problem& p, const SolveOptions& o) {
     w.data.iso_scale = 1;
   }
   w.data.iso_edge_weight = o.iso_edges;
-  w.data.flat_fairness = o.flat_fairness;
+  w.data.fair2d_along = o.fair2d_along;
   w.weights = o.weights;
   return w;
 }

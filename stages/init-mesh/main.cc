@@ -88,8 +88,7 @@ int main(int argc, char** argv) {
                  "paper's sum of squared c_iso")
       ->capture_default_str()->check(CLI::IsMember({"strain", "raw"}));
   AddIsoEdgesOption(app, &o.refine.iso_edges);
-  bool flat_bending = o.refine.flat_fairness == isometry::FlatFairness::kBending;
-  AddFlatFairnessOption(app, &flat_bending);
+  AddFair2dAlongOption(app, &o.refine.fair2d_along);
   app.add_option("--outline-hold", o.outline_hold,
                  "weight of the term holding M's border to the page outline in the reference "
                  "image (sliding along it); 0 = off")
@@ -135,8 +134,6 @@ int main(int argc, char** argv) {
   app.add_flag("--verbose", verbose, "log every outer iteration of the refinement");
 
   return RunStage("init-mesh", app, argc, argv, [&] {
-    o.refine.flat_fairness =
-        flat_bending ? isometry::FlatFairness::kBending : isometry::FlatFairness::kUniform;
     const auto start = std::chrono::steady_clock::now();
     std::smatch match;
     if (!std::regex_match(grid, match, std::regex(R"((\d+)x(\d+))")))

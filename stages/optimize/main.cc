@@ -65,8 +65,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   AddFairnessBoostOptions(app, &o.unsupported_fairness, &o.support_radius);
   AddIsoEdgesOption(app, &o.iso_edges);
-  bool flat_bending = o.flat_fairness == isometry::FlatFairness::kBending;
-  AddFlatFairnessOption(app, &flat_bending);
+  AddFair2dAlongOption(app, &o.fair2d_along);
   app.add_option("--side-outliers", o.side_outliers,
                  "take samples inside a real page side off it when farther "
                  "than this fraction of M's diagonal, and 4 sigma of the "
@@ -132,8 +131,6 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_flag("--no-scene", no_scene, "do not write scene.glb");
   return RunStage("optimize", app, argc, argv, [&] {
-    o.flat_fairness =
-        flat_bending ? isometry::FlatFairness::kBending : isometry::FlatFairness::kUniform;
     if (solver == "gn") {
       o.method = isometry::Method::kGaussNewton;
     } else if (solver == "lbfgs") {
@@ -172,9 +169,7 @@ int main(int argc, char** argv) {
                                {"unsupported_fairness", o.unsupported_fairness},
                                {"support_radius", o.support_radius},
                                {"iso_edges", o.iso_edges},
-                               {"flat_fairness", o.flat_fairness == isometry::FlatFairness::kBending
-                                                     ? "bending"
-                                                     : "uniform"},
+                               {"fair2d_along", o.fair2d_along},
                                {"side_outliers", o.side_outliers},
                                {"line_spacing", o.line_spacing},
                                {"max_spacing_ratio", o.max_spacing_ratio},

@@ -119,7 +119,7 @@ OptimizeResult Run(const OptimizeInputs& in, const OptimizeOptions& o) {
     so.unsupported_fairness = o.unsupported_fairness;
     so.support_radius = o.support_radius;
     so.iso_edges = o.iso_edges;
-    so.flat_fairness = o.flat_fairness;
+    so.fair2d_along = o.fair2d_along;
     so.line_spacing = o.line_spacing;
     so.max_spacing_ratio = o.max_spacing_ratio;
     so.relative_tolerance = o.relative_tolerance;

@@ -49,7 +49,7 @@ struct OptimizeOptions {
   double unsupported_fairness = 1;
   double support_radius = 0.03;       // fraction of the model size
   double iso_edges = 0;               // isometry::SolveOptions::iso_edges
-  isometry::FlatFairness flat_fairness = isometry::FlatFairness::kUniform;
+  double fair2d_along = 1;            // isometry::SolveOptions::fair2d_along
   // DropSideOutliers' tolerance (fraction of M's diagonal; 0 keeps every
   // marker). On set05 a fold's notch in the left side's outline, 30 px off
   // the page's edge in flat.png, was held straight with the side; two front

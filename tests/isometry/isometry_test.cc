@@ -196,8 +196,8 @@ TEST(Isometry, AnalyticJacobianMatchesFiniteDifferencesForEveryTerm) {
       }
   };
   for (int term = 0; term < isometry::internal::kNumTerms; ++term) check(term);
-  // E_fair(M') with only the bending across each grid line.
-  d.flat_fairness = isometry::FlatFairness::kBending;
+  // E_fair(M') split across and along each grid line.
+  d.fair2d_along = 0.3;
   check(isometry::internal::kFair2d);
 }
 
