@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <ctime>
 #include <filesystem>
 
 namespace docunfold {
@@ -30,6 +31,16 @@ void Spin(double seconds) {
   while (Clock::now() < end) x = x + 1;
 }
 
+// Spins until this process has used `seconds` of CPU (or 20 times that of
+// wall time), so that a loaded machine does not starve the measurement.
+void SpinCpu(double seconds) {
+  const std::clock_t start = std::clock();
+  const auto give_up = Clock::now() + std::chrono::duration<double>(20 * seconds);
+  volatile double x = 0;
+  while (double(std::clock() - start) / CLOCKS_PER_SEC < seconds && Clock::now() < give_up)
+    x = x + 1;
+}
+
 TEST(CpuShare, OthersAreTheBusyTimeNotSpentByThisProcess) {
   // 3 s of CPU in 2 s of wall time, 1 s of it this process's: others used 1
   // core.
@@ -48,7 +59,7 @@ TEST(CpuShare, SamplesCountThisProcessWork) {
   if (!std::filesystem::exists("/proc/stat")) GTEST_SKIP() << "no /proc/stat";
   const CpuSample before = SampleCpu();
   ASSERT_TRUE(before.valid);
-  Spin(0.3);
+  SpinCpu(0.3);
   const CpuSample after = SampleCpu();
   const double self = after.self_seconds - before.self_seconds;
   EXPECT_GT(self, 0.15);
