@@ -145,6 +145,11 @@ struct SolveOptions {
   // by the isometry, swings such a panel about its fold where it has few
   // points to hold it. 0 = bending only.
   double fair2d_along = 1;
+  // E_fair(M') measures how far each second difference has moved from its
+  // value in the M' given to Solve instead of from zero: it smooths the
+  // change of M' and no longer pulls M' (and M with it) toward an evenly
+  // spaced, straight grid, which the given pair may rightly not be.
+  bool fair2d_relative = false;
   // λ3 is multiplied by up to this where M has no inlier point within
   // support_radius (fraction of the model size, along M), reaching it at
   // twice that distance: blank paper then continues its panel's plane

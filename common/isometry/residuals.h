@@ -41,7 +41,10 @@ struct StepData {
   std::vector<Marker> markers;        // rays in the normalised frame
   double iso_scale = 1;               // multiplies every c_iso (see IsoNormalization)
   double iso_edge_weight = 0;         // edge rows' share of E_iso (SolveOptions::iso_edges)
-  double fair2d_along = 1;           // SolveOptions::fair2d_along
+  double fair2d_along = 1;            // SolveOptions::fair2d_along
+  // Per fairness triplet, the second difference E_fair(M') measures from
+  // (SolveOptions::fair2d_relative); empty: zero.
+  std::vector<Eigen::Vector2d> fair2d_rest;
   double beta_point = 1;
   double beta_normal = 0.1;
   int num_inliers = 0;
@@ -187,9 +190,11 @@ inline std::array<int, 3> FairTriplet(const QuadGrid& g, int t) {
 // derivatives: ∂(n·s)/∂u = −(t·s/|u|) n and ∂(t·s)/∂u = (n·s/|u|) n.
 inline int FairRows(const State& s, const StepData& data, int t, bool flat, Row* rows) {
   const auto v = FairTriplet(s.grid, t);
+  const Eigen::Vector2d rest =
+      flat && !data.fair2d_rest.empty() ? data.fair2d_rest[t] : Eigen::Vector2d::Zero();
   if (flat && data.fair2d_along < 1) {
     const Eigen::Vector2d u = s.v2[v[2]] - s.v2[v[0]];
-    const Eigen::Vector2d sd = s.v2[v[0]] - 2 * s.v2[v[1]] + s.v2[v[2]];
+    const Eigen::Vector2d sd = s.v2[v[0]] - 2 * s.v2[v[1]] + s.v2[v[2]] - rest;
     const double len = u.norm();
     if (!(len > 0)) {  // a collapsed triplet has no direction to split along
       rows[0].Reset();
@@ -222,7 +227,7 @@ inline int FairRows(const State& s, const StepData& data, int t, bool flat, Row*
     const int dim = first + k;
     Row& r = rows[k];
     r.Reset();
-    r.value = flat ? s.v2[v[0]][k] - 2 * s.v2[v[1]][k] + s.v2[v[2]][k]
+    r.value = flat ? s.v2[v[0]][k] - 2 * s.v2[v[1]][k] + s.v2[v[2]][k] - rest[k]
                    : s.v3[v[0]][k] - 2 * s.v3[v[1]][k] + s.v3[v[2]][k];
     r.value *= scale;
     r.Add(v[0])[dim] = scale;

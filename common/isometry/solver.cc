@@ -227,6 +227,13 @@ Work Normalise(const Problem& p, const SolveOptions& o) {
   }
   w.data.iso_edge_weight = o.iso_edges;
   w.data.fair2d_along = o.fair2d_along;
+  if (o.fair2d_relative) {
+    const auto& v = w.state.v2;
+    for (int t = 0; t < internal::NumFairTriplets(w.state.grid); ++t) {
+      const auto c = internal::FairTriplet(w.state.grid, t);
+      w.data.fair2d_rest.push_back(v[c[0]] - 2 * v[c[1]] + v[c[2]]);
+    }
+  }
   w.weights = o.weights;
   return w;
 }

@@ -66,6 +66,9 @@ int main(int argc, char** argv) {
   AddFairnessBoostOptions(app, &o.unsupported_fairness, &o.support_radius);
   AddIsoEdgesOption(app, &o.iso_edges);
   AddFair2dAlongOption(app, &o.fair2d_along);
+  app.add_flag("--fair2d-relative", o.fair2d_relative,
+               "E_fair(M') measures the change of M' from each round's start, not its "
+               "distance from an evenly spaced straight grid");
   app.add_option("--side-outliers", o.side_outliers,
                  "take samples inside a real page side off it when farther "
                  "than this fraction of M's diagonal, and 4 sigma of the "
@@ -170,6 +173,7 @@ int main(int argc, char** argv) {
                                {"support_radius", o.support_radius},
                                {"iso_edges", o.iso_edges},
                                {"fair2d_along", o.fair2d_along},
+                               {"fair2d_relative", o.fair2d_relative},
                                {"side_outliers", o.side_outliers},
                                {"line_spacing", o.line_spacing},
                                {"max_spacing_ratio", o.max_spacing_ratio},

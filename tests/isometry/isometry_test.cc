@@ -196,8 +196,14 @@ TEST(Isometry, AnalyticJacobianMatchesFiniteDifferencesForEveryTerm) {
       }
   };
   for (int term = 0; term < isometry::internal::kNumTerms; ++term) check(term);
-  // E_fair(M') split across and along each grid line.
+  // E_fair(M') split across and along each grid line, and measured from a
+  // rest shape.
   d.fair2d_along = 0.3;
+  check(isometry::internal::kFair2d);
+  for (int t = 0; t < isometry::internal::NumFairTriplets(s.grid); ++t)
+    d.fair2d_rest.emplace_back(0.01 * uni(rng), 0.01 * uni(rng));
+  check(isometry::internal::kFair2d);
+  d.fair2d_along = 1;
   check(isometry::internal::kFair2d);
 }
 
@@ -344,12 +350,12 @@ TEST(Isometry, SolveMovesTowardTheTruthOnEveryDataSet) {
 // (isometrically: a hinge, so isometry alone does not undo it). With λ3
 // stiffened away from the points it straightens; with the paper's tiny λ3
 // it is still bent after as many iterations.
-TEST(Isometry, BendingOnlyFlatFairnessKeepsUnevenSpacing) {
+TEST(Isometry, BendingOnlyOrRelativeFlatFairnessKeepsUnevenSpacing) {
   // A flat page whose grid columns are spaced ever wider (as a panel seen at
   // a grazing angle is by the reference image's even grid). The paper's
   // E_fair(M') evens the spacing out (the points let M slide along itself;
-  // where rays and outline hold it instead, M swings); bending only leaves
-  // the spacing as it is.
+  // where rays and outline hold it instead, M swings); bending only, or
+  // fairness measured from the given M', leaves the spacing as it is.
   MeshPair page;
   page.grid = {21, 11};
   for (int r = 0; r < page.grid.ny; ++r)
@@ -369,9 +375,10 @@ TEST(Isometry, BendingOnlyFlatFairnessKeepsUnevenSpacing) {
     return (m.mesh2d[m.grid.Index(r, last)] - m.mesh2d[m.grid.Index(r, last - 1)]).norm() /
            (m.mesh2d[m.grid.Index(r, 1)] - m.mesh2d[m.grid.Index(r, 0)]).norm();
   };
-  const auto solve = [&](double along) {
+  const auto solve = [&](double along, bool relative = false) {
     SolveOptions o;
     o.fair2d_along = along;
+    o.fair2d_relative = relative;
     return isometry::Solve(problem, o).meshes;
   };
   const double before = gap_ratio(page);
@@ -380,6 +387,7 @@ TEST(Isometry, BendingOnlyFlatFairnessKeepsUnevenSpacing) {
   const MeshPair bending = solve(0);
   EXPECT_NEAR(gap_ratio(bending), before, 0.05 * before);
   EXPECT_LT(isometry::IsometryEdgeError(bending).mean, 1e-3);
+  EXPECT_NEAR(gap_ratio(solve(1, true)), before, 0.05 * before);
 }
 
 TEST(Isometry, StifferFairnessAwayFromPointsStraightensBlankParts) {
