@@ -66,9 +66,12 @@ int main(int argc, char** argv) {
   AddFairnessBoostOptions(app, &o.unsupported_fairness, &o.support_radius);
   AddIsoEdgesOption(app, &o.iso_edges);
   AddFair2dAlongOption(app, &o.fair2d_along);
-  app.add_flag("--fair2d-relative", o.fair2d_relative,
-               "E_fair(M') measures the change of M' from each round's start, not its "
-               "distance from an evenly spaced straight grid");
+  app.add_option("--fair2d-relative-rounds", o.fair2d_relative_rounds,
+                 "in this many rounds from the first, E_fair(M') measures the change of M' "
+                 "from the round's start, not its distance from an evenly spaced straight "
+                 "grid (0 = the paper)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 100));
   app.add_option("--side-outliers", o.side_outliers,
                  "take samples inside a real page side off it when farther "
                  "than this fraction of M's diagonal, and 4 sigma of the "
@@ -173,7 +176,7 @@ int main(int argc, char** argv) {
                                {"support_radius", o.support_radius},
                                {"iso_edges", o.iso_edges},
                                {"fair2d_along", o.fair2d_along},
-                               {"fair2d_relative", o.fair2d_relative},
+                               {"fair2d_relative_rounds", o.fair2d_relative_rounds},
                                {"side_outliers", o.side_outliers},
                                {"line_spacing", o.line_spacing},
                                {"max_spacing_ratio", o.max_spacing_ratio},

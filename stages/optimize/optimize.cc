@@ -120,7 +120,7 @@ OptimizeResult Run(const OptimizeInputs& in, const OptimizeOptions& o) {
     so.support_radius = o.support_radius;
     so.iso_edges = o.iso_edges;
     so.fair2d_along = o.fair2d_along;
-    so.fair2d_relative = o.fair2d_relative;
+    so.fair2d_relative = r < o.fair2d_relative_rounds;
     so.line_spacing = o.line_spacing;
     so.max_spacing_ratio = o.max_spacing_ratio;
     so.relative_tolerance = o.relative_tolerance;

@@ -50,7 +50,9 @@ struct OptimizeOptions {
   double support_radius = 0.03;       // fraction of the model size
   double iso_edges = 0;               // isometry::SolveOptions::iso_edges
   double fair2d_along = 1;            // isometry::SolveOptions::fair2d_along
-  bool fair2d_relative = false;       // isometry::SolveOptions::fair2d_relative
+  // isometry::SolveOptions::fair2d_relative in this many rounds from the
+  // first (0 = none, the paper).
+  int fair2d_relative_rounds = 0;
   // DropSideOutliers' tolerance (fraction of M's diagonal; 0 keeps every
   // marker). On set05 a fold's notch in the left side's outline, 30 px off
   // the page's edge in flat.png, was held straight with the side; two front
