@@ -84,9 +84,35 @@ std::optional<Eigen::Vector3d> GroundTruth::SurfacePoint(
          l.y() * mesh.vertices[tri[2]];
 }
 
+const RasterResult& GroundTruth::ViewRaster(const PinholeCamera& camera) const {
+  const bool same = view_camera_ && view_camera_->width == camera.width &&
+                    view_camera_->height == camera.height && view_camera_->K == camera.K &&
+                    view_camera_->R == camera.R && view_camera_->t == camera.t;
+  if (!same) {
+    view_raster_ = RasterizeMesh(camera, mesh.vertices, triangles);
+    view_camera_ = camera;
+  }
+  return view_raster_;
+}
+
+namespace {
+
+// Whether the surface point p3 is seen by `camera` (in front of it, inside
+// its image and not behind the page itself), and where.
+bool SeenAt(const RasterResult& depth, const PinholeCamera& camera,
+            const std::optional<Eigen::Vector3d>& p3, Eigen::Vector2d* px) {
+  if (!p3) return false;
+  const Eigen::Vector3d xc = camera.CamFromWorld(*p3);
+  *px = camera.ProjectCam(xc);
+  const int x = int(std::lround(px->x())), y = int(std::lround(px->y()));
+  return xc.z() > 0 && x >= 0 && y >= 0 && x < camera.width && y < camera.height &&
+         xc.z() <= depth.depth(y, x) * (1 + 2e-3);
+}
+
+}  // namespace
+
 cv::Mat1b TruePageMask(const GroundTruth& gt, const PinholeCamera& camera) {
-  RasterResult r = RasterizeMesh(camera, gt.mesh.vertices, gt.triangles);
-  return r.face >= 0;
+  return gt.ViewRaster(camera).face >= 0;
 }
 
 std::array<Eigen::Vector2d, 4> TrueCorners(const GroundTruth& gt,
@@ -112,7 +138,7 @@ std::array<Eigen::Vector2d, 4> TrueCorners(const GroundTruth& gt,
 std::vector<TrueLine> TrueLinesInView(const GroundTruth& gt,
                                       const PinholeCamera& camera,
                                       double step_px) {
-  RasterResult depth = RasterizeMesh(camera, gt.mesh.vertices, gt.triangles);
+  const RasterResult& depth = gt.ViewRaster(camera);
   std::vector<TrueLine> out;
   for (const TrueLine& line : gt.lines) {
     TrueLine piece{line.kind, {}};
@@ -125,18 +151,11 @@ std::vector<TrueLine> TrueLinesInView(const GroundTruth& gt,
       const int n = std::max(1, int(std::ceil((b - a).norm() / step_px)));
       for (int j = 0; j <= n; ++j) {
         if (k > 0 && j == 0) continue;
-        auto p3 = gt.SurfacePoint(a + (b - a) * (double(j) / n));
-        bool visible = false;
         Eigen::Vector2d px;
-        if (p3) {
-          Eigen::Vector3d xc = camera.CamFromWorld(*p3);
-          px = camera.ProjectCam(xc);
-          const int x = int(std::lround(px.x())), y = int(std::lround(px.y()));
-          visible = xc.z() > 0 && x >= 0 && y >= 0 && x < camera.width &&
-                    y < camera.height &&
-                    xc.z() <= depth.depth(y, x) * (1 + 2e-3);
-        }
-        if (visible) piece.points.push_back(px); else flush();
+        if (SeenAt(depth, camera, gt.SurfacePoint(a + (b - a) * (double(j) / n)), &px))
+          piece.points.push_back(px);
+        else
+          flush();
       }
     }
     flush();
@@ -147,7 +166,7 @@ std::vector<TrueLine> TrueLinesInView(const GroundTruth& gt,
 std::vector<std::vector<Eigen::Vector2d>> TrueOutlineInView(const GroundTruth& gt,
                                                             const PinholeCamera& camera,
                                                             double step_px) {
-  RasterResult depth = RasterizeMesh(camera, gt.mesh.vertices, gt.triangles);
+  const RasterResult& depth = gt.ViewRaster(camera);
   const double w = gt.flat_width - 1.0, h = gt.flat_height - 1.0;
   // Slightly inside the page so that every sample finds a surface point.
   const double e = 0.5;
@@ -162,17 +181,11 @@ std::vector<std::vector<Eigen::Vector2d>> TrueOutlineInView(const GroundTruth& g
     const Eigen::Vector2d a = corners[k], b = corners[(k + 1) % 4];
     const int n = std::max(1, int(std::ceil((b - a).norm() / step_px)));
     for (int j = 0; j <= n; ++j) {
-      auto p3 = gt.SurfacePoint(a + (b - a) * (double(j) / n));
-      bool visible = false;
       Eigen::Vector2d px;
-      if (p3) {
-        const Eigen::Vector3d xc = camera.CamFromWorld(*p3);
-        px = camera.ProjectCam(xc);
-        const int x = int(std::lround(px.x())), y = int(std::lround(px.y()));
-        visible = xc.z() > 0 && x >= 0 && y >= 0 && x < camera.width && y < camera.height &&
-                  xc.z() <= depth.depth(y, x) * (1 + 2e-3);
-      }
-      if (visible) piece.push_back(px); else flush();
+      if (SeenAt(depth, camera, gt.SurfacePoint(a + (b - a) * (double(j) / n)), &px))
+        piece.push_back(px);
+      else
+        flush();
     }
     flush();  // sides are kept apart
   }
@@ -181,7 +194,7 @@ std::vector<std::vector<Eigen::Vector2d>> TrueOutlineInView(const GroundTruth& g
 
 std::array<CornerView, 4> TrueCornersInView(const GroundTruth& gt, const PinholeCamera& camera,
                                             double margin_px) {
-  RasterResult depth = RasterizeMesh(camera, gt.mesh.vertices, gt.triangles);
+  const RasterResult& depth = gt.ViewRaster(camera);
   const double w = gt.flat_width - 1.0, h = gt.flat_height - 1.0, e = 0.5;
   const Eigen::Vector2d corners[4] = {{e, e}, {w - e, e}, {w - e, h - e}, {e, h - e}};
   std::array<CornerView, 4> out;

@@ -42,9 +42,16 @@ struct GroundTruth {
   std::optional<Eigen::Vector3d> SurfacePoint(
       const Eigen::Vector2d& flat_px) const;
 
+  // The surface rasterized into `camera`'s image (face ids and depth),
+  // kept for the last camera asked: the page mask, corners, outline and
+  // lines of one view share it. Not for concurrent use.
+  const RasterResult& ViewRaster(const PinholeCamera& camera) const;
+
   // Rasterization of the surface in (s, t) space, built on first use.
   mutable RasterResult st_raster_;
   mutable double st_scale_ = 0;
+  mutable std::optional<PinholeCamera> view_camera_;
+  mutable RasterResult view_raster_;
 };
 
 // True when `dataset` has what LoadGroundTruth needs (page.json,
