@@ -92,7 +92,9 @@ TEST(CpuShare, SeesAnotherProcessLoad) {
   EXPECT_GE(share.others(), child_cores - 0.15);
   EXPECT_GE(threads, 1);
   EXPECT_LE(threads, std::max(1, AvailableCores()));
-  if (AvailableCores() <= 2 && child_cores > 0.8) EXPECT_EQ(threads, 1);
+  if (AvailableCores() <= 2 && child_cores > 0.8) {
+    EXPECT_EQ(threads, 1);
+  }
 }
 
 TEST(CpuShare, OneThreadAskedIsOneAndNothingMeasuredIsAllAsked) {

@@ -77,7 +77,9 @@ TEST(Synth, WritesTheGroundTruthLayoutAndItValidates) {
     }
     EXPECT_GT(text, 5) << kind;
     EXPECT_EQ(border, 4) << kind;
-    if (std::string(kind) == "table" || std::string(kind) == "poster") EXPECT_GT(rule, 4);
+    if (std::string(kind) == "table" || std::string(kind) == "poster") {
+      EXPECT_GT(rule, 4);
+    }
     EXPECT_GT(fs::file_size(out / "ground_truth/text.txt"), 100u) << kind;
   }
 }
