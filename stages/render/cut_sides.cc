@@ -5,6 +5,7 @@
 #include <memory>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/features2d.hpp>
+#include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "common/raster.h"
@@ -439,7 +440,8 @@ cv::Mat1b TextureStrips(const std::vector<const ExtensionStrip*>& strips,
                         const cv::Mat3b& reference_render,
                         const cv::Mat1b& reference_valid,
                         const cv::Mat1b& fillable, cv::Mat3b* image,
-                        std::vector<ViewRegistration>* registrations) {
+                        std::vector<ViewRegistration>* registrations,
+                        double min_agreement) {
   const int W = image->cols, H = image->rows;
   cv::Mat1b done(H, W, uchar(0));
   const StripMesh m = JoinStrips(strips, x0, y0, scale);
@@ -472,7 +474,7 @@ cv::Mat1b TextureStrips(const std::vector<const ExtensionStrip*>& strips,
     }
     // A view that does not match the reference where they overlap would
     // repeat or misplace what the reference shows.
-    reg.used = reg.agreement >= kMinAgreement;
+    reg.used = reg.agreement >= min_agreement;
     if (registrations) registrations->push_back(reg);
     if (!reg.used) continue;
     for (int y = 0; y < H; ++y)
@@ -481,6 +483,205 @@ cv::Mat1b TextureStrips(const std::vector<const ExtensionStrip*>& strips,
         if (!fillable(y, x) || !(d > best(y, x))) continue;
         best(y, x) = d;
         (*image)(y, x) = r.colour(y, x);
+        done(y, x) = 255;
+      }
+  }
+  return done;
+}
+
+namespace {
+
+// Smaller singular value of a 2x2 map (how finely it resolves the page in
+// its worst direction), capped at 1: finer than the output tells nothing.
+double Resolution(const Eigen::Matrix2d& J) {
+  const Eigen::Matrix2d G = J.transpose() * J;
+  const double half_trace = 0.5 * G.trace();
+  const double d = std::sqrt(std::max(0.0, half_trace * half_trace - G.determinant()));
+  return std::min(1.0, std::sqrt(std::max(0.0, half_trace - d)));
+}
+
+// d(pixel)/d(world point) of the pinhole camera at world point x.
+Eigen::Matrix<double, 2, 3> ProjectionJacobian(const PinholeCamera& camera,
+                                               const Eigen::Vector3d& x_world) {
+  const Eigen::Vector3d h = camera.K * camera.CamFromWorld(x_world);
+  const double u = h.x() / h.z(), v = h.y() / h.z();
+  Eigen::Matrix<double, 2, 3> d;
+  d.row(0) = (camera.K.row(0) - u * camera.K.row(2)) / h.z();
+  d.row(1) = (camera.K.row(1) - v * camera.K.row(2)) / h.z();
+  return d * camera.R;
+}
+
+// Per triangle: +1 when its projection winds the way it does in M', else -1.
+std::vector<signed char> Winding(const std::vector<Eigen::Vector2d>& pixels,
+                                 const std::vector<Eigen::Vector2d>& flat,
+                                 const std::vector<Triangle>& tris) {
+  auto cross = [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+    return a.x() * b.y() - a.y() * b.x();
+  };
+  std::vector<signed char> w(tris.size());
+  for (size_t f = 0; f < tris.size(); ++f) {
+    const Triangle& t = tris[f];
+    const double a = cross(pixels[t[1]] - pixels[t[0]], pixels[t[2]] - pixels[t[0]]);
+    const double a2 = cross(flat[t[1]] - flat[t[0]], flat[t[2]] - flat[t[0]]);
+    w[f] = (a2 >= 0) == (a >= 0) ? 1 : -1;
+  }
+  return w;
+}
+
+// Per channel, the median ratio of `reference` to `view` over `where`; 1
+// with fewer than 500 pixels.
+cv::Vec3f MedianGain(const cv::Mat3b& reference, const cv::Mat3b& view, const cv::Mat1b& where) {
+  cv::Vec3f gain(1, 1, 1);
+  if (cv::countNonZero(where) < 500) return gain;
+  std::vector<double> ratios[3];
+  for (int y = 0; y < where.rows; ++y)
+    for (int x = 0; x < where.cols; ++x) {
+      if (!where(y, x)) continue;
+      const cv::Vec3b a = reference(y, x), b = view(y, x);
+      for (int k = 0; k < 3; ++k) ratios[k].push_back(a[k] / std::max(1.0, double(b[k])));
+    }
+  for (int k = 0; k < 3; ++k) gain[k] = float(Median(ratios[k]));
+  return gain;
+}
+
+}  // namespace
+
+cv::Mat1b TextureFromBetterViews(const MeshPair& meshes,
+                                 const std::vector<Eigen::Vector2d>& flat,
+                                 const RasterResult& out_raster,
+                                 const PinholeCamera& reference_camera,
+                                 double scale, const std::vector<ViewMask>& views,
+                                 const std::vector<cv::Mat>& photos, bool antialias,
+                                 const cv::Mat1b& replaceable,
+                                 const BetterViewOptions& options, cv::Mat3b* image,
+                                 std::vector<ViewRegistration>* registrations) {
+  const int W = image->cols, H = image->rows;
+  cv::Mat1b done(H, W, uchar(0));
+  if (!(options.min_gain > 0)) return done;
+  const std::vector<Triangle> tris = meshes.grid.Triangles();
+  const std::vector<Eigen::Vector3d>& world = meshes.mesh3d;
+  // Output pixel -> world point, per triangle (affine over it).
+  std::vector<Eigen::Matrix<double, 3, 2>> dx_dpix(tris.size());
+  for (size_t f = 0; f < tris.size(); ++f) {
+    const Triangle& t = tris[f];
+    Eigen::Matrix2d Q;
+    Q << flat[t[1]] - flat[t[0]], flat[t[2]] - flat[t[0]];
+    Eigen::Matrix<double, 3, 2> P;
+    P << world[t[1]] - world[t[0]], world[t[2]] - world[t[0]];
+    dx_dpix[f] = std::abs(Q.determinant()) > 0
+                     ? Eigen::Matrix<double, 3, 2>(P * Q.inverse() / scale)
+                     : Eigen::Matrix<double, 3, 2>::Zero();
+  }
+  auto point = [&](int y, int x, int* face) -> Eigen::Vector3d {
+    *face = out_raster.face(y, x);
+    const Triangle& t = tris[*face];
+    const cv::Vec2f b = out_raster.bary(y, x);
+    return (1 - b[0] - b[1]) * world[t[0]] + b[0] * world[t[1]] + b[1] * world[t[2]];
+  };
+  // The reference's resolution per output pixel; a view must beat it by
+  // min_gain.
+  cv::Mat1f reference_resolution(H, W, 0.0f);
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      if (!replaceable(y, x) || out_raster.face(y, x) < 0) continue;
+      int f;
+      const Eigen::Vector3d X = point(y, x, &f);
+      reference_resolution(y, x) =
+          float(Resolution(ProjectionJacobian(reference_camera, X) * dx_dpix[f]));
+    }
+  cv::Mat1f best = reference_resolution * options.min_gain;
+  // The printed side: the winding most triangles have in the reference view.
+  std::vector<Eigen::Vector2d> reference_pixels(world.size());
+  for (size_t i = 0; i < world.size(); ++i) reference_pixels[i] = reference_camera.Project(world[i]);
+  long majority = 0;
+  for (signed char w : Winding(reference_pixels, flat, tris)) majority += w;
+  const signed char printed = majority >= 0 ? 1 : -1;
+  Eigen::Vector3d lo = world[0], hi = world[0];
+  for (const auto& v : world) {
+    lo = lo.cwiseMin(v);
+    hi = hi.cwiseMax(v);
+  }
+  const double depth_tolerance = options.depth_tolerance * (hi - lo).norm();
+
+  const cv::Mat3b reference_image = image->clone();
+  const ReferenceRendering reference = PrepareReference(reference_image, replaceable);
+  for (size_t v = 0; v < views.size(); ++v) {
+    if (photos[v].empty()) continue;
+    const ViewMask& view = views[v];
+    const PinholeCamera& cam = view.camera;
+    // The view's depth buffer of M and the winding of each triangle in it.
+    std::vector<Eigen::Vector3d> screen(world.size());
+    std::vector<Eigen::Vector2d> pixels(world.size());
+    bool in_front = true;
+    for (size_t i = 0; i < world.size() && in_front; ++i) {
+      const auto p = ProjectDistorted(cam, view.distortion, world[i]);
+      in_front = p.has_value();
+      if (!in_front) break;
+      pixels[i] = *p;
+      screen[i] = {p->x(), p->y(), cam.CamFromWorld(world[i]).z()};
+    }
+    if (!in_front) continue;
+    const std::vector<signed char> winding = Winding(pixels, flat, tris);
+    const RasterResult depth = Rasterize(screen, tris, cam.width, cam.height);
+    const TextureSampler sampler(photos[v]);
+    ViewRendering r{cv::Mat3b(H, W, cv::Vec3b(0, 0, 0)), cv::Mat1f(H, W, 0.0f)};
+    cv::parallel_for_(cv::Range(0, H), [&](const cv::Range& range) {
+      for (int y = range.start; y < range.end; ++y)
+        for (int x = 0; x < W; ++x) {
+          if (!replaceable(y, x) || out_raster.face(y, x) < 0) continue;
+          int f;
+          const Eigen::Vector3d X = point(y, x, &f);
+          if (winding[f] != printed) continue;
+          const auto p = ProjectDistorted(cam, view.distortion, X);
+          if (!p || p->x() < 0 || p->y() < 0 || p->x() > cam.width - 1 ||
+              p->y() > cam.height - 1)
+            continue;
+          const int u = int(std::lround(p->x())), w = int(std::lround(p->y()));
+          if (!view.mask(w, u)) continue;
+          const float nearest = depth.depth(w, u);
+          if (std::isfinite(nearest) && cam.CamFromWorld(X).z() > nearest + depth_tolerance)
+            continue;
+          const Eigen::Matrix2d J = ProjectionJacobian(cam, X) * dx_dpix[f];
+          const float Jf[4] = {float(J(0, 0)), float(J(0, 1)), float(J(1, 0)), float(J(1, 1))};
+          float colour[3];
+          sampler.Sample(float(p->x()), float(p->y()), Jf, antialias, colour);
+          r.colour(y, x) = cv::Vec3b(cv::saturate_cast<uchar>(colour[0]),
+                                     cv::saturate_cast<uchar>(colour[1]),
+                                     cv::saturate_cast<uchar>(colour[2]));
+          r.density(y, x) = float(std::max(1e-6, Resolution(J)));
+        }
+    });
+    if (cv::countNonZero(r.density > best) == 0) continue;  // nowhere better
+    // Registered with the reference's rendering as the cut sides' strips are.
+    ViewRegistration reg;
+    reg.view = int(v);
+    reg.agreement = Agreement(reference, r);
+    const cv::Matx23d A = Register(reference, r, 15, &reg.inliers);
+    if (reg.inliers >= 15) {
+      ViewRendering moved = Warp(r, A);
+      const double agreement = Agreement(reference, moved);
+      if (agreement > reg.agreement) {
+        reg.affine = A;
+        reg.agreement = agreement;
+        reg.moved = true;
+        r = moved;
+      }
+    }
+    reg.used = reg.agreement >= kMinAgreement;
+    if (registrations) registrations->push_back(reg);
+    if (!reg.used) continue;
+    // Another exposure: the view's colours scaled to the reference's where
+    // both resolve the page well.
+    const cv::Vec3f gain = MedianGain(
+        reference_image, r.colour, (reference_resolution >= 0.7f) & (r.density >= 0.7f));
+    for (int y = 0; y < H; ++y)
+      for (int x = 0; x < W; ++x) {
+        const float d = r.density(y, x);
+        if (!replaceable(y, x) || !(d > best(y, x))) continue;
+        best(y, x) = d;
+        const cv::Vec3b c = r.colour(y, x);
+        cv::Vec3b& out = (*image)(y, x);
+        for (int k = 0; k < 3; ++k) out[k] = cv::saturate_cast<uchar>(c[k] * gain[k]);
         done(y, x) = 255;
       }
   }

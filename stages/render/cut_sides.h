@@ -14,6 +14,7 @@
 
 #include "common/camera.h"
 #include "common/grid_mesh.h"
+#include "common/raster.h"
 
 namespace docunfold::render {
 
@@ -123,8 +124,10 @@ std::array<CutSideEdge, 4> FindCutSideEdges(
 // moved onto `reference_render` where the two overlap (`reference_valid`;
 // the strips' band rows) when SIFT matches agree on an affine map that
 // improves their agreement; a view whose detail then still does not
-// correlate with the reference's there is not used. `photos[v]` belongs to
-// `views[v]` (empty: not used). Returns the pixels textured (255).
+// correlate with the reference's there is not used (`min_agreement` of
+// the correlation of their fine detail; -1: every view is used, e.g. the
+// reference's own photo). `photos[v]` belongs to `views[v]` (empty: not
+// used). Returns the pixels textured (255).
 cv::Mat1b TextureStrips(const std::vector<const ExtensionStrip*>& strips,
                         const std::vector<ViewMask>& views,
                         const std::vector<cv::Mat>& photos, double x0,
@@ -132,6 +135,38 @@ cv::Mat1b TextureStrips(const std::vector<const ExtensionStrip*>& strips,
                         const cv::Mat3b& reference_render,
                         const cv::Mat1b& reference_valid,
                         const cv::Mat1b& fillable, cv::Mat3b* image,
-                        std::vector<ViewRegistration>* registrations);
+                        std::vector<ViewRegistration>* registrations,
+                        double min_agreement = 0.3);
+
+// Where the reference view sees the page at a grazing angle (a fold's steep
+// panel, a curl's far side), another photo may see it squarely.
+struct BetterViewOptions {
+  // A photo replaces the reference's texture at an output pixel where it
+  // resolves the page at least this many times better: the smaller singular
+  // value of the map from output pixels to its pixels, each capped at 1
+  // (finer than the output tells nothing). 0 = off.
+  double min_gain = 0;
+  // A point is seen by a view when no part of M lies nearer to it along the
+  // ray by more than this fraction of M's diagonal.
+  double depth_tolerance = 0.005;
+};
+
+// Retextures the pixels of `image` in `replaceable` (the reference's own
+// samples) from the photos that resolve them at least
+// BetterViewOptions::min_gain times better than the reference camera does.
+// `out_raster` maps output pixels to triangles of `meshes` (output pixel
+// (x, y) is the point (x0 + (x + 0.5) / scale, y0 + (y + 0.5) / scale) of
+// `flat`). Each view's rendering is registered with `image` first (as in
+// TextureStrips) and its colours scaled to the reference's where both
+// resolve the page well. Returns the pixels retextured (255).
+cv::Mat1b TextureFromBetterViews(const MeshPair& meshes,
+                                 const std::vector<Eigen::Vector2d>& flat,
+                                 const RasterResult& out_raster,
+                                 const PinholeCamera& reference_camera,
+                                 double scale, const std::vector<ViewMask>& views,
+                                 const std::vector<cv::Mat>& photos, bool antialias,
+                                 const cv::Mat1b& replaceable,
+                                 const BetterViewOptions& options, cv::Mat3b* image,
+                                 std::vector<ViewRegistration>* registrations);
 
 }  // namespace docunfold::render

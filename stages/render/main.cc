@@ -94,7 +94,7 @@ int main(int argc, char** argv) {
                  "paper comes out one even colour, as from a scanner (far better OCR); keep: "
                  "the reference photo's brightness, as the paper's method renders it")
       ->capture_default_str()->check(CLI::IsMember({"keep", "remove"}));
-  bool no_extend = false, no_texture_cut = false;
+  bool no_extend = false, no_texture_cut = false, no_reach = false;
   std::string images, features;
   app.add_option("--features", features,
                  "features.json (30_features/): when Tesseract cannot tell which way up the "
@@ -105,6 +105,9 @@ int main(int argc, char** argv) {
                  "from the other views that see it (without: the fill colour)");
   app.add_flag("--no-texture-cut-sides", no_texture_cut,
                "fill the page found past a cut side instead of texturing it");
+  app.add_flag("--no-reach-real-sides", no_reach,
+               "where M stops short of a real side (a blank margin with no points), crop "
+               "where M stops instead of continuing M to the side's outline");
   app.add_flag("--no-extend-cut-sides", no_extend,
                "stop the crop where the reference image cuts the page off (by default the "
                "page edge past it is looked for in the other views' page masks, "
@@ -113,6 +116,11 @@ int main(int argc, char** argv) {
                  "how far past a cut side the page edge is looked for, as a fraction of "
                  "what the reference view shows along that axis")
       ->capture_default_str()->check(CLI::Range(0.0, 10.0));
+  app.add_option("--better-views", o.better_views.min_gain,
+                 "texture a point from another photo (--images) where it resolves the page "
+                 "this many times better than the reference photo, e.g. a fold's panel the "
+                 "reference sees at a grazing angle (0 = off)")
+      ->capture_default_str()->check(CLI::Range(0.0, 100.0));
   return RunStage("render", app, argc, argv, [&] {
     const auto start = std::chrono::steady_clock::now();
     o.antialias = !no_antialias;
@@ -120,6 +128,7 @@ int main(int argc, char** argv) {
     o.orient = !no_orient;
     o.extend_cut_sides = !no_extend;
     o.texture_cut_sides = !no_texture_cut;
+    o.reach_real_sides = !no_reach;
     const render::RenderInputs in =
         render::ReadRenderInputs(sfm, boundary, meshes, images, features);
     const double read_s = SecondsSince(start);

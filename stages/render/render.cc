@@ -144,6 +144,16 @@ struct ProjectedMesh {
   int faces_in_view = 0;
 };
 
+// The page region of the reference image: the boundary's outline filled.
+cv::Mat1b OutlineMask(const Boundary& boundary, int width, int height) {
+  cv::Mat1b mask(height, width, uchar(0));
+  std::vector<cv::Point> polygon;
+  for (const auto& p : boundary.contour)
+    polygon.emplace_back(int(std::lround(p.x())), int(std::lround(p.y())));
+  if (polygon.size() >= 3) cv::fillPoly(mask, std::vector<std::vector<cv::Point>>{polygon}, 255);
+  return mask;
+}
+
 // Projection of M into the reference view; which triangles face the camera
 // (paper is seen from its printed side: the orientation of the majority of
 // the projected area) and the reference image's pixel density on M': the
@@ -515,6 +525,9 @@ Json MakeReport(const RenderOptions& options, const RenderInputs& in,
     }
     if (!s.note.empty()) j["note"] = s.note;
     if (s.scattered) j["median_bound"] = s.median_bound;
+    if (const CutSideEdge& e = r.reached_sides[i]; e.measured)
+      j["reached_past_mesh"] = {{"bound", e.bound}, {"extension", e.extension},
+                                {"crossings", e.crossings}};
     if (!s.real && options.extend_cut_sides) {
       const CutSideEdge& e = r.cut_edges[i];
       Json c = {{"measured", e.measured},
@@ -537,6 +550,7 @@ Json MakeReport(const RenderOptions& options, const RenderInputs& in,
   doc["hidden_fraction"] = r.hidden_fraction;
   doc["minified_fraction"] = r.minified_fraction;
   doc["other_view_fraction"] = r.other_view_fraction;
+  doc["better_view_fraction"] = r.better_view_fraction;
   doc["shading"] = {{"removed", r.shading_removed}};
   if (r.shading_removed) doc["shading"]["paper_fraction"] = r.shading_paper_fraction;
   Json regs = Json::array();
@@ -693,6 +707,34 @@ RenderResult Run(const RenderOptions& options, const RenderInputs& in) {
                              " columns)"));
     }
   }
+  // A real side that M stops short of (its border runs inside the outline
+  // where a blank margin has no points, so too few of the side's samples
+  // map onto M): the surface is continued past M's border, as for a cut
+  // side, until it leaves the page in the reference image itself.
+  std::vector<ViewMask> self_view;
+  if (options.reach_real_sides) {
+    std::array<bool, 4> short_side{};
+    for (int i = 0; i < 4; ++i)
+      short_side[i] = r.sides[i].real && !r.sides[i].used && !r.sides[i].scattered;
+    if (std::count(short_side.begin(), short_side.end(), true) > 0) {
+      self_view.push_back({cam, OutlineMask(in.boundary, cam.width, cam.height),
+                           in.boundary.file, in.reference_file, {}});
+      const std::array<CutSideEdge, 4> reached =
+          FindCutSideEdges(in.meshes, flat, visible, short_side, self_view, options.cut_sides);
+      for (int i = 0; i < 4; ++i) {
+        if (!short_side[i]) continue;
+        const CutSideEdge& e = reached[i];
+        if (!e.measured || !e.edge_seen || !(e.extension > 0)) continue;
+        visible[BoxIndexOfSide(i)] = e.bound;
+        r.reached_sides[i] = e;
+        const double axis_extent = i % 2 == 0 ? visible[3] - visible[1] : visible[2] - visible[0];
+        char share[32];
+        std::snprintf(share, sizeof share, "%.1f", 100 * e.extension / axis_extent);
+        Log(std::string(kSideNames[i]) + " side lies past M's border: M continued by " + share +
+            " % of the page to reach it (" + std::to_string(e.crossings) + " columns)");
+      }
+    }
+  }
   for (int i = 0; i < 4; ++i) {
     if (!r.sides[i].scattered) continue;
     std::vector<double> across;
@@ -708,7 +750,7 @@ RenderResult Run(const RenderOptions& options, const RenderInputs& in) {
                              options.crop_rule == "middle" ? options.crop_middle_max_deg * M_PI / 180
                                                            : -1.0);
   for (int i = 0; i < 4; ++i)
-    if (r.sides[i].real && !r.sides[i].used)
+    if (r.sides[i].real && !r.sides[i].used && !r.reached_sides[i].measured)
       Log(std::string(kSideNames[i]) +
           " side not used for the crop: " + r.sides[i].note);
   r.crop_rule = crop.rule;
@@ -751,13 +793,35 @@ RenderResult Run(const RenderOptions& options, const RenderInputs& in) {
   std::vector<const ExtensionStrip*> strips;
   for (const CutSideEdge& e : r.cut_edges)
     if (!e.strip.flat.empty()) strips.push_back(&e.strip);
-  if (!strips.empty() && options.texture_cut_sides) {
-    std::vector<cv::Mat> photos(in.views.size());
+  const bool better_views = options.better_views.min_gain > 0 && !in.views.empty();
+  std::vector<cv::Mat> photos(in.views.size());
+  if ((!strips.empty() && options.texture_cut_sides) || better_views)
     for (size_t v = 0; v < in.views.size(); ++v) {
       const ViewMask& view = in.views[v];
       if (view.photo.empty()) continue;
       photos[v] = ReadViewPhoto(view.photo, view.camera, in.cameras_file, cv::IMREAD_COLOR);
     }
+  if (better_views) {
+    const cv::Mat1b textured = TextureFromBetterViews(
+        in.meshes, flat, out_raster, in.camera, size.scale, in.views, photos,
+        options.antialias, state == kPage, options.better_views, &image, &r.registrations);
+    state.setTo(kOtherView, textured);
+    r.better_view_fraction = cv::countNonZero(textured) / (double(size.width) * size.height);
+    timer.Mark("better_views");
+  }
+  // The margin reached past M's border, from the reference photo itself.
+  std::vector<const ExtensionStrip*> reached_strips;
+  for (const CutSideEdge& e : r.reached_sides)
+    if (!e.strip.flat.empty()) reached_strips.push_back(&e.strip);
+  if (!reached_strips.empty()) {
+    const cv::Mat1b textured = TextureStrips(
+        reached_strips, self_view, {in.reference}, r.crop_x0, r.crop_y0, size.scale,
+        options.antialias, image.clone(), state == kPage, state == kOutside, &image, nullptr,
+        /*min_agreement=*/-1);
+    state.setTo(kPage, textured);
+    timer.Mark("reached_sides");
+  }
+  if (!strips.empty() && options.texture_cut_sides) {
     const cv::Mat3b reference_render = image.clone();
     const cv::Mat1b textured = TextureStrips(
         strips, in.views, photos, r.crop_x0, r.crop_y0, size.scale, options.antialias,

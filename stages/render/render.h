@@ -106,7 +106,14 @@ struct RenderOptions {
   // Texture the page found past cut sides from the other photos that see
   // it (RenderInputs::views[].photo); off: the fill colour.
   bool texture_cut_sides = true;
+  // Where M stops short of a real side (too few of its samples map onto
+  // M), continue M past its border to the outline in the reference image
+  // and crop there; off: the crop stops where M does.
+  bool reach_real_sides = true;
   CutSideOptions cut_sides;
+  // Texture from another photo where it sees the page much more squarely
+  // than the reference (cut_sides.h); off by default.
+  BetterViewOptions better_views;
   // "remove": divide out the light's shading (folds, curls, shadows) so the
   // paper comes out one even colour, as a scan (common/shading.h); "keep":
   // the reference photo's brightness, as the paper's method renders it (and
@@ -177,12 +184,14 @@ struct RenderResult {
   bool capped = false;  // the default size was reduced to max_pixels
   std::array<SideFit, 4> sides;
   std::array<CutSideEdge, 4> cut_edges;  // the page edge past cut sides
+  std::array<CutSideEdge, 4> reached_sides;  // real sides past M's border
   std::vector<ViewRegistration> registrations;  // of the views textured from
   cv::Vec3b fill;
   double page_fraction = 0;      // output pixels showing the page
   double hidden_fraction = 0;    // output pixels on M' but not seen
   double minified_fraction = 0;  // output pixels that needed pre-filtering
   double other_view_fraction = 0;  // output pixels from another view's photo
+  double better_view_fraction = 0;  // of the reference's, retextured (better_views)
   bool shading_removed = false;
   double shading_paper_fraction = 0;  // of the image taken as paper (shading = remove)
   int grid_line_step = 1;

@@ -138,6 +138,12 @@ render::RenderInputs Inputs(
     in.boundary.sides[i].points = sides[i];
     in.boundary.sides[i].real = real[i];
   }
+  // The outline: top TL->TR, right TR->BR, bottom BR->BL, left BL->TL.
+  auto& contour = in.boundary.contour;
+  contour.insert(contour.end(), sides[0].begin(), sides[0].end());
+  contour.insert(contour.end(), sides[1].begin(), sides[1].end());
+  contour.insert(contour.end(), sides[2].rbegin(), sides[2].rend());
+  contour.insert(contour.end(), sides[3].rbegin(), sides[3].rend());
   in.meshes = meshes;
   in.cameras_file = "cameras.json";
   in.reference_file = "reference.png";

@@ -588,5 +588,103 @@ TEST(RenderCutSides, ThePagePastTheReferenceImageIsTexturedFromAnotherView) {
   EXPECT_LT(off.median, 1.5);
 }
 
+// M without its first `rows` grid rows: a top margin M stops short of.
+MeshPair WithoutTopRows(const MeshPair& m, int rows) {
+  MeshPair out;
+  out.grid = {m.grid.nx, m.grid.ny - rows};
+  for (int r = rows; r < m.grid.ny; ++r)
+    for (int c = 0; c < m.grid.nx; ++c) {
+      out.mesh3d.push_back(m.mesh3d[m.grid.Index(r, c)]);
+      out.mesh2d.push_back(m.mesh2d[m.grid.Index(r, c)]);
+    }
+  return out;
+}
+
+TEST(RenderScene, RealSidePastMsBorderIsReachedAndTexturedFromTheReference) {
+  SceneOptions o;
+  o.radius = 0;
+  const SyntheticScene full = MakeScene(o);
+  ASSERT_TRUE(full.real[0]);
+  SyntheticScene s = full;
+  const int rows = 4;  // of 56: M stops 7 % of the page short of the top side
+  s.meshes = WithoutTopRows(full.meshes, rows);
+  const double top = o.page_h * rows / (full.meshes.grid.ny - 1);
+
+  render::RenderOptions off;
+  off.reach_real_sides = false;
+  const render::RenderResult before = render::Run(off, InputsOf(s));
+  const render::RenderResult r = render::Run({}, InputsOf(s));
+  Keep("reached-side", r.rectified);
+  const double px = 1 / r.pixels_per_unit;
+  EXPECT_FALSE(r.sides[0].used) << "the side's samples miss M";
+  EXPECT_NEAR(before.crop_y0, top, 2 * px);
+  ASSERT_TRUE(r.reached_sides[0].measured);
+  EXPECT_NEAR(r.crop_y0, 0.0, 0.005 * o.page_h + 2 * px);  // the true top edge
+  EXPECT_NEAR(r.crop_y1, before.crop_y1, px);
+  EXPECT_NEAR(r.crop_x0, before.crop_x0, px);
+  EXPECT_FALSE(r.reached_sides[1].measured || r.reached_sides[2].measured ||
+               r.reached_sides[3].measured);
+  // The margin shows the page's texture where it belongs.
+  const int y_end = int((before.crop_y0 - r.crop_y0) * r.pixels_per_unit) - 3;
+  ASSERT_GT(y_end, 20);
+  cv::Mat1b mask = Inner(r.page_mask, 3);
+  mask.rowRange(y_end, mask.rows).setTo(0);
+  ASSERT_GT(cv::countNonZero(mask), 20 * 100);
+  const cv::Mat1f a = Detail(ExpectedImage(full, r)), b = Detail(r.rectified);
+  EXPECT_GT(Correlation(a, b, mask), 0.6);
+
+  // A mesh that reaches its sides is left as it was.
+  const render::RenderResult whole = render::Run({}, InputsOf(full));
+  for (const auto& e : whole.reached_sides) EXPECT_FALSE(e.measured);
+}
+
+TEST(RenderScene, BetterViewTexturesWhatTheReferenceSeesAtAGrazingAngle) {
+  TempDir dir;
+  SceneOptions o;
+  o.radius = 0;
+  o.tilt_deg = 72;  // the reference sees the page nearly edge-on
+  o.page_origin = {-0.21, -0.12, 0.9};
+  const SyntheticScene s = MakeScene(o);
+  ASSERT_TRUE(s.real[0] && s.real[1] && s.real[2] && s.real[3]);
+  // Another photo square on to the page: the page's own frame moved to
+  // `square.page_origin` in front of that camera.
+  SceneOptions square = o;
+  square.tilt_deg = 0;
+  square.page_origin = {-0.21, -0.28, 0.8};
+  const SyntheticScene s2 = MakeScene(square);
+  const Eigen::Matrix3d tilt =
+      Eigen::AngleAxisd(o.tilt_deg * M_PI / 180, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  render::ViewMask view;
+  view.camera = s2.camera;
+  view.camera.image = "view_01.png";
+  view.camera.R = tilt.transpose();
+  view.camera.t = square.page_origin - tilt.transpose() * o.page_origin;
+  ASSERT_LT((view.camera.Project(s.meshes.mesh3d[0]) - s2.camera.Project(s2.meshes.mesh3d[0]))
+                .norm(),
+            1e-6);
+  view.mask = RasterizeMesh(s2.camera, s2.meshes.mesh3d, s2.meshes.grid.Triangles()).face >= 0;
+  view.photo = dir / "view_01.png";
+  WriteImageAtomic(view.photo, s2.photo);
+  render::RenderInputs in = InputsOf(s);
+  in.views = {view};
+
+  const render::RenderResult before = render::Run({}, in);  // off by default
+  EXPECT_EQ(before.better_view_fraction, 0);
+  render::RenderOptions better;
+  better.better_views.min_gain = 1.5;
+  const render::RenderResult r = render::Run(better, in);
+  Keep("better-view", r.rectified);
+  EXPECT_GT(r.better_view_fraction, 0.5);
+  ASSERT_EQ(r.registrations.size(), 1u);
+  EXPECT_TRUE(r.registrations[0].used);
+  // The same crop; the print comes out sharper where it belongs.
+  EXPECT_EQ(r.rectified.size(), before.rectified.size());
+  const cv::Mat1b mask = Inner(r.page_mask, 3);
+  const cv::Mat1f truth = Detail(ExpectedImage(s, r));
+  const double c_before = Correlation(truth, Detail(before.rectified), mask);
+  const double c_after = Correlation(truth, Detail(r.rectified), mask);
+  EXPECT_GT(c_after, c_before + 0.1) << c_before << " -> " << c_after;
+}
+
 }  // namespace
 }  // namespace docunfold::testing
