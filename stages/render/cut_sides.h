@@ -3,6 +3,10 @@
 // border. The other photos often see further: the surface is continued past
 // the mesh border (straight on, in M and M' alike), projected into each
 // other view, and the page edge is where it leaves that view's page mask.
+// The same continuation, projected into the reference's own outline, reaches
+// a real side that M stops short of (render.cc). And the other photos'
+// texture where they see the page more squarely than the reference
+// (TextureFromBetterViews).
 #pragma once
 
 #include <Eigen/Core>
