@@ -431,6 +431,30 @@ double Agreement(const ReferenceRendering& reference,
   return cv::mean(prod, both)[0] / (sa[0] * sb[0] + 1e-9);
 }
 
+// Moves view `v`'s rendering `r` onto the reference's where the two overlap
+// when SIFT matches agree on an affine map that improves the correlation of
+// their fine detail. A view that still correlates below `min_agreement` is
+// not to be used: it would repeat or misplace what the reference shows.
+ViewRegistration RegisterWithReference(const ReferenceRendering& reference, int v,
+                                       double min_agreement, ViewRendering* r) {
+  ViewRegistration reg;
+  reg.view = v;
+  reg.agreement = Agreement(reference, *r);
+  const cv::Matx23d A = Register(reference, *r, 15, &reg.inliers);
+  if (reg.inliers >= 15) {
+    ViewRendering moved = Warp(*r, A);
+    const double agreement = Agreement(reference, moved);
+    if (agreement > reg.agreement) {
+      reg.affine = A;
+      reg.agreement = agreement;
+      reg.moved = true;
+      *r = moved;
+    }
+  }
+  reg.used = reg.agreement >= min_agreement;
+  return reg;
+}
+
 }  // namespace
 
 cv::Mat1b TextureStrips(const std::vector<const ExtensionStrip*>& strips,
@@ -458,23 +482,7 @@ cv::Mat1b TextureStrips(const std::vector<const ExtensionStrip*>& strips,
     // The other view sees M where it is least sure (the page's cut edge in
     // the reference view); move its texture onto the reference's where the
     // two overlap (the strips' band rows run back over M).
-    ViewRegistration reg;
-    reg.view = int(v);
-    reg.agreement = Agreement(reference, r);
-    const cv::Matx23d A = Register(reference, r, 15, &reg.inliers);
-    if (reg.inliers >= 15) {
-      ViewRendering moved = Warp(r, A);
-      const double agreement = Agreement(reference, moved);
-      if (agreement > reg.agreement) {
-        reg.affine = A;
-        reg.agreement = agreement;
-        reg.moved = true;
-        r = moved;
-      }
-    }
-    // A view that does not match the reference where they overlap would
-    // repeat or misplace what the reference shows.
-    reg.used = reg.agreement >= min_agreement;
+    const ViewRegistration reg = RegisterWithReference(reference, int(v), min_agreement, &r);
     if (registrations) registrations->push_back(reg);
     if (!reg.used) continue;
     for (int y = 0; y < H; ++y)
@@ -653,21 +661,7 @@ cv::Mat1b TextureFromBetterViews(const MeshPair& meshes,
     });
     if (cv::countNonZero(r.density > best) == 0) continue;  // nowhere better
     // Registered with the reference's rendering as the cut sides' strips are.
-    ViewRegistration reg;
-    reg.view = int(v);
-    reg.agreement = Agreement(reference, r);
-    const cv::Matx23d A = Register(reference, r, 15, &reg.inliers);
-    if (reg.inliers >= 15) {
-      ViewRendering moved = Warp(r, A);
-      const double agreement = Agreement(reference, moved);
-      if (agreement > reg.agreement) {
-        reg.affine = A;
-        reg.agreement = agreement;
-        reg.moved = true;
-        r = moved;
-      }
-    }
-    reg.used = reg.agreement >= kMinAgreement;
+    const ViewRegistration reg = RegisterWithReference(reference, int(v), kMinAgreement, &r);
     if (registrations) registrations->push_back(reg);
     if (!reg.used) continue;
     // Another exposure: the view's colours scaled to the reference's where
