@@ -37,6 +37,15 @@ struct PinholeCamera {
   Eigen::Vector2d Project(const Eigen::Vector3d& x_world) const {
     return ProjectCam(CamFromWorld(x_world));
   }
+  // d(pixel)/d(x_cam) of ProjectCam at a point in camera coordinates (z > 0).
+  Eigen::Matrix<double, 2, 3> ProjectCamJacobian(const Eigen::Vector3d& x_cam) const {
+    const Eigen::Vector3d h = K * x_cam;
+    const double u = h.x() / h.z(), v = h.y() / h.z();
+    Eigen::Matrix<double, 2, 3> d;
+    d.row(0) = (K.row(0) - u * K.row(2)) / h.z();
+    d.row(1) = (K.row(1) - v * K.row(2)) / h.z();
+    return d;
+  }
   // Unit viewing direction of a pixel, in world coordinates.
   Eigen::Vector3d RayDirection(const Eigen::Vector2d& pixel) const {
     Eigen::Vector3d d = K.inverse() * Eigen::Vector3d(pixel.x(), pixel.y(), 1);

@@ -433,10 +433,10 @@ double Agreement(const ReferenceRendering& reference,
 
 // Moves view `v`'s rendering `r` onto the reference's where the two overlap
 // when SIFT matches agree on an affine map that improves the correlation of
-// their fine detail. A view that still correlates below `min_agreement` is
+// their fine detail. A view that still correlates below kMinAgreement is
 // not to be used: it would repeat or misplace what the reference shows.
 ViewRegistration RegisterWithReference(const ReferenceRendering& reference, int v,
-                                       double min_agreement, ViewRendering* r) {
+                                       ViewRendering* r) {
   ViewRegistration reg;
   reg.view = v;
   reg.agreement = Agreement(reference, *r);
@@ -451,7 +451,7 @@ ViewRegistration RegisterWithReference(const ReferenceRendering& reference, int 
       *r = moved;
     }
   }
-  reg.used = reg.agreement >= min_agreement;
+  reg.used = reg.agreement >= kMinAgreement;
   return reg;
 }
 
@@ -465,7 +465,7 @@ cv::Mat1b TextureStrips(const std::vector<const ExtensionStrip*>& strips,
                         const cv::Mat1b& reference_valid,
                         const cv::Mat1b& fillable, cv::Mat3b* image,
                         std::vector<ViewRegistration>* registrations,
-                        double min_agreement) {
+                        bool own_photo) {
   const int W = image->cols, H = image->rows;
   cv::Mat1b done(H, W, uchar(0));
   const StripMesh m = JoinStrips(strips, x0, y0, scale);
@@ -481,8 +481,12 @@ cv::Mat1b TextureStrips(const std::vector<const ExtensionStrip*>& strips,
     if (cv::countNonZero(r.density > 0) == 0) continue;
     // The other view sees M where it is least sure (the page's cut edge in
     // the reference view); move its texture onto the reference's where the
-    // two overlap (the strips' band rows run back over M).
-    const ViewRegistration reg = RegisterWithReference(reference, int(v), min_agreement, &r);
+    // two overlap (the strips' band rows run back over M). The reference's
+    // own photo matches itself: nothing to register.
+    ViewRegistration reg;
+    reg.view = int(v);
+    reg.used = true;
+    if (!own_photo) reg = RegisterWithReference(reference, int(v), &r);
     if (registrations) registrations->push_back(reg);
     if (!reg.used) continue;
     for (int y = 0; y < H; ++y)
@@ -506,17 +510,6 @@ double Resolution(const Eigen::Matrix2d& J) {
   const double half_trace = 0.5 * G.trace();
   const double d = std::sqrt(std::max(0.0, half_trace * half_trace - G.determinant()));
   return std::min(1.0, std::sqrt(std::max(0.0, half_trace - d)));
-}
-
-// d(pixel)/d(world point) of the pinhole camera at world point x.
-Eigen::Matrix<double, 2, 3> ProjectionJacobian(const PinholeCamera& camera,
-                                               const Eigen::Vector3d& x_world) {
-  const Eigen::Vector3d h = camera.K * camera.CamFromWorld(x_world);
-  const double u = h.x() / h.z(), v = h.y() / h.z();
-  Eigen::Matrix<double, 2, 3> d;
-  d.row(0) = (camera.K.row(0) - u * camera.K.row(2)) / h.z();
-  d.row(1) = (camera.K.row(1) - v * camera.K.row(2)) / h.z();
-  return d * camera.R;
 }
 
 // Per triangle: +1 when its projection winds the way it does in M', else -1.
@@ -568,18 +561,14 @@ cv::Mat1b TextureFromBetterViews(const MeshPair& meshes,
   if (!(options.min_gain > 0)) return done;
   const std::vector<Triangle> tris = meshes.grid.Triangles();
   const std::vector<Eigen::Vector3d>& world = meshes.mesh3d;
-  // Output pixel -> world point, per triangle (affine over it).
-  std::vector<Eigen::Matrix<double, 3, 2>> dx_dpix(tris.size());
-  for (size_t f = 0; f < tris.size(); ++f) {
-    const Triangle& t = tris[f];
-    Eigen::Matrix2d Q;
-    Q << flat[t[1]] - flat[t[0]], flat[t[2]] - flat[t[0]];
-    Eigen::Matrix<double, 3, 2> P;
-    P << world[t[1]] - world[t[0]], world[t[2]] - world[t[0]];
-    dx_dpix[f] = std::abs(Q.determinant()) > 0
-                     ? Eigen::Matrix<double, 3, 2>(P * Q.inverse() / scale)
-                     : Eigen::Matrix<double, 3, 2>::Zero();
-  }
+  // Per triangle: d(world point)/d(output pixel).
+  const std::vector<Eigen::Matrix<double, 3, 2>> dx_dpix =
+      SurfacePerOutputPixel(world, flat, tris, scale);
+  // d(pixel)/d(world point) of `camera` at X.
+  auto projection_jacobian = [](const PinholeCamera& camera, const Eigen::Vector3d& X) {
+    return Eigen::Matrix<double, 2, 3>(camera.ProjectCamJacobian(camera.CamFromWorld(X)) *
+                                       camera.R);
+  };
   auto point = [&](int y, int x, int* face) -> Eigen::Vector3d {
     *face = out_raster.face(y, x);
     const Triangle& t = tris[*face];
@@ -595,7 +584,7 @@ cv::Mat1b TextureFromBetterViews(const MeshPair& meshes,
       int f;
       const Eigen::Vector3d X = point(y, x, &f);
       reference_resolution(y, x) =
-          float(Resolution(ProjectionJacobian(reference_camera, X) * dx_dpix[f]));
+          float(Resolution(projection_jacobian(reference_camera, X) * dx_dpix[f]));
     }
   cv::Mat1f best = reference_resolution * options.min_gain;
   // The printed side: the winding most triangles have in the reference view.
@@ -649,7 +638,7 @@ cv::Mat1b TextureFromBetterViews(const MeshPair& meshes,
           const float nearest = depth.depth(w, u);
           if (std::isfinite(nearest) && cam.CamFromWorld(X).z() > nearest + depth_tolerance)
             continue;
-          const Eigen::Matrix2d J = ProjectionJacobian(cam, X) * dx_dpix[f];
+          const Eigen::Matrix2d J = projection_jacobian(cam, X) * dx_dpix[f];
           const float Jf[4] = {float(J(0, 0)), float(J(0, 1)), float(J(1, 0)), float(J(1, 1))};
           float colour[3];
           sampler.Sample(float(p->x()), float(p->y()), Jf, antialias, colour);
@@ -661,7 +650,7 @@ cv::Mat1b TextureFromBetterViews(const MeshPair& meshes,
     });
     if (cv::countNonZero(r.density > best) == 0) continue;  // nowhere better
     // Registered with the reference's rendering as the cut sides' strips are.
-    const ViewRegistration reg = RegisterWithReference(reference, int(v), kMinAgreement, &r);
+    const ViewRegistration reg = RegisterWithReference(reference, int(v), &r);
     if (registrations) registrations->push_back(reg);
     if (!reg.used) continue;
     // Another exposure: the view's colours scaled to the reference's where

@@ -128,10 +128,9 @@ std::array<CutSideEdge, 4> FindCutSideEdges(
 // moved onto `reference_render` where the two overlap (`reference_valid`;
 // the strips' band rows) when SIFT matches agree on an affine map that
 // improves their agreement; a view whose detail then still does not
-// correlate with the reference's there is not used (`min_agreement` of
-// the correlation of their fine detail; -1: every view is used, e.g. the
-// reference's own photo). `photos[v]` belongs to `views[v]` (empty: not
-// used). Returns the pixels textured (255).
+// correlate with the reference's there is not used. With `own_photo` the
+// views are the reference's own photo, which needs neither. `photos[v]`
+// belongs to `views[v]` (empty: not used). Returns the pixels textured (255).
 cv::Mat1b TextureStrips(const std::vector<const ExtensionStrip*>& strips,
                         const std::vector<ViewMask>& views,
                         const std::vector<cv::Mat>& photos, double x0,
@@ -140,7 +139,7 @@ cv::Mat1b TextureStrips(const std::vector<const ExtensionStrip*>& strips,
                         const cv::Mat1b& reference_valid,
                         const cv::Mat1b& fillable, cv::Mat3b* image,
                         std::vector<ViewRegistration>* registrations,
-                        double min_agreement = 0.3);
+                        bool own_photo = false);
 
 // Where the reference view sees the page at a grazing angle (a fold's steep
 // panel, a curl's far side), another photo may see it squarely.

@@ -288,20 +288,9 @@ SampleStats SamplePixels(const RenderOptions& options, const RenderInputs& in,
   const int W = out_raster.face.cols, H = out_raster.face.rows;
   *image = cv::Mat3b(H, W, cv::Vec3b(0, 0, 0));
   *state = cv::Mat1b(H, W, kOutside);
-  // Per triangle: d(camera point)/d(output pixel), a 3x2 matrix, from the
-  // affine map M' -> M over the triangle.
-  std::vector<Eigen::Matrix<double, 3, 2>> dx_dpix(pm.triangles.size());
-  for (size_t f = 0; f < pm.triangles.size(); ++f) {
-    const Triangle& t = pm.triangles[f];
-    Eigen::Matrix2d Q;
-    Q << flat[t[1]] - flat[t[0]], flat[t[2]] - flat[t[0]];
-    Eigen::Matrix<double, 3, 2> P;
-    P << pm.cam[t[1]] - pm.cam[t[0]], pm.cam[t[2]] - pm.cam[t[0]];
-    const double det = Q.determinant();
-    dx_dpix[f] = std::abs(det) > 0
-                     ? Eigen::Matrix<double, 3, 2>(P * Q.inverse() / scale)
-                     : Eigen::Matrix<double, 3, 2>::Zero();
-  }
+  // Per triangle: d(camera point)/d(output pixel).
+  const std::vector<Eigen::Matrix<double, 3, 2>> dx_dpix =
+      SurfacePerOutputPixel(pm.cam, flat, pm.triangles, scale);
   double diag = 0;
   {
     Eigen::Vector3d lo = pm.cam[0], hi = lo;
@@ -363,10 +352,7 @@ SampleStats SamplePixels(const RenderOptions& options, const RenderInputs& in,
           ++stats.page;
         }
         // Footprint: d(u,v)/d(X) of the projection times d(X)/d(pixel).
-        Eigen::Matrix<double, 2, 3> dproj;
-        dproj.row(0) = (K.row(0) - u * K.row(2)) / h.z();
-        dproj.row(1) = (K.row(1) - v * K.row(2)) / h.z();
-        const Eigen::Matrix2d J = dproj * dx_dpix[f];
+        const Eigen::Matrix2d J = cam.ProjectCamJacobian(X) * dx_dpix[f];
         const float Jf[4] = {float(J(0, 0)), float(J(0, 1)), float(J(1, 0)),
                              float(J(1, 1))};
         float c[3];
@@ -716,7 +702,7 @@ RenderResult Run(const RenderOptions& options, const RenderInputs& in) {
     std::array<bool, 4> short_side{};
     for (int i = 0; i < 4; ++i)
       short_side[i] = r.sides[i].real && !r.sides[i].used && !r.sides[i].scattered;
-    if (std::count(short_side.begin(), short_side.end(), true) > 0) {
+    if (std::any_of(short_side.begin(), short_side.end(), [](bool s) { return s; })) {
       self_view.push_back({cam, OutlineMask(in.boundary, cam.width, cam.height),
                            in.boundary.file, in.reference_file, {}});
       const std::array<CutSideEdge, 4> reached =
@@ -817,7 +803,7 @@ RenderResult Run(const RenderOptions& options, const RenderInputs& in) {
     const cv::Mat1b textured = TextureStrips(
         reached_strips, self_view, {in.reference}, r.crop_x0, r.crop_y0, size.scale,
         options.antialias, image.clone(), state == kPage, state == kOutside, &image, nullptr,
-        /*min_agreement=*/-1);
+        /*own_photo=*/true);
     state.setTo(kPage, textured);
     timer.Mark("reached_sides");
   }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <Eigen/LU>
 #include <opencv2/imgproc.hpp>
 
 namespace docunfold::render {
@@ -128,6 +129,23 @@ bool TextureSampler::Sample(float u, float v, const float J[4], bool antialias,
     }
   }
   return true;
+}
+
+std::vector<Eigen::Matrix<double, 3, 2>> SurfacePerOutputPixel(
+    const std::vector<Eigen::Vector3d>& surface, const std::vector<Eigen::Vector2d>& flat,
+    const std::vector<Triangle>& triangles, double scale) {
+  std::vector<Eigen::Matrix<double, 3, 2>> out(triangles.size());
+  for (size_t f = 0; f < triangles.size(); ++f) {
+    const Triangle& t = triangles[f];
+    Eigen::Matrix2d Q;
+    Q << flat[t[1]] - flat[t[0]], flat[t[2]] - flat[t[0]];
+    Eigen::Matrix<double, 3, 2> P;
+    P << surface[t[1]] - surface[t[0]], surface[t[2]] - surface[t[0]];
+    out[f] = std::abs(Q.determinant()) > 0
+                 ? Eigen::Matrix<double, 3, 2>(P * Q.inverse() / scale)
+                 : Eigen::Matrix<double, 3, 2>::Zero();
+  }
+  return out;
 }
 
 }  // namespace docunfold::render

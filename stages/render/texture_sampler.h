@@ -11,8 +11,11 @@
 // whose pixel is at most half the footprint's minor width.
 #pragma once
 
+#include <Eigen/Core>
 #include <opencv2/core.hpp>
 #include <vector>
+
+#include "common/raster.h"
 
 namespace docunfold::render {
 
@@ -38,5 +41,13 @@ class TextureSampler {
   std::vector<cv::Mat> levels_;  // level k has 2^-k the size; pixel x of level
                                  // k sits at pixel 2^k x of level 0 (pyrDown)
 };
+
+// Per triangle, d(surface point)/d(output pixel): the affine map from the
+// triangle in `flat` (M', `scale` output pixels per unit) onto the same
+// triangle of `surface` (M, in any frame); zero for a degenerate triangle.
+// Times a camera's projection Jacobian it is an output pixel's footprint.
+std::vector<Eigen::Matrix<double, 3, 2>> SurfacePerOutputPixel(
+    const std::vector<Eigen::Vector3d>& surface, const std::vector<Eigen::Vector2d>& flat,
+    const std::vector<Triangle>& triangles, double scale);
 
 }  // namespace docunfold::render
