@@ -108,6 +108,11 @@ int main(int argc, char** argv) {
   app.add_flag("--no-reach-real-sides", no_reach,
                "where M stops short of a real side (a blank margin with no points), crop "
                "where M stops instead of continuing M to the side's outline");
+  app.add_option("--reach-partial-below", o.reach_partial_below,
+                 "also reach a real side of which fewer than this fraction of the samples map "
+                 "onto M (they are only where M gets to it), and crop at the farther of its "
+                 "line and the reached edge (0 = only sides too short to fit)")
+      ->capture_default_str()->check(CLI::Range(0.0, 1.0));
   app.add_flag("--no-extend-cut-sides", no_extend,
                "stop the crop where the reference image cuts the page off (by default the "
                "page edge past it is looked for in the other views' page masks, "

@@ -701,7 +701,9 @@ RenderResult Run(const RenderOptions& options, const RenderInputs& in) {
   if (options.reach_real_sides) {
     std::array<bool, 4> short_side{};
     for (int i = 0; i < 4; ++i)
-      short_side[i] = r.sides[i].real && !r.sides[i].used && !r.sides[i].scattered;
+      short_side[i] = r.sides[i].real && !r.sides[i].scattered &&
+                      (!r.sides[i].used ||
+                       r.sides[i].mapped < options.reach_partial_below * r.sides[i].samples);
     if (std::any_of(short_side.begin(), short_side.end(), [](bool s) { return s; })) {
       self_view.push_back({cam, OutlineMask(in.boundary, cam.width, cam.height),
                            in.boundary.file, in.reference_file, {}});
@@ -711,6 +713,24 @@ RenderResult Run(const RenderOptions& options, const RenderInputs& in) {
         if (!short_side[i]) continue;
         const CutSideEdge& e = reached[i];
         if (!e.measured || !e.edge_seen || !(e.extension > 0)) continue;
+        SideFit& side = r.sides[i];
+        if (side.used) {
+          // The line where it crosses the middle of the visible box; the
+          // reached edge replaces it only if it lies farther out.
+          const bool horizontal = i == 0 || i == 2;
+          const double mid = horizontal ? 0.5 * (visible[0] + visible[2])
+                                        : 0.5 * (visible[1] + visible[3]);
+          const double line =
+              horizontal
+                  ? side.point.y() + side.direction.y() * (mid - side.point.x()) / side.direction.x()
+                  : side.point.x() + side.direction.x() * (mid - side.point.y()) / side.direction.y();
+          const bool farther = (i == 0 || i == 3) ? e.bound < line : e.bound > line;
+          if (!farther) continue;
+          side.used = false;
+          side.note = "only " + std::to_string(side.mapped) + " of " +
+                      std::to_string(side.samples) +
+                      " samples map onto the mesh, and the side lies past their line";
+        }
         visible[BoxIndexOfSide(i)] = e.bound;
         r.reached_sides[i] = e;
         const double axis_extent = i % 2 == 0 ? visible[3] - visible[1] : visible[2] - visible[0];

@@ -110,6 +110,11 @@ struct RenderOptions {
   // M), continue M past its border to the outline in the reference image
   // and crop there; off: the crop stops where M does.
   bool reach_real_sides = true;
+  // A real side of which fewer than this fraction of the samples map onto M
+  // is reached as well, though its line is fitted: those samples are only
+  // where M gets to the side, and the crop follows the farther of the line
+  // and the reached edge (0: only sides too short to fit).
+  double reach_partial_below = 0.6;
   CutSideOptions cut_sides;
   // Texture from another photo where it sees the page much more squarely
   // than the reference (cut_sides.h); off by default.

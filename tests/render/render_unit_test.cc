@@ -638,6 +638,62 @@ TEST(RenderScene, RealSidePastMsBorderIsReachedAndTexturedFromTheReference) {
   for (const auto& e : whole.reached_sides) EXPECT_FALSE(e.measured);
 }
 
+// M stopping short of the top side by `left_rows` grid rows on the columns
+// left of `split` and by `right_rows` right of it: the rows in between
+// collapse onto the first row kept.
+MeshPair WithTopRowsCollapsed(const MeshPair& m, int split, int left_rows, int right_rows) {
+  MeshPair out = m;
+  for (int c = 0; c < m.grid.nx; ++c) {
+    const int rows = c < split ? left_rows : right_rows;
+    for (int r = 0; r < rows; ++r) {
+      out.mesh3d[m.grid.Index(r, c)] = m.mesh3d[m.grid.Index(rows, c)];
+      out.mesh2d[m.grid.Index(r, c)] = m.mesh2d[m.grid.Index(rows, c)];
+    }
+  }
+  return out;
+}
+
+// Where M stops a pixel or two short of a side over part of it, those
+// samples snap onto M's border and fit a line inside the page edge; the
+// rest miss M. The side is fitted (enough samples map) and reached as well,
+// and the crop takes the reached edge, which lies farther out.
+TEST(RenderScene, APartlyMappedSideIsReachedWhenItLiesPastItsLine) {
+  SceneOptions o;
+  o.radius = 0;
+  o.focal = 400;  // rows of 4 px: one row short is within render's snap
+  const SyntheticScene full = MakeScene(o);
+  ASSERT_TRUE(full.real[0]);
+  SyntheticScene s = full;
+  const int split = full.meshes.grid.nx * 2 / 5;
+  s.meshes = WithTopRowsCollapsed(full.meshes, split, 1, 5);
+  const double row = o.page_h / (full.meshes.grid.ny - 1);
+  // M' of the rows next to the left part's border sheared down towards the
+  // split, as a crease M misses bends it: the samples there tilt their line.
+  for (int c = 0; c < split; ++c)
+    for (int r = 0; r <= 3; ++r)
+      s.meshes.mesh2d[s.meshes.grid.Index(r, c)].y() +=
+          0.8 * row * c / split * (3 - std::max(r, 1)) / 2.0;
+
+  render::RenderOptions old;
+  old.reach_partial_below = 0;
+  const render::RenderResult before = render::Run(old, InputsOf(s));
+  const render::RenderResult r = render::Run({}, InputsOf(s));
+  const double px = 1 / r.pixels_per_unit;
+  std::printf("[render] partly mapped top: %d of %d samples on M, crop top %.4f without the "
+              "reach, %.4f with it (a row is %.4f)\n",
+              before.sides[0].mapped, before.sides[0].samples, before.crop_y0, r.crop_y0, row);
+  ASSERT_TRUE(before.sides[0].used) << before.sides[0].note;
+  EXPECT_LT(before.sides[0].mapped, 0.6 * before.sides[0].samples);
+  EXPECT_GT(before.crop_y0, 0.7 * row) << "the line of the snapped samples lies inside";
+  EXPECT_FALSE(r.sides[0].used);
+  ASSERT_TRUE(r.reached_sides[0].measured);
+  EXPECT_NEAR(r.crop_y0, 0.0, 0.005 * o.page_h + 2 * px);  // the true top edge
+  EXPECT_NEAR(r.crop_y1, before.crop_y1, px);
+  // A mesh that reaches its sides is left as it was.
+  const render::RenderResult whole = render::Run({}, InputsOf(full));
+  for (const auto& e : whole.reached_sides) EXPECT_FALSE(e.measured);
+}
+
 TEST(RenderScene, BetterViewTexturesWhatTheReferenceSeesAtAGrazingAngle) {
   TempDir dir;
   SceneOptions o;
