@@ -653,9 +653,10 @@ MeshPair WithTopRowsCollapsed(const MeshPair& m, int split, int left_rows, int r
   return out;
 }
 
-// Where M stops a pixel or two short of a side over part of it, those
-// samples snap onto M's border and fit a line inside the page edge; the
-// rest miss M. The side is fitted (enough samples map) and reached as well,
+// M gets to the top side over 40 % of it (one row short there, within
+// render's snap) and misses it elsewhere; a crease M does not follow shears
+// M' where it gets there, so the samples on M fit a line that tilts inside
+// the page. The side is fitted (enough samples map) and reached as well,
 // and the crop takes the reached edge, which lies farther out.
 TEST(RenderScene, APartlyMappedSideIsReachedWhenItLiesPastItsLine) {
   SceneOptions o;
