@@ -79,6 +79,8 @@ Line FitTotalLeastSquares(const std::vector<Eigen::Vector2d>& pts) {
   return line;
 }
 
+}  // namespace
+
 // Evaluations of the lines of the four sides: top/bottom as y(x),
 // left/right as x(y).
 double YAt(const SideFit& s, double x) {
@@ -87,8 +89,6 @@ double YAt(const SideFit& s, double x) {
 double XAt(const SideFit& s, double y) {
   return s.point.x() + (y - s.point.y()) * s.direction.x() / s.direction.y();
 }
-
-}  // namespace
 
 std::vector<Eigen::Vector2d> MapPolylineOntoFlat(
     const MeshPair& mesh, const PinholeCamera& camera,

@@ -34,6 +34,10 @@ SideFit FitSideLine(int side, bool real,
                     const std::vector<Eigen::Vector2d>& flat_points,
                     int samples);
 
+// Where a fitted side's line crosses x (top, bottom) or y (left, right).
+double YAt(const SideFit& side, double x);
+double XAt(const SideFit& side, double y);
+
 // Angle (radians) by which the used sides say M' is turned away from
 // upright: the weighted mean of each line's deviation from its axis. 0 when
 // no side is used.

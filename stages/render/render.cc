@@ -720,10 +720,7 @@ RenderResult Run(const RenderOptions& options, const RenderInputs& in) {
           const bool horizontal = i == 0 || i == 2;
           const double mid = horizontal ? 0.5 * (visible[0] + visible[2])
                                         : 0.5 * (visible[1] + visible[3]);
-          const double line =
-              horizontal
-                  ? side.point.y() + side.direction.y() * (mid - side.point.x()) / side.direction.x()
-                  : side.point.x() + side.direction.x() * (mid - side.point.y()) / side.direction.y();
+          const double line = horizontal ? YAt(side, mid) : XAt(side, mid);
           const bool farther = (i == 0 || i == 3) ? e.bound < line : e.bound > line;
           if (!farther) continue;
           side.used = false;
