@@ -351,7 +351,7 @@ std::vector<isometry::FeatureLine> AssignLines(const MeshPair& meshes, const Gro
 }
 
 int DropSideOutliers(const MeshPair& meshes, const Grouping& grouping, double tolerance,
-                     MarkerSet* markers) {
+                     MarkerSet* markers, double end_factor) {
   const int n = int(grouping.line_kind.size());
   const double diagonal = FlatDiagonal(meshes);
   std::vector<std::vector<int>> of_line(n);
@@ -382,7 +382,9 @@ int DropSideOutliers(const MeshPair& meshes, const Grouping& grouping, double to
       std::vector<int> next;
       for (size_t k = 0; k < kept.size(); ++k) {
         const double t = (c.points[k] - c.centre).dot(c.direction);
-        if (residual[k] <= limit || t < c.t_min + end || t > c.t_max - end)
+        const bool at_end = t < c.t_min + end || t > c.t_max - end;
+        if (residual[k] <= limit ||
+            (at_end && (end_factor <= 0 || residual[k] <= end_factor * limit)))
           next.push_back(kept[k]);
       }
       if (next.size() < 3) break;

@@ -102,8 +102,11 @@ std::vector<isometry::FeatureLine> AssignLines(const MeshPair& meshes, const Gro
 // farther than `tolerance` (fraction of the diagonal of M') and 4 robust
 // sigma of the side's scatter from the side's fitted line lose their line:
 // a fold's notch, not the page's edge, made that part of the outline.
-// Returns how many were dropped.
+// In the last tenths a marker loses it only when more than `end_factor`
+// times that far off (0: never): there M is least certain and the line is
+// what straightens the edge, but a sample whose ray grazes M's border can
+// land anywhere along it. Returns how many were dropped.
 int DropSideOutliers(const MeshPair& meshes, const Grouping& grouping, double tolerance,
-                     MarkerSet* markers);
+                     MarkerSet* markers, double end_factor = 0);
 
 }  // namespace docunfold::optimize

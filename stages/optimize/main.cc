@@ -78,6 +78,12 @@ int main(int argc, char** argv) {
                  "side's scatter, from its line (0 = keep all)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1.0));
+  app.add_option("--side-end-outliers", o.side_end_outliers,
+                 "in the last tenth at either end of a real side, take samples off it "
+                 "only when this many times farther from its line than a sample inside may "
+                 "be (0 = keep all)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1000.0));
   app.add_option("--line-spacing", o.line_spacing,
                  "each outer iteration, move a text row this fraction of the "
                  "way to the middle of its neighbouring rows (0 = off)")
@@ -178,6 +184,7 @@ int main(int argc, char** argv) {
                                {"fair2d_along", o.fair2d_along},
                                {"fair2d_relative_rounds", o.fair2d_relative_rounds},
                                {"side_outliers", o.side_outliers},
+                               {"side_end_outliers", o.side_end_outliers},
                                {"line_spacing", o.line_spacing},
                                {"max_spacing_ratio", o.max_spacing_ratio},
                                {"features", o.features},

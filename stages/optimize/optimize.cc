@@ -144,7 +144,8 @@ OptimizeResult Run(const OptimizeInputs& in, const OptimizeOptions& o) {
         *c.lines = AssignLines(*c.meshes, grouping, &current, o.axis_lines);
         if (o.side_outliers > 0)
           round.side_markers_dropped =
-              DropSideOutliers(*c.meshes, grouping, o.side_outliers, &current);
+              DropSideOutliers(*c.meshes, grouping, o.side_outliers, &current,
+                               o.side_end_outliers);
         c.markers->clear();
         kept.clear();
         for (size_t i = 0; i < current.markers.size(); ++i)

@@ -83,16 +83,16 @@ TEST(CastMarkers, OutlineSamplesNearACornerKeepToTheirOwnSide) {
 }
 
 // A real left side 5 px inside the sheet's border, with `bumps`: runs of
-// samples pushed 12 px into the page (a fold's notch in the outline).
+// samples pushed `bump_px` into the page (a fold's notch in the outline).
 MarkerSet SideWithBumps(const Scene& scene, const std::vector<std::pair<int, int>>& bumps,
-                        Grouping* grouping) {
+                        Grouping* grouping, int bump_px = 12) {
   Segment side;
   side.kind = "boundary";
   side.side = 3;
   for (int y = 260; y <= 540; y += 4) {
     bool bumped = false;
     for (const auto& [from, to] : bumps) bumped = bumped || (y >= from && y <= to);
-    side.pixels.emplace_back(bumped ? 317 : 305, y);
+    side.pixels.emplace_back(bumped ? 305 + bump_px : 305, y);
   }
   MarkerSet set = CastMarkers(scene.meshes, scene.camera, {side});
   grouping->line_of_segment = {0};
@@ -123,6 +123,22 @@ TEST(DropSideOutliers, ANotchInsideTheSideLosesItsLineItsEndsDoNot) {
   EXPECT_EQ(DropSideOutliers(scene.meshes, grouping, 0.05, &notched), 0);
   MarkerSet long_run = SideWithBumps(scene, {{360, 452}}, &grouping);
   EXPECT_EQ(DropSideOutliers(scene.meshes, grouping, 0.005, &long_run), 0);
+}
+
+TEST(DropSideOutliers, AtTheEndsOnlyFarOutliersLoseTheirLine) {
+  const Scene scene;
+  Grouping grouping;
+  // The end's 12 px bump is within 3 times the limit and stays, as with 0.
+  MarkerSet near = SideWithBumps(scene, {{392, 408}, {264, 272}}, &grouping);
+  EXPECT_EQ(DropSideOutliers(scene.meshes, grouping, 0.005, &near, 3), 5);
+  // The first sample 60 px into the page (its ray grazed M's border and
+  // met M elsewhere) goes with end_factor 3, and stays with 0 (old rule).
+  MarkerSet far = SideWithBumps(scene, {{260, 260}}, &grouping, 60);
+  MarkerSet far_kept = far;
+  EXPECT_EQ(DropSideOutliers(scene.meshes, grouping, 0.005, &far, 3), 1);
+  for (size_t i = 0; i < far.markers.size(); ++i)
+    EXPECT_EQ(far.markers[i].line, i == 0 ? -1 : 0) << "y " << far.pixel[i].y();
+  EXPECT_EQ(DropSideOutliers(scene.meshes, grouping, 0.005, &far_kept, 0), 0);
 }
 
 }  // namespace
