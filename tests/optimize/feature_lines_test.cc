@@ -128,14 +128,14 @@ TEST(DropSideOutliers, ANotchInsideTheSideLosesItsLineItsEndsDoNot) {
 TEST(DropSideOutliers, AtTheEndsOnlyFarOutliersLoseTheirLine) {
   const Scene scene;
   Grouping grouping;
-  // The end's 12 px bump is within 3 times the limit and stays, as with 0.
+  // The end's 12 px bump is within 4 times the limit and stays, as with 0.
   MarkerSet near = SideWithBumps(scene, {{392, 408}, {264, 272}}, &grouping);
-  EXPECT_EQ(DropSideOutliers(scene.meshes, grouping, 0.005, &near, 3), 5);
+  EXPECT_EQ(DropSideOutliers(scene.meshes, grouping, 0.005, &near, 4), 5);
   // The first sample 60 px into the page (its ray grazed M's border and
-  // met M elsewhere) goes with end_factor 3, and stays with 0 (old rule).
+  // met M elsewhere) goes with end_factor 4, and stays with 0 (old rule).
   MarkerSet far = SideWithBumps(scene, {{260, 260}}, &grouping, 60);
   MarkerSet far_kept = far;
-  EXPECT_EQ(DropSideOutliers(scene.meshes, grouping, 0.005, &far, 3), 1);
+  EXPECT_EQ(DropSideOutliers(scene.meshes, grouping, 0.005, &far, 4), 1);
   for (size_t i = 0; i < far.markers.size(); ++i)
     EXPECT_EQ(far.markers[i].line, i == 0 ? -1 : 0) << "y " << far.pixel[i].y();
   EXPECT_EQ(DropSideOutliers(scene.meshes, grouping, 0.005, &far_kept, 0), 0);
