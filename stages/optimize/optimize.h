@@ -63,10 +63,10 @@ struct OptimizeOptions {
   // tenths). r03's standing flap: the bottom side's first samples landed
   // 5-18 % of M's diagonal off its line, somewhere else each iteration, so F
   // jumped (the line term x20) and rounds 0 and 1 ran 61 and 44 iterations.
-  // 4 against 0 on two benchmark front ends: r03 0.691 -> 0.719 (9.0 ->
-  // 4.5 s), set04 +0.010, set08 -0.003 on one, all 12 identical on the
-  // other; 3 took a curved end of set04's and set08's sides off there
-  // (-0.010, -0.011).
+  // 4 against 0 on three benchmark front ends: r03 0.691 -> 0.719 (11 ->
+  // 5.6 s), set04 +0.010, set08 -0.003 on one, all 12 identical on another,
+  // r03 +0.004 on the third; 3 took a curved end of set04's and set08's
+  // sides off (-0.010, -0.011) (README, "Choices we measured").
   double side_end_outliers = 4;
   double line_spacing = 0;            // isometry::SolveOptions::line_spacing
   double max_spacing_ratio = 1.35;    // isometry::SolveOptions::max_spacing_ratio
