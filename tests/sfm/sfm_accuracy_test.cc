@@ -6,10 +6,11 @@
 //   - camera centres within 1 % of the page diagonal (RMS, after a similarity
 //     alignment of the sfm centres onto the true ones, Eigen::umeyama);
 //   - median distance of the points on the page to the true surface within
-//     0.5 % of the diagonal, after the same similarity ("on the page": the
+//     0.5 % of the diagonal, and the camera centres still within 1 %, after
+//     the similarity that fits cameras and page together ("on the page": the
 //     point falls on the true page in at least half of the true views whose
 //     image it falls in; points on a textured table are real points, just
-//     not of the page);
+//     not of the page); within 1 % after the cameras' similarity alone;
 //   - a sensible reference: it sees the whole page when some view does, and
 //     is about as frontal as the most frontal such view;
 //   - the files are what later stages expect (schema, reference frame, median
@@ -32,6 +33,14 @@ namespace {
 
 constexpr double kMaxCameraRms = 0.01;        // of the page diagonal
 constexpr double kMaxMedianDistance = 0.005;  // of the page diagonal
+// After the cameras' similarity alone. With 4 views a common tilt of all
+// cameras of 0.06 deg moves the page 2 mm along its normal relative to their
+// centres (see stages/sfm/sfm.cc), and COLMAP seeds its RANSAC afresh each
+// run: twelve runs of sfm on r02 with the same code measured 0.17-0.55 % here
+// (3 above 0.5 %) and 0.08-0.20 % for the page, 0.08-0.15 % for the cameras
+// under the joint fit. So this gauge keeps a bound for gross errors only
+// (r03's solution bent by wrong matches reached 2.6 %).
+constexpr double kMaxCameraGaugeMedianDistance = 0.01;
 // The reference's true resolution where it sees the page worst (10 %
 // quantile of pixels per metre across the foreshortening, hidden parts 0) is
 // at least this fraction of the best whole-page view's. sfm estimates it from
@@ -76,7 +85,9 @@ TEST_P(SfmAccuracy, MatchesGroundTruth) {
   EXPECT_EQ(f.registered, f.views) << name;
   EXPECT_LE(f.camera_rms, kMaxCameraRms) << name;
   EXPECT_GE(f.page_points, 100) << name;
-  EXPECT_LE(f.median_page_distance, kMaxMedianDistance) << name;
+  EXPECT_LE(f.joint_median_distance, kMaxMedianDistance) << name;
+  EXPECT_LE(f.joint_camera_rms, kMaxCameraRms) << name;
+  EXPECT_LE(f.median_page_distance, kMaxCameraGaugeMedianDistance) << name;
   if (!f.best_true_view.empty()) {
     EXPECT_TRUE(f.reference_whole_page)
         << name << ": reference " << f.reference << " cuts the page off, "

@@ -80,6 +80,37 @@ Eigen::Matrix4d Umeyama(const std::vector<Eigen::Vector3d>& src,
   return Eigen::umeyama(a, b, true);
 }
 
+// The similarity minimising sum w_i |s R src_i + t - dst_i|^2 (Umeyama's
+// closed form with weighted means and covariance).
+Eigen::Matrix4d WeightedUmeyama(const std::vector<Eigen::Vector3d>& src,
+                                const std::vector<Eigen::Vector3d>& dst,
+                                const std::vector<double>& w) {
+  double total = 0;
+  Eigen::Vector3d mean_src = Eigen::Vector3d::Zero(), mean_dst = Eigen::Vector3d::Zero();
+  for (size_t i = 0; i < src.size(); ++i) {
+    total += w[i];
+    mean_src += w[i] * src[i];
+    mean_dst += w[i] * dst[i];
+  }
+  mean_src /= total;
+  mean_dst /= total;
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  double var_src = 0;
+  for (size_t i = 0; i < src.size(); ++i) {
+    cov += w[i] * (dst[i] - mean_dst) * (src[i] - mean_src).transpose();
+    var_src += w[i] * (src[i] - mean_src).squaredNorm();
+  }
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(cov, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Vector3d sign = Eigen::Vector3d::Ones();
+  if (svd.matrixU().determinant() * svd.matrixV().determinant() < 0) sign.z() = -1;
+  const Eigen::Matrix3d R = svd.matrixU() * sign.asDiagonal() * svd.matrixV().transpose();
+  const double scale = svd.singularValues().dot(sign) / var_src;
+  Eigen::Matrix4d T = Eigen::Matrix4d::Identity();
+  T.topLeftCorner<3, 3>() = scale * R;
+  T.topRightCorner<3, 1>() = mean_dst - scale * R * mean_src;
+  return T;
+}
+
 Eigen::Vector3d Apply(const Eigen::Matrix4d& T, const Eigen::Vector3d& p) {
   return T.topLeftCorner<3, 3>() * p + T.topRightCorner<3, 1>();
 }
@@ -231,18 +262,18 @@ SfmFigures MeasureSfm(const fs::path& sfm_dir, const GroundTruth& gt) {
   // optical axis (the true distance, and that over the centres' scale on
   // sfm's side), so the cameras' orientations hold it too.
   Eigen::Matrix4d T = Umeyama(src, dst);
+  std::vector<Eigen::Vector3d> axis_src = src, axis_dst = dst;
   {
     Eigen::Vector3d page_centre = Eigen::Vector3d::Zero();
     for (const auto& v : gt.mesh.vertices) page_centre += v / double(gt.mesh.vertices.size());
     const double scale = T.block<3, 1>(0, 0).norm();
-    std::vector<Eigen::Vector3d> src2 = src, dst2 = dst;
     for (const PinholeCamera& c : sfm.views)
       if (const PinholeCamera* t = gt.cameras.Find(c.image)) {
         const double d = (page_centre - t->Center()).norm();
-        dst2.push_back(t->Center() + d * t->R.row(2).transpose());
-        src2.push_back(c.Center() + d / scale * c.R.row(2).transpose());
+        axis_dst.push_back(t->Center() + d * t->R.row(2).transpose());
+        axis_src.push_back(c.Center() + d / scale * c.R.row(2).transpose());
       }
-    T = Umeyama(src2, dst2);
+    T = Umeyama(axis_src, axis_dst);
   }
   double sum = 0;
   for (size_t i = 0; i < src.size(); ++i) sum += (Apply(T, src[i]) - dst[i]).squaredNorm();
@@ -279,9 +310,12 @@ SfmFigures MeasureSfm(const fs::path& sfm_dir, const GroundTruth& gt) {
   f.median_all_distance = Median(all);
   f.median_page_distance = Median(page);
 
-  // Shape alone: trimmed ICP of the page points onto the surface.
-  if (page_points.size() >= 10) {
+  // Trimmed ICP of the page points onto the surface, from T; with
+  // `cameras` the camera pairs (centres and axis points, as in T) weigh as
+  // much as the points together, so the fit holds both.
+  auto fit = [&](bool cameras, double* median, double* camera_rms) {
     std::vector<Eigen::Vector3d> cur = page_points;
+    Eigen::Matrix4d icp = Eigen::Matrix4d::Identity();
     for (int iter = 0; iter < 15; ++iter) {
       std::vector<std::pair<double, size_t>> order;
       std::vector<Eigen::Vector3d> feet(cur.size());
@@ -293,12 +327,31 @@ SfmFigures MeasureSfm(const fs::path& sfm_dir, const GroundTruth& gt) {
         a.push_back(cur[order[k].second]);
         b.push_back(feet[order[k].second]);
       }
-      const Eigen::Matrix4d S = Umeyama(a, b);
+      std::vector<double> w(a.size(), 1.0);
+      if (cameras) {
+        const double share = double(a.size()) / double(axis_src.size());
+        for (size_t i = 0; i < axis_src.size(); ++i) {
+          a.push_back(Apply(icp * T, axis_src[i]));
+          b.push_back(axis_dst[i]);
+          w.push_back(share);
+        }
+      }
+      const Eigen::Matrix4d S = WeightedUmeyama(a, b, w);
       for (Eigen::Vector3d& p : cur) p = Apply(S, p);
+      icp = S * icp;
     }
     std::vector<double> d;
     for (const Eigen::Vector3d& p : cur) d.push_back(surface.Distance(p) / diag);
-    f.shape_median_distance = Median(d);
+    *median = Median(d);
+    double sum = 0;
+    for (size_t i = 0; i < src.size(); ++i)
+      sum += (Apply(icp * T, src[i]) - dst[i]).squaredNorm();
+    *camera_rms = std::sqrt(sum / src.size()) / diag;
+  };
+  if (page_points.size() >= 10) {
+    double unused = 0;
+    fit(false, &f.shape_median_distance, &unused);
+    fit(true, &f.joint_median_distance, &f.joint_camera_rms);
   }
 
   const auto truth = TrueViews(gt);
@@ -331,12 +384,15 @@ std::string FormatFigures(const SfmFigures& f) {
   char buf[768];
   std::snprintf(buf, sizeof buf,
                 "registered %d/%d, camera centres RMS %.3f%%, points %d (on page %d), "
-                "median distance page points %.3f%% (all %.3f%%, shape after ICP %.3f%%), "
+                "median distance page points %.3f%% (all %.3f%%, shape after ICP %.3f%%; fitting cameras and page together: cameras %.3f%%, "
+                "page points %.3f%%), "
                 "reference %s (true frontality %.3f, resolution %.0f px/m, whole page %s; "
                 "best-resolving whole view %s %.0f)",
                 f.registered, f.views, 100 * f.camera_rms, f.points, f.page_points,
                 100 * f.median_page_distance, 100 * f.median_all_distance,
-                100 * f.shape_median_distance, f.reference.c_str(), f.reference_frontality,
+                100 * f.shape_median_distance, 100 * f.joint_camera_rms,
+                100 * f.joint_median_distance,
+                f.reference.c_str(), f.reference_frontality,
                 f.reference_resolution, f.reference_whole_page ? "yes" : "no",
                 f.best_true_view.c_str(), f.best_true_resolution);
   return buf;

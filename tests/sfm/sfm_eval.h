@@ -48,6 +48,12 @@ struct SfmFigures {
   // Median distance of the page points after fitting them to the surface by
   // a similarity (ICP): the shape alone, without the camera error.
   double shape_median_distance = 0;
+  // The same ICP with the camera pairs of the alignment above in the fit,
+  // weighing as much as the points: the similarity that fits cameras and
+  // page together, and the camera-centre RMS and page points' median
+  // distance under it (fractions of the diagonal).
+  double joint_camera_rms = 0;
+  double joint_median_distance = 0;
   std::string reference;
   double reference_frontality = 0;  // true figures of the chosen reference
   double reference_resolution = 0;
