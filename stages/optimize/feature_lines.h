@@ -4,6 +4,7 @@
 // close to one straight line in M' are merged into feature lines.
 #pragma once
 
+#include <array>
 #include <string>
 #include <vector>
 
@@ -12,6 +13,7 @@
 #include "common/axis_direction.h"
 #include "common/camera.h"
 #include "common/grid_mesh.h"
+#include "common/page_files.h"
 #include "common/isometry/isometry.h"
 
 namespace docunfold::optimize {
@@ -108,5 +110,17 @@ std::vector<isometry::FeatureLine> AssignLines(const MeshPair& meshes, const Gro
 // land anywhere along it. Returns how many were dropped.
 int DropSideOutliers(const MeshPair& meshes, const Grouping& grouping, double tolerance,
                      MarkerSet* markers, double end_factor = 0);
+
+// M's grid corners are the page's corners TL TR BR BL (init-mesh builds the
+// grid between the boundary's four sides). Which corners lie between two
+// real sides and have their grid corner in `meshes` project within `max_px`
+// reference pixels of them.
+std::array<bool, 4> HeldCorners(const MeshPair& meshes, const Boundary& boundary,
+                                const PinholeCamera& reference, double max_px);
+// For each `held` corner an E_ray marker (no line) holding M's grid corner
+// to the viewing ray of the boundary's corner.
+std::vector<isometry::Marker> CornerMarkers(const MeshPair& meshes, const Boundary& boundary,
+                                            const PinholeCamera& reference,
+                                            const std::array<bool, 4>& held);
 
 }  // namespace docunfold::optimize

@@ -84,6 +84,12 @@ int main(int argc, char** argv) {
                  "be (0 = keep all)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1000.0));
+  app.add_option("--corner-max-px", o.corner_max_px,
+                 "hold M's grid corners to the rays of the page corners between two real "
+                 "sides where init-mesh's corner lies within this many reference pixels of "
+                 "them (0 = off)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 10000.0));
   app.add_option("--line-spacing", o.line_spacing,
                  "each outer iteration, move a text row this fraction of the "
                  "way to the middle of its neighbouring rows (0 = off)")
@@ -185,6 +191,7 @@ int main(int argc, char** argv) {
                                {"fair2d_relative_rounds", o.fair2d_relative_rounds},
                                {"side_outliers", o.side_outliers},
                                {"side_end_outliers", o.side_end_outliers},
+                               {"corner_max_px", o.corner_max_px},
                                {"line_spacing", o.line_spacing},
                                {"max_spacing_ratio", o.max_spacing_ratio},
                                {"features", o.features},

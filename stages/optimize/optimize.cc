@@ -1,5 +1,6 @@
 #include "stages/optimize/optimize.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 
@@ -97,6 +98,14 @@ OptimizeResult Run(const OptimizeInputs& in, const OptimizeOptions& o) {
       Log(std::string(buf) + ": M' left as it is");
     }
   }
+  const std::array<bool, 4> held_corners =
+      o.corner_max_px > 0 ? HeldCorners(in.init, in.boundary, in.reference, o.corner_max_px)
+                          : std::array<bool, 4>{false, false, false, false};
+  result.held_corners = int(std::count(held_corners.begin(), held_corners.end(), true));
+  if (o.corner_max_px > 0)
+    Log("M's grid corners held to " + std::to_string(result.held_corners) +
+        " page corners (between real sides, init-mesh's corner within " +
+        std::to_string(int(o.corner_max_px)) + " px)");
   isometry::Weights weights = o.weights;
   if (segments.empty()) weights.line = weights.ray = 0;
   for (int r = 0; r < o.rounds; ++r) {
@@ -153,6 +162,10 @@ OptimizeResult Run(const OptimizeInputs& in, const OptimizeOptions& o) {
             c.markers->push_back(current.markers[i]);
             kept.push_back(int(i));
           }
+        // After the line markers, so `kept` still maps the solver's first ones.
+        const std::vector<isometry::Marker> corners =
+            CornerMarkers(*c.meshes, in.boundary, in.reference, held_corners);
+        c.markers->insert(c.markers->end(), corners.begin(), corners.end());
       };
     }
     isometry::Result solved = isometry::Solve(problem, so);

@@ -68,6 +68,10 @@ struct OptimizeOptions {
   // r03 +0.004 on the third; 3 took a curved end of set04's and set08's
   // sides off (-0.010, -0.011) (README, "Choices we measured").
   double side_end_outliers = 4;
+  // M's grid corners are held to the rays of the boundary's corners between
+  // two real sides (CornerMarkers) where init-mesh's corner projects within
+  // this many reference pixels of them; 0 = off.
+  double corner_max_px = 0;
   double line_spacing = 0;            // isometry::SolveOptions::line_spacing
   double max_spacing_ratio = 1.35;    // isometry::SolveOptions::max_spacing_ratio
   isometry::Method method = isometry::Method::kGaussNewton;
@@ -145,6 +149,7 @@ struct OptimizeResult {
   int segments = 0;                // feature segments given (text + edge)
   int segments_off_page = 0;       // of those, dropped: their samples miss M
   int boundary_lines = 0;          // real boundary sides used
+  int held_corners = 0;            // page corners M's grid corners were held to
   double seconds = 0;
 };
 

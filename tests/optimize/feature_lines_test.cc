@@ -141,5 +141,42 @@ TEST(DropSideOutliers, AtTheEndsOnlyFarOutliersLoseTheirLine) {
   EXPECT_EQ(DropSideOutliers(scene.meshes, grouping, 0.005, &far_kept, 0), 0);
 }
 
+TEST(CornerMarkers, HoldTheGridCornersToTheRaysOfRealCornersNearThem) {
+  const Scene scene;
+  Boundary boundary;
+  boundary.corners = {Eigen::Vector2d(300, 250), Eigen::Vector2d(500, 250),
+                      Eigen::Vector2d(530, 580), Eigen::Vector2d(304, 547)};
+  for (BoundarySide& side : boundary.sides) side.real = true;
+  // BR is 42 px from the grid's corner, the others within 5 px.
+  EXPECT_EQ(HeldCorners(scene.meshes, boundary, scene.camera, 20),
+            (std::array<bool, 4>{true, true, false, true}));
+  EXPECT_EQ(HeldCorners(scene.meshes, boundary, scene.camera, 50),
+            (std::array<bool, 4>{true, true, true, true}));
+  // A corner on a cut side is no page corner.
+  Boundary cut = boundary;
+  cut.sides[2].real = false;
+  EXPECT_EQ(HeldCorners(scene.meshes, cut, scene.camera, 50),
+            (std::array<bool, 4>{true, true, false, false}));
+
+  const std::array<bool, 4> held = {true, true, true, true};
+  const std::vector<isometry::Marker> markers =
+      CornerMarkers(scene.meshes, boundary, scene.camera, held);
+  ASSERT_EQ(markers.size(), 4u);
+  const int corner_vertex[4] = {0, 4, 34, 30};  // TL TR BR BL of the 5 x 7 grid
+  for (int k = 0; k < 4; ++k) {
+    const isometry::Marker& m = markers[k];
+    EXPECT_EQ(m.line, -1);
+    EXPECT_TRUE(m.across.isZero());
+    EXPECT_LT((PointOnMesh3d(scene.meshes, m.where) - scene.meshes.mesh3d[corner_vertex[k]])
+                  .norm(),
+              1e-12)
+        << k;
+    EXPECT_GT(m.ray_direction.dot(scene.camera.RayDirection(boundary.corners[k])), 1 - 1e-12);
+  }
+  EXPECT_EQ(CornerMarkers(scene.meshes, boundary, scene.camera, {false, true, false, false})
+                .size(),
+            1u);
+}
+
 }  // namespace
 }  // namespace docunfold::optimize
