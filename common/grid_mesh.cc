@@ -1,5 +1,6 @@
 #include "common/grid_mesh.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "common/errors.h"
@@ -30,6 +31,18 @@ std::vector<Triangle> QuadGrid::Triangles() const {
     tris.push_back({c[0], c[2], c[3]});
   }
   return tris;
+}
+
+SurfacePoint VertexSurfacePoint(const QuadGrid& grid, int row, int col) {
+  const int qr = std::min(row, grid.ny - 2), qc = std::min(col, grid.nx - 2);
+  const int quad = qr * (grid.nx - 1) + qc;
+  // Its place among the quad's corners (r,c) (r,c+1) (r+1,c+1) (r+1,c);
+  // triangle 2q holds corners 0 1 2, triangle 2q+1 corners 0 2 3.
+  const int corner = row == qr ? (col == qc ? 0 : 1) : (col == qc ? 3 : 2);
+  SurfacePoint p;
+  p.triangle = corner == 3 ? 2 * quad + 1 : 2 * quad;
+  p.bary = Eigen::Vector3d::Unit(corner == 3 ? 2 : corner);
+  return p;
 }
 
 namespace {

@@ -54,6 +54,9 @@ struct SurfacePoint {
   Eigen::Vector3d bary = Eigen::Vector3d::Zero();
 };
 
+// Grid vertex (row, col) as a corner of one of its quads' triangles.
+SurfacePoint VertexSurfacePoint(const QuadGrid& grid, int row, int col);
+
 Eigen::Vector3d PointOnMesh3d(const MeshPair& m, const SurfacePoint& p);
 Eigen::Vector2d PointOnMesh2d(const MeshPair& m, const SurfacePoint& p);
 

@@ -536,14 +536,7 @@ std::vector<isometry::Marker> OutlineMarkers(const MeshPair& m, const PinholeCam
       }
       if (!std::isfinite(best) || cut) continue;
       isometry::Marker mk;
-      // A triangle of a quad with v as a corner (see QuadGrid::Triangles).
-      const int qr = std::min(r, g.ny - 2), qc = std::min(c, g.nx - 2);
-      const int quad = qr * (g.nx - 1) + qc;
-      const int corner = r == qr ? (c == qc ? 0 : 1) : (c == qc ? 3 : 2);
-      mk.where.triangle = corner == 3 ? 2 * quad + 1 : 2 * quad;
-      mk.where.bary = corner == 0   ? Eigen::Vector3d(1, 0, 0)
-                      : corner == 1 ? Eigen::Vector3d(0, 1, 0)
-                                    : Eigen::Vector3d(0, 0, 1);
+      mk.where = VertexSurfacePoint(g, r, c);
       mk.ray_origin = centre;
       mk.ray_direction = cam.RayDirection(q);
       mk.across = mk.ray_direction.cross(cam.RayDirection(q + tangent)).normalized();

@@ -408,22 +408,21 @@ namespace {
 // bottom 2, left 3).
 constexpr int kCornerSides[4][2] = {{0, 3}, {0, 1}, {1, 2}, {2, 3}};
 
-int CornerVertex(const QuadGrid& grid, int k) {
-  const int row = k >= 2 ? grid.ny - 1 : 0, col = k == 1 || k == 2 ? grid.nx - 1 : 0;
-  return grid.Index(row, col);
-}
+int CornerRow(const QuadGrid& grid, int k) { return k >= 2 ? grid.ny - 1 : 0; }
+int CornerCol(const QuadGrid& grid, int k) { return k == 1 || k == 2 ? grid.nx - 1 : 0; }
 
 }  // namespace
 
 std::array<bool, 4> HeldCorners(const MeshPair& meshes, const Boundary& boundary,
                                 const PinholeCamera& reference, double max_px) {
   std::array<bool, 4> held = {false, false, false, false};
-  if (meshes.grid.nx < 2 || meshes.grid.ny < 2) return held;
+  const QuadGrid& grid = meshes.grid;
+  if (grid.nx < 2 || grid.ny < 2) return held;
   for (int k = 0; k < 4; ++k) {
     if (!boundary.sides[kCornerSides[k][0]].real || !boundary.sides[kCornerSides[k][1]].real)
       continue;
-    const Eigen::Vector3d x_cam =
-        reference.CamFromWorld(meshes.mesh3d[CornerVertex(meshes.grid, k)]);
+    const Eigen::Vector3d x_cam = reference.CamFromWorld(
+        meshes.mesh3d[grid.Index(CornerRow(grid, k), CornerCol(grid, k))]);
     held[k] = x_cam.z() > 0 && (reference.ProjectCam(x_cam) - boundary.corners[k]).norm() <= max_px;
   }
   return held;
@@ -435,17 +434,10 @@ std::vector<isometry::Marker> CornerMarkers(const MeshPair& meshes, const Bounda
   std::vector<isometry::Marker> out;
   const QuadGrid& grid = meshes.grid;
   if (grid.nx < 2 || grid.ny < 2) return out;
-  // The corner vertex's quad and its place in that quad's triangles
-  // (QuadGrid::Triangles: 2q = quad corners 0 1 2, 2q+1 = 0 2 3 of (r,c)
-  // (r,c+1) (r+1,c+1) (r+1,c)).
-  const int quad[4] = {0, grid.nx - 2, grid.NumQuads() - 1, (grid.ny - 2) * (grid.nx - 1)};
-  const int triangle[4] = {0, 0, 0, 1};  // 2q + this
-  const int bary_index[4] = {0, 1, 2, 2};
   for (int k = 0; k < 4; ++k) {
     if (!held[k]) continue;
     isometry::Marker m;
-    m.where.triangle = 2 * quad[k] + triangle[k];
-    m.where.bary = Eigen::Vector3d::Unit(bary_index[k]);
+    m.where = VertexSurfacePoint(grid, CornerRow(grid, k), CornerCol(grid, k));
     m.ray_origin = reference.Center();
     m.ray_direction = reference.RayDirection(boundary.corners[k]);
     out.push_back(m);
