@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 #include "common/statistics.h"
@@ -266,6 +267,48 @@ CropRect ChooseCrop(std::array<SideFit, 4>* sides_in,
   }
   crop.rule = used == 4 ? "boundary-lines" : "real-sides-and-visible-mesh";
   return crop;
+}
+
+PageFormatFit ExtendToPageFormat(CropRect* crop, const std::array<bool, 4>& unseen,
+                                 double aspect) {
+  PageFormatFit fit;
+  const bool x_unseen = unseen[1] || unseen[3], y_unseen = unseen[0] || unseen[2];
+  if (!x_unseen && !y_unseen) return fit;
+  if (x_unseen && y_unseen) {
+    fit.note = "sides of both axes are cut off unseen: the page's width is not known";
+    return fit;
+  }
+  fit.axis = x_unseen ? 0 : 1;
+  fit.seen = x_unseen ? crop->Width() : crop->Height();
+  fit.across = x_unseen ? crop->Height() : crop->Width();
+  if (!(aspect >= 1) || !(fit.seen > 0) || !(fit.across > 0)) {
+    fit.note = "no usable extent";
+    return fit;
+  }
+  const double shorter = fit.across / aspect, longer = fit.across * aspect;
+  if (fit.seen <= shorter) {
+    fit.length = shorter;
+  } else if (fit.seen <= 1.01 * longer) {
+    fit.length = std::max(fit.seen, longer);
+  } else {
+    char buf[160];
+    std::snprintf(buf, sizeof buf,
+                  "the part seen is already %.3f times the page's width, longer than the "
+                  "format's %.3f",
+                  fit.seen / fit.across, aspect);
+    fit.note = buf;
+    return fit;
+  }
+  const double grow = fit.length - fit.seen;
+  if (grow <= 0) return fit;
+  const int low = x_unseen ? 3 : 0, high = x_unseen ? 1 : 2;
+  const double share = unseen[low] && unseen[high] ? 0.5 * grow : grow;
+  double& low_edge = x_unseen ? crop->x0 : crop->y0;
+  double& high_edge = x_unseen ? crop->x1 : crop->y1;
+  if (unseen[low]) low_edge -= share;
+  if (unseen[high]) high_edge += share;
+  fit.applied = true;
+  return fit;
 }
 
 }  // namespace docunfold::render

@@ -67,6 +67,17 @@ struct CropRect {
 CropRect ChooseCrop(std::array<SideFit, 4>* sides,
                     const Eigen::Vector4d& visible_box, double middle_max_slant = -1);
 
+// A page cut off where no photo sees its edge ends somewhere past the crop;
+// a paper format of long-to-short ratio `aspect` says where. Lengthens `crop`
+// across the sides flagged in `unseen` (0 top, 1 right, 2 bottom, 3 left) to
+// the shorter of W * aspect and W / aspect that is at least the part seen,
+// W being the crop's extent across them; two unseen sides of one axis share
+// the lengthening. Not applied when both axes have an unseen side (W is then
+// not the page's) or the part seen is longer than W * aspect (+1 %: not that
+// format).
+PageFormatFit ExtendToPageFormat(CropRect* crop, const std::array<bool, 4>& unseen,
+                                 double aspect);
+
 // Angle (radians) of a side's line from its axis: from +x for top and
 // bottom, from +y for left and right, positive clockwise in image axes.
 double SlantOf(const SideFit& side, int index);

@@ -121,6 +121,24 @@ int main(int argc, char** argv) {
                  "how far past a cut side the page edge is looked for, as a fraction of "
                  "what the reference view shows along that axis")
       ->capture_default_str()->check(CLI::Range(0.0, 10.0));
+  std::string page_format = "none";
+  app.add_option("--page-format", page_format,
+                 "where the page is cut off and no photo sees its edge, lengthen the crop "
+                 "across the cut to the whole page of this format, the unseen part in the "
+                 "fill colour: iso (A4, A5, ...: sides 1:1.414), letter (1:1.294), legal "
+                 "(1:1.647), a long-to-short ratio such as 1.5, or none (stop where the "
+                 "photos do)")
+      ->capture_default_str()
+      ->check([](const std::string& v) -> std::string {
+        if (v == "iso" || v == "letter" || v == "legal" || v == "none") return "";
+        try {
+          size_t used = 0;
+          const double ratio = std::stod(v, &used);
+          if (used == v.size() && ratio >= 1 && ratio <= 10) return "";
+        } catch (const std::exception&) {
+        }
+        return "expected iso, letter, legal, none or a ratio between 1 and 10, got '" + v + "'";
+      });
   app.add_option("--better-views", o.better_views.min_gain,
                  "texture a point from another photo (--images) where it resolves the page "
                  "this many times better than the reference photo, e.g. a fold's panel the "
@@ -134,6 +152,11 @@ int main(int argc, char** argv) {
     o.extend_cut_sides = !no_extend;
     o.texture_cut_sides = !no_texture_cut;
     o.reach_real_sides = !no_reach;
+    o.page_aspect = page_format == "iso"      ? render::kIsoAspect
+                    : page_format == "letter" ? render::kLetterAspect
+                    : page_format == "legal"  ? render::kLegalAspect
+                    : page_format == "none"   ? 0.0
+                                              : std::stod(page_format);
     const render::RenderInputs in =
         render::ReadRenderInputs(sfm, boundary, meshes, images, features);
     const double read_s = SecondsSince(start);

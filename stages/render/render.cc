@@ -468,7 +468,8 @@ Json OptionsToJson(const RenderOptions& o) {
           {"extend_cut_sides", o.extend_cut_sides},
           {"texture_cut_sides", o.texture_cut_sides},
           {"scattered_sides", o.scattered_sides},
-          {"max_extension", o.cut_sides.max_extension}};
+          {"max_extension", o.cut_sides.max_extension},
+          {"page_aspect", o.page_aspect}};
 }
 
 Json Vec2(const Eigen::Vector2d& v) { return Json::array({v.x(), v.y()}); }
@@ -531,6 +532,13 @@ Json MakeReport(const RenderOptions& options, const RenderInputs& in,
     sides[kSideNames[i]] = j;
   }
   doc["sides"] = sides;
+  if (const PageFormatFit& f = r.page_format; options.page_aspect > 0 && f.axis >= 0) {
+    Json j = {{"aspect", options.page_aspect}, {"applied", f.applied},
+              {"axis", f.axis == 0 ? "x" : "y"}, {"seen", f.seen}, {"across", f.across}};
+    if (f.applied) j["length"] = f.length;
+    if (!f.note.empty()) j["note"] = f.note;
+    doc["page_format"] = j;
+  }
   doc["fill_rgb"] = {r.fill[2], r.fill[1], r.fill[0]};
   doc["page_fraction"] = r.page_fraction;
   doc["hidden_fraction"] = r.hidden_fraction;
@@ -756,6 +764,25 @@ RenderResult Run(const RenderOptions& options, const RenderInputs& in) {
     if (r.sides[i].real && !r.sides[i].used && !r.reached_sides[i].measured)
       Log(std::string(kSideNames[i]) +
           " side not used for the crop: " + r.sides[i].note);
+  if (options.page_aspect > 0) {
+    std::array<bool, 4> unseen;
+    for (int i = 0; i < 4; ++i)
+      unseen[i] = !in.boundary.sides[i].real &&
+                  !(r.cut_edges[i].measured && r.cut_edges[i].edge_seen);
+    r.page_format = ExtendToPageFormat(&crop, unseen, options.page_aspect);
+    const PageFormatFit& f = r.page_format;
+    if (f.applied) {
+      char buf[200];
+      std::snprintf(buf, sizeof buf,
+                    "no photo sees where the page ends past its cut %s: the crop lengthened "
+                    "from %.3f to %.3f, %.2f times its width (--page-format)",
+                    f.axis == 0 ? "left or right" : "top or bottom", f.seen, f.length,
+                    f.length / f.across);
+      Log(buf);
+    } else if (!f.note.empty()) {
+      Log("page format not applied: " + f.note);
+    }
+  }
   r.crop_rule = crop.rule;
   timer.Mark("crop");
 

@@ -220,6 +220,8 @@ TEST_F(RenderCli, ContradictoryFlagsAreUsageErrors) {
   ExpectFailure(Render(scene(), out, "--fill purple"), 2, "--fill", out);
   ExpectFailure(Render(scene(), out, "--width 100000"), 2, "--max-pixels", out);
   ExpectFailure(Render(scene(), out, "--shading dim"), 2, "--shading", out);
+  ExpectFailure(Render(scene(), out, "--page-format a3"), 2, "--page-format", out);
+  ExpectFailure(Render(scene(), out, "--page-format 0.7"), 2, "--page-format", out);
 }
 
 // --shading remove divides the light out (common/shading.h, tested there):

@@ -211,6 +211,7 @@ TEST(RenderScene, CutOffPageIsCroppedByItsRealSidesAndWhatTheViewSees) {
   ASSERT_TRUE(s.real[0] && s.real[1] && s.real[2]);
   const render::RenderResult r = render::Run({}, InputsOf(s));
   EXPECT_EQ(r.crop_rule, "real-sides-and-visible-mesh");
+  EXPECT_FALSE(r.page_format.applied);
   EXPECT_FALSE(r.sides[3].used);
   EXPECT_TRUE(r.sides[0].used);
   EXPECT_TRUE(r.sides[1].used);
@@ -248,6 +249,87 @@ TEST(RenderScene, CutOffPageIsCroppedByItsRealSidesAndWhatTheViewSees) {
   ASSERT_GT(off.tiles, 5);
   EXPECT_EQ(off.matched, off.tiles);
   EXPECT_LT(off.median, 0.5);
+}
+
+TEST(RenderScene, APageCutOffUnseenIsCompletedToItsFormat) {
+  SceneOptions o;
+  o.page_origin = {-0.6, -0.3, 1.0};  // the left part runs off the image
+  const SyntheticScene s = MakeScene(o);
+  ASSERT_FALSE(s.real[3]);
+  render::RenderOptions options;
+  options.page_aspect = o.page_h / o.page_w;  // the scene's page, 0.56 x 0.42
+  const render::RenderResult r = render::Run(options, InputsOf(s));
+  ASSERT_TRUE(r.page_format.applied);
+  EXPECT_EQ(r.page_format.axis, 0);
+  const double px = 1 / r.pixels_per_unit;
+  // The whole page, its unseen left part in the fill colour.
+  EXPECT_NEAR(r.crop_x0, 0, 2 * px);
+  EXPECT_NEAR(r.crop_x1, s.page_w, px);
+  EXPECT_NEAR(r.crop_y0, 0, px);
+  EXPECT_NEAR(r.crop_y1, s.page_h, px);
+  EXPECT_EQ(r.rectified.at<cv::Vec3b>(r.rectified.rows / 2, 2), r.fill);
+  EXPECT_EQ(r.report["page_format"]["applied"], true);
+  EXPECT_EQ(r.report["page_format"]["axis"], "x");
+  // ISO: the part seen is narrower than 0.56 / 1.414, so the page is taken
+  // to be that wide (its long side up).
+  ASSERT_LT(r.page_format.seen, s.page_h / render::kIsoAspect);
+  options.page_aspect = render::kIsoAspect;
+  const render::RenderResult iso = render::Run(options, InputsOf(s));
+  ASSERT_TRUE(iso.page_format.applied);
+  EXPECT_NEAR(iso.crop_x1 - iso.crop_x0, s.page_h / render::kIsoAspect, 2 * px);
+  EXPECT_NEAR(iso.crop_x1, s.page_w, px);
+}
+
+TEST(RenderCrop, TheFormatLengthensOnlyUnseenSidesOfOneAxis) {
+  const double a = render::kIsoAspect;
+  auto crop = [](double w, double h) { return render::CropRect{0, 0, w, h, "test"}; };
+  // Right side unseen, 1 high: the page seen (0.5 wide) is the short side,
+  // 1 / 1.414 = 0.707 wide.
+  render::CropRect c = crop(0.5, 1);
+  render::PageFormatFit f = render::ExtendToPageFormat(&c, {false, true, false, false}, a);
+  EXPECT_TRUE(f.applied);
+  EXPECT_EQ(f.axis, 0);
+  EXPECT_NEAR(c.x1, 1 / a, 1e-12);
+  EXPECT_EQ(c.x0, 0);
+  EXPECT_EQ(c.y1, 1);
+  // 0.8 wide seen: more than the short side, so the long one, 1.414.
+  c = crop(0.8, 1);
+  f = render::ExtendToPageFormat(&c, {false, true, false, false}, a);
+  EXPECT_TRUE(f.applied);
+  EXPECT_NEAR(c.x1, a, 1e-12);
+  EXPECT_NEAR(f.length, a, 1e-12);
+  // Top and bottom unseen: they share the lengthening.
+  c = crop(1, 1.2);
+  f = render::ExtendToPageFormat(&c, {true, false, true, false}, a);
+  EXPECT_TRUE(f.applied);
+  EXPECT_EQ(f.axis, 1);
+  EXPECT_NEAR(c.y0, -0.5 * (a - 1.2), 1e-12);
+  EXPECT_NEAR(c.y1, 1.2 + 0.5 * (a - 1.2), 1e-12);
+  // Already the format's length (within 1 %): left as it is.
+  c = crop(1.42, 1);
+  f = render::ExtendToPageFormat(&c, {false, false, false, true}, a);
+  EXPECT_FALSE(f.applied);
+  EXPECT_TRUE(f.note.empty());
+  EXPECT_EQ(c.x0, 0);
+  // Longer than any page of that format: not this format, left, with a note.
+  c = crop(1.6, 1);
+  f = render::ExtendToPageFormat(&c, {false, true, false, false}, a);
+  EXPECT_FALSE(f.applied);
+  EXPECT_FALSE(f.note.empty());
+  EXPECT_EQ(c.x1, 1.6);
+  // Both axes cut off unseen: the width is not known.
+  c = crop(0.5, 0.5);
+  f = render::ExtendToPageFormat(&c, {true, true, false, false}, a);
+  EXPECT_FALSE(f.applied);
+  EXPECT_FALSE(f.note.empty());
+  EXPECT_EQ(c.x1, 0.5);
+  EXPECT_EQ(c.y0, 0);
+  // Nothing unseen: nothing to do.
+  c = crop(0.5, 1);
+  f = render::ExtendToPageFormat(&c, {false, false, false, false}, a);
+  EXPECT_FALSE(f.applied);
+  EXPECT_EQ(f.axis, -1);
+  EXPECT_EQ(c.x1, 0.5);
 }
 
 TEST(RenderScene, PartsTheReferenceViewCannotSeeAreFilled) {
