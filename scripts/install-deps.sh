@@ -19,8 +19,8 @@ packages=(
   libtinygltf-dev
   # k-d trees for nearest points (SfM points, footpoints)
   libnanoflann-dev
-  # structure from motion
-  colmap
+  # structure from motion; SQLite to read COLMAP's database (exact matching)
+  colmap libsqlite3-dev
   # sparse Cholesky (CHOLMOD) for Gauss-Newton steps; L-BFGS as the
   # alternative solver. (CGAL, OpenMesh and Ceres are not needed: see the
   # README's dependency table for why.)

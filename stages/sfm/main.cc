@@ -9,7 +9,8 @@ using namespace docunfold;
 int main(int argc, char** argv) {
   CLI::App app{
       "Recovers the cameras and a sparse point cloud of the page with COLMAP (CPU SIFT, "
-      "exhaustive matching, incremental mapper), picks the reference view (the one that "
+      "every pair of views matched exactly and verified, incremental mapper: the same photos "
+      "give the same result on every run), picks the reference view (the one that "
       "sees the whole page and resolves its worst-seen part best) unless --ref names it, and writes "
       "cameras.json, points.ply and the undistorted reference.png in the reference "
       "camera's frame scaled to median depth 1, plus COLMAP's workspace in colmap/. "
@@ -42,6 +43,12 @@ int main(int argc, char** argv) {
   app.add_flag("--two-view-tracks,!--no-two-view-tracks", o.two_view_tracks,
                "also triangulate points only two views see (default: on; COLMAP's "
                "own default is off)");
+  app.add_option("--matcher", o.matcher,
+                 "exact: brute-force SIFT matching under COLMAP's criteria, verified by "
+                 "COLMAP (the same photos give the same result on every run); colmap: "
+                 "COLMAP's exhaustive_matcher (FLANN: a few matches differ between runs)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"exact", "colmap"}));
   app.add_flag("!--no-retry", o.retry,
                "do not retry the mapper with other settings when its result is "
                "implausible (views missing, focal length off, too few points)");

@@ -22,6 +22,7 @@
 #include "common/dataset.h"
 #include "common/errors.h"
 #include "common/ply.h"
+#include "stages/sfm/matching.h"
 #include "stages/sfm/subprocess.h"
 
 // Camera model and filter: measured on the data sets with ground truth
@@ -231,6 +232,7 @@ Json SfmOptions::ToJson() const {
           {"refine_distortion", refine_distortion},
           {"max_reprojection_error", max_reprojection_error},
           {"two_view_tracks", two_view_tracks},
+          {"matcher", matcher},
           {"retry", retry},
           {"min_points", min_points},
           {"threads", threads}};
@@ -464,14 +466,44 @@ SfmResult RunSfm(const SfmOptions& o) {
     progress.Done();
     result.seconds_extracting = SecondsSince(t0);
   }
-  // 2. Matches between every pair.
+  // 2. Matches between every pair: exact nearest neighbours (matching.h)
+  // verified by COLMAP, or COLMAP's own exhaustive matcher.
   {
     const auto t0 = std::chrono::steady_clock::now();
-    Log("matching features: " + std::to_string(n * (n - 1) / 2) + " pairs of views");
-    colmap.Run("exhaustive_matcher",
-               {"--database_path", database.string(), "--SiftMatching.use_gpu", "0",
-                "--SiftMatching.num_threads", threads},
-               "exhaustive_matcher.log", nullptr);
+    const int pairs = n * (n - 1) / 2;
+    Log("matching features: " + std::to_string(pairs) + " pairs of views (" + o.matcher + ")");
+    if (o.matcher == "exact") {
+      NumberImagesByName(database);
+      const std::vector<ImageDescriptors> images = ReadDatabaseDescriptors(database);
+      const fs::path list_file = colmap.dir / "matches_raw.txt";
+      std::ofstream list(list_file);
+      Progress progress("matching features", pairs);
+      long done = 0, total = 0;
+      for (size_t a = 0; a < images.size(); ++a)
+        for (size_t b = a + 1; b < images.size(); ++b) {
+          const auto matches = MatchDescriptors(images[a], images[b], MatchCriteria{});
+          list << images[a].name << ' ' << images[b].name << '\n';
+          for (const auto& [i, j] : matches) list << i << ' ' << j << '\n';
+          list << '\n';
+          total += long(matches.size());
+          progress.Update(++done);
+        }
+      list.close();
+      if (!list) throw OutputError(list_file.string() + ": write failed");
+      progress.Done();
+      Log("matching features: " + std::to_string(total) +
+          " matches before geometric verification");
+      colmap.Run("matches_importer",
+                 {"--database_path", database.string(), "--match_list_path",
+                  list_file.string(), "--match_type", "raw", "--SiftMatching.use_gpu", "0",
+                  "--SiftMatching.num_threads", threads},
+                 "matches_importer.log", nullptr);
+    } else {
+      colmap.Run("exhaustive_matcher",
+                 {"--database_path", database.string(), "--SiftMatching.use_gpu", "0",
+                  "--SiftMatching.num_threads", threads},
+                 "exhaustive_matcher.log", nullptr);
+    }
     result.seconds_matching = SecondsSince(t0);
   }
   // 3. Incremental mapping; retried with other settings when the result is

@@ -1,6 +1,6 @@
 // sfm: cameras and a sparse point cloud from the photos of a data set, by
-// COLMAP's command-line tools (CPU SIFT, exhaustive matching, incremental
-// mapper), expressed in the frame of an automatically chosen reference view
+// COLMAP's command-line tools (CPU SIFT, every pair matched exactly by
+// matching.h and verified by COLMAP, incremental mapper), expressed in the frame of an automatically chosen reference view
 // (DESIGN §4-5).
 //
 // Writes into options.out_dir (all or nothing: everything is made in a
@@ -66,6 +66,12 @@ struct SfmOptions {
   // telephoto to a 120-degree wide angle).
   double min_focal_factor = 0.3;
   double max_focal_factor = 10.0;
+
+  // "exact": every pair's SIFT matches by brute force under COLMAP's
+  // criteria (matching.h), verified by COLMAP's matches_importer: the same
+  // photos give the same cameras and points on every run. "colmap": COLMAP's
+  // exhaustive_matcher, whose FLANN search differs a little from run to run.
+  std::string matcher = "exact";
 
   int min_points = 100;     // fewer 3D points: bad input (exit 3)
   int threads = -1;         // COLMAP threads; -1 = all cores

@@ -93,7 +93,8 @@ TEST_F(SfmCli, UsageErrorsExit2) {
   for (const std::string& args :
        {std::string("--out ") + Quote(out.string()), std::string("--data x"),
         Args("x", out, "--camera-model FISHEYE"), Args("x", out, "--max-image-size 0"),
-        Args("x", out, "--no-such-flag"), Args("x", out, "--threads many")}) {
+        Args("x", out, "--no-such-flag"), Args("x", out, "--threads many"),
+        Args("x", out, "--matcher flann")}) {
     const CommandResult r = Sfm(args);
     EXPECT_EQ(r.exit_code, 2) << args << "\n" << r.output;
     EXPECT_FALSE(fs::exists(out));
@@ -208,7 +209,8 @@ TEST_F(SfmCli, GoodRunThenRefThenFailedRunKeepsTheOutput) {
   for (const char* f : {"cameras.json", "points.ply", "reference.png", "colmap/database.db",
                         "colmap/sparse/0/cameras.bin", "colmap/sparse/0/images.bin",
                         "colmap/sparse/0/points3D.bin", "colmap/feature_extractor.log",
-                        "colmap/exhaustive_matcher.log", "colmap/mapper.log"})
+                        "colmap/matches_raw.txt", "colmap/matches_importer.log",
+                        "colmap/mapper.log"})
     EXPECT_TRUE(fs::is_regular_file(out / f)) << f;
   const CameraSet first = ReadCameras(out / "cameras.json");
   EXPECT_EQ(first.views.size(), 3u);
@@ -229,6 +231,20 @@ TEST_F(SfmCli, GoodRunThenRefThenFailedRunKeepsTheOutput) {
   EXPECT_TRUE(second.Find(other)->R.isIdentity(0));
   EXPECT_TRUE(second.Find(other)->t.isZero(0));
   EXPECT_EQ(Listing(out.parent_path()), std::set<std::string>{"10_sfm"});
+
+  // Exact matching: the same photos give the same points, byte for byte.
+  auto read_bytes = [](const fs::path& f) {
+    std::ifstream in(f, std::ios::binary);
+    return std::string((std::istreambuf_iterator<char>(in)), {});
+  };
+  const std::string points = read_bytes(out / "points.ply");
+  ASSERT_EQ(Sfm(Args(data, out, "--threads 2 --ref " + other)).exit_code, 0);
+  EXPECT_EQ(read_bytes(out / "points.ply"), points);
+  // COLMAP's own matcher stays available.
+  const CommandResult r3 = Sfm(Args(data, out, "--threads 2 --matcher colmap"));
+  ASSERT_EQ(r3.exit_code, 0) << r3.output;
+  EXPECT_TRUE(fs::is_regular_file(out / "colmap/exhaustive_matcher.log"));
+  EXPECT_FALSE(fs::exists(out / "colmap/matches_raw.txt"));
 
   // A failing run leaves the last good output as it was.
   std::ifstream before_file(out / "cameras.json");

@@ -1,6 +1,9 @@
 // Unit tests of sfm's parts: COLMAP's binary model reader and pixel
 // convention, the reference frame, the reference-view score, the image
-// checks, undistortion and the subprocess runner. No COLMAP needed.
+// checks, undistortion, the subprocess runner and exact matching. No COLMAP
+// needed.
+#include <sqlite3.h>
+
 #include <cstdio>
 #include <fstream>
 #include <random>
@@ -14,6 +17,7 @@
 
 #include "common/errors.h"
 #include "stages/sfm/colmap_model.h"
+#include "stages/sfm/matching.h"
 #include "stages/sfm/reference_view.h"
 #include "stages/sfm/sfm.h"
 #include "stages/sfm/subprocess.h"
@@ -505,6 +509,133 @@ TEST(SfmEvalTest, PointTriangleDistance) {
   EXPECT_DOUBLE_EQ(PointTriangleDistance({0.5, -2, 0}, a, b, c), 2.0);      // edge ab
   EXPECT_NEAR(PointTriangleDistance({1, 1, 0}, a, b, c), std::sqrt(0.5), 1e-12);  // edge bc
   EXPECT_DOUBLE_EQ(PointTriangleDistance({2, 0, 0}, a, b, c), 1.0);         // vertex b
+}
+
+// --- exact matching ------------------------------------------------------
+
+// n random SIFT-like descriptors: non-negative, L2 norm 512, as bytes.
+Eigen::Matrix<float, Eigen::Dynamic, 128, Eigen::RowMajor> RandomDescriptors(int n,
+                                                                            std::mt19937* rng) {
+  std::uniform_real_distribution<float> u(0, 1);
+  Eigen::Matrix<float, Eigen::Dynamic, 128, Eigen::RowMajor> d(n, 128);
+  for (int i = 0; i < n; ++i) {
+    Eigen::Matrix<float, 1, 128> row;
+    for (int k = 0; k < 128; ++k) row[k] = u(*rng) * u(*rng);
+    row *= 512 / row.norm();
+    for (int k = 0; k < 128; ++k) d(i, k) = std::min(255.f, std::round(row[k]));
+  }
+  return d;
+}
+
+TEST(ExactMatchingTest, FindsTheSameFeaturesAndRejectsAmbiguousOnes) {
+  std::mt19937 rng(7);
+  sfm::ImageDescriptors a, b;
+  a.rows = RandomDescriptors(300, &rng);
+  // b: a's rows 0..199 in reverse order, each a little perturbed, then 100
+  // unrelated ones; row 0 of a appears twice in b (ambiguous: ratio test).
+  b.rows.resize(301, 128);
+  std::uniform_int_distribution<int> jitter(-2, 2);
+  for (int i = 0; i < 200; ++i)
+    for (int k = 0; k < 128; ++k)
+      b.rows(199 - i, k) = std::clamp(a.rows(i, k) + float(jitter(rng)), 0.f, 255.f);
+  b.rows.middleRows(200, 100) = RandomDescriptors(100, &rng);
+  b.rows.row(300) = b.rows.row(199);
+  const auto matches = sfm::MatchDescriptors(a, b, sfm::MatchCriteria{});
+  int right = 0;
+  for (const auto& [i, j] : matches) {
+    EXPECT_LT(i, 200);
+    EXPECT_EQ(j, 199 - i);
+    right += j == 199 - i;
+    EXPECT_NE(i, 0);  // two equally near candidates
+  }
+  EXPECT_GE(right, 190);
+  // The same call gives the same matches; swapping the images swaps them.
+  EXPECT_EQ(sfm::MatchDescriptors(a, b, sfm::MatchCriteria{}), matches);
+  const auto swapped = sfm::MatchDescriptors(b, a, sfm::MatchCriteria{});
+  ASSERT_EQ(swapped.size(), matches.size());
+  for (const auto& [j, i] : swapped) EXPECT_EQ(j, 199 - i);
+  // Unrelated features: the ratio test leaves (almost) nothing.
+  sfm::ImageDescriptors c;
+  c.rows = RandomDescriptors(300, &rng);
+  EXPECT_LT(sfm::MatchDescriptors(a, c, sfm::MatchCriteria{}).size(), 5u);
+}
+
+// A COLMAP-like database: images, keypoints and descriptors tables.
+void MakeDatabase(const fs::path& file, const std::vector<std::pair<int, std::string>>& images,
+                  int descriptor_bytes = 128) {
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open(file.c_str(), &db), SQLITE_OK);
+  std::string sql =
+      "CREATE TABLE images (image_id INTEGER PRIMARY KEY AUTOINCREMENT NOT NULL, name TEXT "
+      "NOT NULL UNIQUE, camera_id INTEGER NOT NULL);"
+      "CREATE TABLE keypoints (image_id INTEGER PRIMARY KEY NOT NULL, rows INTEGER NOT NULL, "
+      "cols INTEGER NOT NULL, data BLOB);"
+      "CREATE TABLE descriptors (image_id INTEGER PRIMARY KEY NOT NULL, rows INTEGER NOT NULL, "
+      "cols INTEGER NOT NULL, data BLOB);";
+  for (const auto& [id, name] : images) {
+    const std::string i = std::to_string(id);
+    // One keypoint and one descriptor whose first byte is the id.
+    char hex[3];
+    std::snprintf(hex, sizeof hex, "%02x", id);
+    sql += "INSERT INTO images VALUES (" + i + ", '" + name + "', 1);";
+    sql += "INSERT INTO keypoints VALUES (" + i + ", 1, 4, x'" + std::string(hex) +
+           std::string(30, '0') + "');";
+    sql += "INSERT INTO descriptors VALUES (" + i + ", 1, 128, x'" + std::string(hex) +
+           std::string(2 * descriptor_bytes - 2, '0') + "');";
+  }
+  char* error = nullptr;
+  EXPECT_EQ(sqlite3_exec(db, sql.c_str(), nullptr, nullptr, &error), SQLITE_OK)
+      << (error ? error : "");
+  sqlite3_free(error);
+  sqlite3_close(db);
+}
+
+TEST(ExactMatchingTest, ImagesAreNumberedByNameWithTheirFeatures) {
+  TempDir tmp;
+  const fs::path db = tmp.path() / "database.db";
+  MakeDatabase(db, {{1, "view_02.jpg"}, {2, "view_00.jpg"}, {3, "view_01.jpg"}});
+  sfm::NumberImagesByName(db);
+  const std::vector<sfm::ImageDescriptors> images = sfm::ReadDatabaseDescriptors(db);
+  ASSERT_EQ(images.size(), 3u);
+  const char* names[] = {"view_00.jpg", "view_01.jpg", "view_02.jpg"};
+  const int first_byte[] = {2, 3, 1};  // the old ids travel with the rows
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_EQ(images[k].image_id, k + 1);
+    EXPECT_EQ(images[k].name, names[k]);
+    ASSERT_EQ(images[k].rows.rows(), 1);
+    EXPECT_EQ(images[k].rows(0, 0), first_byte[k]);
+  }
+  sqlite3* raw = nullptr;
+  ASSERT_EQ(sqlite3_open(db.c_str(), &raw), SQLITE_OK);
+  sqlite3_stmt* stmt = nullptr;
+  ASSERT_EQ(sqlite3_prepare_v2(raw, "SELECT image_id, hex(substr(data, 1, 1)) FROM keypoints "
+                               "ORDER BY image_id", -1, &stmt, nullptr), SQLITE_OK);
+  std::vector<std::string> keypoints;
+  while (sqlite3_step(stmt) == SQLITE_ROW)
+    keypoints.push_back(std::to_string(sqlite3_column_int(stmt, 0)) + ":" +
+                        reinterpret_cast<const char*>(sqlite3_column_text(stmt, 1)));
+  sqlite3_finalize(stmt);
+  sqlite3_close(raw);
+  EXPECT_EQ(keypoints, (std::vector<std::string>{"1:02", "2:03", "3:01"}));
+}
+
+TEST(ExactMatchingTest, BadDatabasesAreErrorsNamingTheFile) {
+  TempDir tmp;
+  const fs::path db = tmp.path() / "short.db";
+  MakeDatabase(db, {{1, "a.jpg"}}, /*descriptor_bytes=*/100);
+  try {
+    sfm::ReadDatabaseDescriptors(db);
+    FAIL() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("short.db"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("a.jpg"), std::string::npos) << e.what();
+  }
+  const fs::path missing = tmp.path() / "missing.db";
+  EXPECT_THROW(sfm::ReadDatabaseDescriptors(missing), std::runtime_error);
+  EXPECT_FALSE(fs::exists(missing));  // read-only: not created
+  const fs::path empty = tmp.path() / "empty.db";
+  { std::ofstream(empty) << ""; }
+  EXPECT_THROW(sfm::NumberImagesByName(empty), std::runtime_error);
 }
 
 }  // namespace

@@ -1,0 +1,164 @@
+#include "stages/sfm/matching.h"
+
+#include <sqlite3.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <memory>
+#include <stdexcept>
+
+namespace docunfold::sfm {
+namespace {
+
+// Best and second-best dot product of one descriptor with the other set.
+struct Nearest {
+  float best = -std::numeric_limits<float>::infinity();
+  float second = -std::numeric_limits<float>::infinity();
+  int index = -1;
+  void Offer(float dot, int i) {
+    if (dot > best) {
+      second = best;
+      best = dot;
+      index = i;
+    } else if (dot > second) {
+      second = dot;
+    }
+  }
+};
+
+// Rows are normalised to 512, so dot / 512^2 is the cosine of the angle.
+double Angle(float dot) {
+  constexpr double kNorm = 1.0 / (512.0 * 512.0);
+  return std::acos(std::clamp(double(dot) * kNorm, -1.0, 1.0));
+}
+
+// The one-way matches that pass the distance and ratio tests; -1 elsewhere.
+std::vector<int> OneWay(const std::vector<Nearest>& nearest, const MatchCriteria& c) {
+  std::vector<int> match(nearest.size(), -1);
+  for (size_t i = 0; i < nearest.size(); ++i) {
+    const Nearest& n = nearest[i];
+    if (n.index < 0) continue;
+    const double best = Angle(n.best);
+    if (best > c.max_distance) continue;
+    const double second =
+        std::isfinite(n.second) ? Angle(n.second) : std::numeric_limits<double>::infinity();
+    if (best >= c.max_ratio * second) continue;
+    match[i] = n.index;
+  }
+  return match;
+}
+
+}  // namespace
+
+namespace {
+
+using Database = std::unique_ptr<sqlite3, int (*)(sqlite3*)>;
+
+Database OpenDatabase(const fs::path& database, int flags) {
+  sqlite3* raw = nullptr;
+  if (sqlite3_open_v2(database.c_str(), &raw, flags, nullptr) != SQLITE_OK) {
+    const std::string why = raw ? sqlite3_errmsg(raw) : "cannot open";
+    sqlite3_close(raw);
+    throw std::runtime_error(database.string() + ": " + why);
+  }
+  return Database(raw, sqlite3_close);
+}
+
+}  // namespace
+
+void NumberImagesByName(const fs::path& database) {
+  const Database db = OpenDatabase(database, SQLITE_OPEN_READWRITE);
+  std::vector<int> old_ids;
+  {
+    sqlite3_stmt* stmt = nullptr;
+    if (sqlite3_prepare_v2(db.get(), "SELECT image_id FROM images ORDER BY name", -1, &stmt,
+                           nullptr) != SQLITE_OK)
+      throw std::runtime_error(database.string() + ": " + sqlite3_errmsg(db.get()));
+    while (sqlite3_step(stmt) == SQLITE_ROW) old_ids.push_back(sqlite3_column_int(stmt, 0));
+    sqlite3_finalize(stmt);
+  }
+  // Moved out of the way first, so that no id is ever taken twice.
+  constexpr long kOffset = 1000000;
+  std::string sql = "BEGIN;";
+  for (const char* table : {"images", "keypoints", "descriptors"}) {
+    sql += std::string("UPDATE ") + table + " SET image_id = image_id + " +
+           std::to_string(kOffset) + ";";
+    for (size_t k = 0; k < old_ids.size(); ++k)
+      sql += std::string("UPDATE ") + table + " SET image_id = " + std::to_string(k + 1) +
+             " WHERE image_id = " + std::to_string(old_ids[k] + kOffset) + ";";
+  }
+  sql += "COMMIT;";
+  char* error = nullptr;
+  if (sqlite3_exec(db.get(), sql.c_str(), nullptr, nullptr, &error) != SQLITE_OK) {
+    const std::string why = error ? error : "failed";
+    sqlite3_free(error);
+    throw std::runtime_error(database.string() + ": renumbering the images: " + why);
+  }
+}
+
+std::vector<ImageDescriptors> ReadDatabaseDescriptors(const fs::path& database) {
+  const Database db = OpenDatabase(database, SQLITE_OPEN_READONLY);
+  sqlite3_stmt* stmt_raw = nullptr;
+  const char* sql =
+      "SELECT images.image_id, images.name, descriptors.rows, descriptors.cols, "
+      "descriptors.data FROM images JOIN descriptors ON images.image_id = "
+      "descriptors.image_id ORDER BY images.image_id";
+  if (sqlite3_prepare_v2(db.get(), sql, -1, &stmt_raw, nullptr) != SQLITE_OK)
+    throw std::runtime_error(database.string() + ": " + sqlite3_errmsg(db.get()));
+  const std::unique_ptr<sqlite3_stmt, int (*)(sqlite3_stmt*)> stmt(stmt_raw, sqlite3_finalize);
+  std::vector<ImageDescriptors> images;
+  int step;
+  while ((step = sqlite3_step(stmt.get())) == SQLITE_ROW) {
+    ImageDescriptors d;
+    d.image_id = sqlite3_column_int(stmt.get(), 0);
+    d.name = reinterpret_cast<const char*>(sqlite3_column_text(stmt.get(), 1));
+    const int rows = sqlite3_column_int(stmt.get(), 2), cols = sqlite3_column_int(stmt.get(), 3);
+    const int bytes = sqlite3_column_bytes(stmt.get(), 4);
+    const auto* data = static_cast<const uint8_t*>(sqlite3_column_blob(stmt.get(), 4));
+    if (cols != 128 || rows < 0 || bytes != rows * cols || (rows > 0 && !data))
+      throw std::runtime_error(database.string() + ": descriptors of " + d.name + " are " +
+                               std::to_string(rows) + "x" + std::to_string(cols) + " in " +
+                               std::to_string(bytes) + " bytes, expected 128 bytes a row");
+    d.rows.resize(rows, 128);
+    for (int i = 0; i < rows * 128; ++i) d.rows.data()[i] = float(data[i]);
+    images.push_back(std::move(d));
+  }
+  if (step != SQLITE_DONE)
+    throw std::runtime_error(database.string() + ": " + sqlite3_errmsg(db.get()));
+  return images;
+}
+
+std::vector<std::pair<int, int>> MatchDescriptors(const ImageDescriptors& a,
+                                                  const ImageDescriptors& b,
+                                                  const MatchCriteria& criteria) {
+  const int na = int(a.rows.rows()), nb = int(b.rows.rows());
+  std::vector<Nearest> a_to_b(na), b_to_a(nb);
+  // In blocks of a's rows, to bound the memory of the dot products. Each is
+  // a sum of 128 products of integers below 256: exact in float whatever
+  // the order of summation, so the result does not depend on the BLAS path.
+  constexpr int kBlock = 1024;
+  Eigen::MatrixXf dots;
+  for (int start = 0; start < na; start += kBlock) {
+    const int rows = std::min(kBlock, na - start);
+    dots.noalias() = a.rows.middleRows(start, rows) * b.rows.transpose();
+    for (int i = 0; i < rows; ++i)
+      for (int j = 0; j < nb; ++j) {
+        const float d = dots(i, j);
+        a_to_b[start + i].Offer(d, j);
+        b_to_a[j].Offer(d, start + i);
+      }
+  }
+  const std::vector<int> ab = OneWay(a_to_b, criteria);
+  const std::vector<int> ba = criteria.cross_check ? OneWay(b_to_a, criteria) : std::vector<int>();
+  std::vector<std::pair<int, int>> matches;
+  for (int i = 0; i < na; ++i) {
+    if (ab[i] < 0) continue;
+    if (criteria.cross_check && ba[ab[i]] != i) continue;
+    matches.emplace_back(i, ab[i]);
+  }
+  return matches;
+}
+
+}  // namespace docunfold::sfm

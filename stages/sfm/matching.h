@@ -1,0 +1,53 @@
+// Exact SIFT matching between every pair of views, for COLMAP's
+// matches_importer. COLMAP's CPU exhaustive matcher finds nearest
+// neighbours with FLANN's randomised k-d trees, so the same photos give a
+// few different matches on every run and the whole pipeline after it
+// drifts by a few hundredths; brute force over the same criteria gives the
+// same matches every time, and COLMAP's geometric verification of them is
+// repeatable (its RANSAC is seeded).
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace docunfold::sfm {
+
+namespace fs = std::filesystem;
+
+// One image's SIFT descriptors as COLMAP stores them: rows of 128 unsigned
+// bytes, each row L2-normalised to 512.
+struct ImageDescriptors {
+  int image_id = 0;
+  std::string name;
+  Eigen::Matrix<float, Eigen::Dynamic, 128, Eigen::RowMajor> rows;
+};
+
+// Gives a COLMAP database's images the ids 1, 2, ... in the order of their
+// names (images, keypoints and descriptors tables; before matching). The
+// feature extractor numbers them in the order its threads finish, and the
+// mapper's choices follow the ids. Throws std::runtime_error naming the
+// database when it cannot be changed.
+void NumberImagesByName(const fs::path& database);
+
+// Every image of a COLMAP database with its descriptors, by image id.
+// Throws std::runtime_error naming the database when it cannot be read.
+std::vector<ImageDescriptors> ReadDatabaseDescriptors(const fs::path& database);
+
+// COLMAP's SIFT matching criteria (SiftMatchingOptions), computed exactly.
+struct MatchCriteria {
+  double max_ratio = 0.8;     // best angle < max_ratio * second best
+  double max_distance = 0.7;  // best angle (radians) at most this
+  bool cross_check = true;    // keep only mutual best matches
+};
+
+// Index pairs (row of a, row of b) that pass `criteria`, in order of a's
+// rows. Distances are the angles between descriptors, as COLMAP's.
+std::vector<std::pair<int, int>> MatchDescriptors(const ImageDescriptors& a,
+                                                  const ImageDescriptors& b,
+                                                  const MatchCriteria& criteria);
+
+}  // namespace docunfold::sfm
