@@ -7,12 +7,11 @@
 // repeatable (its RANSAC is seeded).
 #pragma once
 
+#include <Eigen/Core>
 #include <filesystem>
 #include <string>
 #include <utility>
 #include <vector>
-
-#include <Eigen/Core>
 
 namespace docunfold::sfm {
 
@@ -46,8 +45,8 @@ struct MatchCriteria {
 
 // Index pairs (row of a, row of b) that pass `criteria`, in order of a's
 // rows. Distances are the angles between descriptors, as COLMAP's.
-std::vector<std::pair<int, int>> MatchDescriptors(const ImageDescriptors& a,
-                                                  const ImageDescriptors& b,
-                                                  const MatchCriteria& criteria);
+std::vector<std::pair<int, int>> MatchDescriptors(
+    const ImageDescriptors& a, const ImageDescriptors& b,
+    const MatchCriteria& criteria);
 
 }  // namespace docunfold::sfm
