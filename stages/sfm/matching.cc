@@ -3,11 +3,14 @@
 #include <sqlite3.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <limits>
 #include <memory>
+#include <mutex>
 #include <stdexcept>
+#include <thread>
 
 namespace docunfold::sfm {
 namespace {
@@ -155,7 +158,7 @@ std::vector<std::pair<int, int>> MatchDescriptors(
   // a sum of 128 products of integers below 256: exact in float whatever
   // the order of summation, so the result does not depend on the BLAS path.
   constexpr int kBlock = 1024;
-  Eigen::MatrixXf dots;
+  Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> dots;
   for (int start = 0; start < na; start += kBlock) {
     const int rows = std::min(kBlock, na - start);
     dots.noalias() = a.rows.middleRows(start, rows) * b.rows.transpose();
@@ -175,6 +178,41 @@ std::vector<std::pair<int, int>> MatchDescriptors(
     if (criteria.cross_check && ba[ab[i]] != i) continue;
     matches.emplace_back(i, ab[i]);
   }
+  return matches;
+}
+
+std::vector<std::vector<std::pair<int, int>>> MatchAllPairs(
+    const std::vector<ImageDescriptors>& images, const MatchCriteria& criteria,
+    int threads, const std::function<void(int done)>& on_pair) {
+  std::vector<std::pair<size_t, size_t>> pairs;
+  for (size_t a = 0; a < images.size(); ++a)
+    for (size_t b = a + 1; b < images.size(); ++b) pairs.emplace_back(a, b);
+  std::vector<std::vector<std::pair<int, int>>> matches(pairs.size());
+  if (threads < 1) threads = int(std::max(1u, std::thread::hardware_concurrency()));
+  threads = std::min<int>(threads, int(pairs.size()));
+  std::atomic<size_t> next{0};
+  std::mutex report;
+  int done = 0;
+  std::exception_ptr failure;
+  auto work = [&] {
+    try {
+      for (size_t k; (k = next++) < pairs.size();) {
+        matches[k] = MatchDescriptors(images[pairs[k].first],
+                                      images[pairs[k].second], criteria);
+        const std::lock_guard<std::mutex> lock(report);
+        if (on_pair) on_pair(++done);
+      }
+    } catch (...) {
+      const std::lock_guard<std::mutex> lock(report);
+      if (!failure) failure = std::current_exception();
+      next = pairs.size();
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int t = 1; t < threads; ++t) pool.emplace_back(work);
+  work();
+  for (std::thread& t : pool) t.join();
+  if (failure) std::rethrow_exception(failure);
   return matches;
 }
 

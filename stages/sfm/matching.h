@@ -9,6 +9,7 @@
 
 #include <Eigen/Core>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -48,5 +49,12 @@ struct MatchCriteria {
 std::vector<std::pair<int, int>> MatchDescriptors(
     const ImageDescriptors& a, const ImageDescriptors& b,
     const MatchCriteria& criteria);
+
+// MatchDescriptors for every pair (a, b) with a < b, in that order: pair
+// (0,1), (0,2), ..., (1,2), ... Pairs run on `threads` threads (< 1: every
+// core); `on_pair` is called, one call at a time, after each.
+std::vector<std::vector<std::pair<int, int>>> MatchAllPairs(
+    const std::vector<ImageDescriptors>& images, const MatchCriteria& criteria,
+    int threads, const std::function<void(int done)>& on_pair = nullptr);
 
 }  // namespace docunfold::sfm

@@ -478,15 +478,15 @@ SfmResult RunSfm(const SfmOptions& o) {
       const fs::path list_file = colmap.dir / "matches_raw.txt";
       std::ofstream list(list_file);
       Progress progress("matching features", pairs);
-      long done = 0, total = 0;
+      const auto matches = MatchAllPairs(images, MatchCriteria{}, o.threads,
+                                         [&](int done) { progress.Update(done); });
+      long total = 0, k = 0;
       for (size_t a = 0; a < images.size(); ++a)
-        for (size_t b = a + 1; b < images.size(); ++b) {
-          const auto matches = MatchDescriptors(images[a], images[b], MatchCriteria{});
+        for (size_t b = a + 1; b < images.size(); ++b, ++k) {
           list << images[a].name << ' ' << images[b].name << '\n';
-          for (const auto& [i, j] : matches) list << i << ' ' << j << '\n';
+          for (const auto& [i, j] : matches[k]) list << i << ' ' << j << '\n';
           list << '\n';
-          total += long(matches.size());
-          progress.Update(++done);
+          total += long(matches[k].size());
         }
       list.close();
       if (!list) throw OutputError(list_file.string() + ": write failed");

@@ -541,6 +541,12 @@ TEST(ExactMatchingTest, FindsTheSameFeaturesAndRejectsAmbiguousOnes) {
   b.rows.middleRows(200, 100) = RandomDescriptors(100, &rng);
   b.rows.row(300) = b.rows.row(199);
   const auto matches = sfm::MatchDescriptors(a, b, sfm::MatchCriteria{});
+  // A third image: a's first 100 rows.
+  auto c_of = [](const sfm::ImageDescriptors& from) {
+    sfm::ImageDescriptors c;
+    c.rows = from.rows.topRows(100);
+    return c;
+  };
   int right = 0;
   for (const auto& [i, j] : matches) {
     EXPECT_LT(i, 200);
@@ -554,6 +560,15 @@ TEST(ExactMatchingTest, FindsTheSameFeaturesAndRejectsAmbiguousOnes) {
   const auto swapped = sfm::MatchDescriptors(b, a, sfm::MatchCriteria{});
   ASSERT_EQ(swapped.size(), matches.size());
   for (const auto& [j, i] : swapped) EXPECT_EQ(j, 199 - i);
+  // Every pair, on two threads: the same as one pair at a time, in order.
+  int calls = 0;
+  const auto all = sfm::MatchAllPairs({a, b, c_of(a)}, sfm::MatchCriteria{}, 2,
+                                      [&](int done) { EXPECT_EQ(done, ++calls); });
+  EXPECT_EQ(calls, 3);
+  ASSERT_EQ(all.size(), 3u);
+  EXPECT_EQ(all[0], matches);
+  EXPECT_EQ(all[1], sfm::MatchDescriptors(a, c_of(a), sfm::MatchCriteria{}));
+  EXPECT_EQ(all[2], sfm::MatchDescriptors(b, c_of(a), sfm::MatchCriteria{}));
   // Unrelated features: the ratio test leaves (almost) nothing.
   sfm::ImageDescriptors c;
   c.rows = RandomDescriptors(300, &rng);
