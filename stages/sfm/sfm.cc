@@ -471,8 +471,18 @@ SfmResult RunSfm(const SfmOptions& o) {
   {
     const auto t0 = std::chrono::steady_clock::now();
     const int pairs = n * (n - 1) / 2;
-    Log("matching features: " + std::to_string(pairs) + " pairs of views (" + o.matcher + ")");
-    if (o.matcher == "exact") {
+    // matches_importer's list names a pair by its two names split at a space.
+    const bool spaced_names =
+        std::any_of(result.images.begin(), result.images.end(), [](const std::string& name) {
+          return name.find_first_of(" \t") != std::string::npos;
+        });
+    const bool exact = o.matcher == "exact" && !spaced_names;
+    if (o.matcher == "exact" && spaced_names)
+      Log("an image name has a space, which COLMAP's match list cannot carry: COLMAP's "
+          "exhaustive matcher is used instead (its matches differ a little between runs)");
+    Log("matching features: " + std::to_string(pairs) + " pairs of views (" +
+        (exact ? "exact" : "colmap") + ")");
+    if (exact) {
       NumberImagesByName(database);
       const std::vector<ImageDescriptors> images = ReadDatabaseDescriptors(database);
       const fs::path list_file = colmap.dir / "matches_raw.txt";

@@ -255,6 +255,22 @@ TEST_F(SfmCli, GoodRunThenRefThenFailedRunKeepsTheOutput) {
   EXPECT_EQ(before, after);
 }
 
+// COLMAP's match list splits a pair's names at spaces: such names fall
+// back to its exhaustive matcher, with a note, rather than fail.
+TEST_F(SfmCli, ImageNamesWithSpacesUseColmapsMatcher) {
+  if (!HaveColmap()) GTEST_SKIP() << "COLMAP not installed";
+  const fs::path data = SmallSet();
+  if (data.empty()) GTEST_SKIP() << "no data set with ground truth";
+  const fs::path first = *fs::directory_iterator(data / "images");
+  fs::rename(first, data / "images" / ("my " + first.filename().string()));
+  const fs::path out = tmp_ / "work" / "10_sfm";
+  const CommandResult r = Sfm(Args(data, out, "--threads 2"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("exhaustive matcher is used instead"), std::string::npos) << r.output;
+  EXPECT_TRUE(fs::is_regular_file(out / "colmap/exhaustive_matcher.log"));
+  EXPECT_EQ(ReadCameras(out / "cameras.json").views.size(), 3u);
+}
+
 TEST_F(SfmCli, RefNotRegistered) {
   if (!HaveColmap()) GTEST_SKIP() << "COLMAP not installed";
   const fs::path data = SmallSet(3);
