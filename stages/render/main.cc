@@ -1,9 +1,31 @@
 // render: texture-maps M' with the reference image through M and writes the
 // cropped, rectified page. See render.h and the README section "render".
 #include <chrono>
+#include <optional>
+#include <string>
 
 #include "common/cli.h"
 #include "stages/render/render.h"
+
+namespace {
+
+// --page-format as a long-to-short side ratio (0: none); nullopt when it is
+// neither a format's name nor a ratio between 1 and 10.
+std::optional<double> PageAspect(const std::string& v) {
+  if (v == "iso") return docunfold::render::kIsoAspect;
+  if (v == "letter") return docunfold::render::kLetterAspect;
+  if (v == "legal") return docunfold::render::kLegalAspect;
+  if (v == "none") return 0.0;
+  try {
+    size_t used = 0;
+    const double ratio = std::stod(v, &used);
+    if (used == v.size() && ratio >= 1 && ratio <= 10) return ratio;
+  } catch (const std::exception&) {
+  }
+  return std::nullopt;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   using namespace docunfold;
@@ -130,14 +152,9 @@ int main(int argc, char** argv) {
                  "photos do)")
       ->capture_default_str()
       ->check([](const std::string& v) -> std::string {
-        if (v == "iso" || v == "letter" || v == "legal" || v == "none") return "";
-        try {
-          size_t used = 0;
-          const double ratio = std::stod(v, &used);
-          if (used == v.size() && ratio >= 1 && ratio <= 10) return "";
-        } catch (const std::exception&) {
-        }
-        return "expected iso, letter, legal, none or a ratio between 1 and 10, got '" + v + "'";
+        return PageAspect(v) ? ""
+                             : "expected iso, letter, legal, none or a ratio between 1 and "
+                               "10, got '" + v + "'";
       });
   app.add_option("--better-views", o.better_views.min_gain,
                  "texture a point from another photo (--images) where it resolves the page "
@@ -152,11 +169,7 @@ int main(int argc, char** argv) {
     o.extend_cut_sides = !no_extend;
     o.texture_cut_sides = !no_texture_cut;
     o.reach_real_sides = !no_reach;
-    o.page_aspect = page_format == "iso"      ? render::kIsoAspect
-                    : page_format == "letter" ? render::kLetterAspect
-                    : page_format == "legal"  ? render::kLegalAspect
-                    : page_format == "none"   ? 0.0
-                                              : std::stod(page_format);
+    o.page_aspect = *PageAspect(page_format);
     const render::RenderInputs in =
         render::ReadRenderInputs(sfm, boundary, meshes, images, features);
     const double read_s = SecondsSince(start);
