@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <cstring>
 #include <limits>
 #include <memory>
 #include <mutex>
@@ -54,10 +53,6 @@ std::vector<int> OneWay(const std::vector<Nearest>& nearest,
   }
   return match;
 }
-
-}  // namespace
-
-namespace {
 
 using Database = std::unique_ptr<sqlite3, int (*)(sqlite3*)>;
 
