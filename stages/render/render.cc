@@ -532,9 +532,15 @@ Json MakeReport(const RenderOptions& options, const RenderInputs& in,
     sides[kSideNames[i]] = j;
   }
   doc["sides"] = sides;
-  if (const PageFormatFit& f = r.page_format; options.page_aspect > 0 && f.axis >= 0) {
+  if (const PageFormatFit& f = r.page_format;
+      options.page_aspect > 0 && (f.axis >= 0 || !f.note.empty())) {
+    // axis -1 with a note: sides of both axes are cut off unseen.
     Json j = {{"aspect", options.page_aspect}, {"applied", f.applied},
-              {"axis", f.axis == 0 ? "x" : "y"}, {"seen", f.seen}, {"across", f.across}};
+              {"axis", f.axis < 0 ? "both" : f.axis == 0 ? "x" : "y"}};
+    if (f.axis >= 0) {
+      j["seen"] = f.seen;
+      j["across"] = f.across;
+    }
     if (f.applied) j["length"] = f.length;
     if (!f.note.empty()) j["note"] = f.note;
     doc["page_format"] = j;

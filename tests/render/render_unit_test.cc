@@ -280,6 +280,25 @@ TEST(RenderScene, APageCutOffUnseenIsCompletedToItsFormat) {
   EXPECT_NEAR(iso.crop_x1, s.page_w, px);
 }
 
+TEST(RenderScene, APageCutOffOnBothAxesKeepsItsCropAndSaysWhy) {
+  SceneOptions o;
+  o.page_origin = {-0.6, -0.55, 1.0};  // the left and top parts run off the image
+  const SyntheticScene s = MakeScene(o);
+  ASSERT_FALSE(s.real[3]);
+  ASSERT_FALSE(s.real[0]);
+  const render::RenderResult plain = render::Run({}, InputsOf(s));
+  render::RenderOptions options;
+  options.page_aspect = render::kIsoAspect;
+  const render::RenderResult r = render::Run(options, InputsOf(s));
+  EXPECT_FALSE(r.page_format.applied);
+  EXPECT_EQ(r.crop_x0, plain.crop_x0);
+  EXPECT_EQ(r.crop_y0, plain.crop_y0);
+  ASSERT_TRUE(r.report.contains("page_format"));
+  EXPECT_EQ(r.report["page_format"]["axis"], "both");
+  EXPECT_EQ(r.report["page_format"]["applied"], false);
+  EXPECT_FALSE(r.report["page_format"]["note"].get<std::string>().empty());
+}
+
 TEST(RenderCrop, TheFormatLengthensOnlyUnseenSidesOfOneAxis) {
   const double a = render::kIsoAspect;
   auto crop = [](double w, double h) { return render::CropRect{0, 0, w, h, "test"}; };
