@@ -5,11 +5,14 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <memory>
 #include <mutex>
 #include <stdexcept>
 #include <thread>
+
+#include "stages/sfm/descriptor_dots.h"
 
 namespace docunfold::sfm {
 namespace {
@@ -144,25 +147,71 @@ std::vector<ImageDescriptors> ReadDatabaseDescriptors(
   return images;
 }
 
+#ifndef DOCUNFOLD_SFM_AVX2
+void DescriptorDotsAvx2(const int16_t*, int, const int16_t*, int, int32_t*, size_t) {
+  throw std::logic_error("DescriptorDotsAvx2: this build has no AVX2 kernel");
+}
+#endif
+
+bool HaveDescriptorDotsAvx2() {
+#ifdef DOCUNFOLD_SFM_AVX2
+  static const bool have = __builtin_cpu_supports("avx2");
+  return have;
+#else
+  return false;
+#endif
+}
+
+const char* AutoDotKernelName() { return HaveDescriptorDotsAvx2() ? "avx2" : "portable"; }
+
 std::vector<std::pair<int, int>> MatchDescriptors(
     const ImageDescriptors& a, const ImageDescriptors& b,
-    const MatchCriteria& criteria) {
+    const MatchCriteria& criteria, DotKernel kernel) {
   const int na = int(a.rows.rows()), nb = int(b.rows.rows());
   std::vector<Nearest> a_to_b(na), b_to_a(nb);
-  // In blocks of a's rows, to bound the memory of the dot products. Each is
-  // a sum of 128 products of integers below 256: exact in float whatever
-  // the order of summation, so the result does not depend on the BLAS path.
-  constexpr int kBlock = 1024;
-  Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> dots;
-  for (int start = 0; start < na; start += kBlock) {
-    const int rows = std::min(kBlock, na - start);
-    dots.noalias() = a.rows.middleRows(start, rows) * b.rows.transpose();
-    for (int i = 0; i < rows; ++i)
-      for (int j = 0; j < nb; ++j) {
-        const float d = dots(i, j);
-        a_to_b[start + i].Offer(d, j);
-        b_to_a[j].Offer(d, start + i);
+  // Each dot product is a sum of 128 products of integers below 256: exact
+  // in int32 and in float whatever the order of summation, so both kernels
+  // (and any BLAS path of Eigen's) give the same values.
+  if (kernel == DotKernel::kAuto && HaveDescriptorDotsAvx2()) {
+    const int blocks = (nb + kDotBlockRows - 1) / kDotBlockRows;
+    std::vector<int16_t> a16(size_t(na) * 128), b_packed(size_t(blocks) * kDotBlockValues, 0);
+    for (int i = 0; i < na; ++i)
+      for (int k = 0; k < 128; ++k) a16[size_t(i) * 128 + k] = int16_t(a.rows(i, k));
+    for (int j = 0; j < nb; ++j)
+      for (int k = 0; k < 128; ++k)
+        b_packed[size_t(j / kDotBlockRows) * kDotBlockValues + (k / 2) * 2 * kDotBlockRows +
+                 (j % kDotBlockRows) * 2 + k % 2] = int16_t(b.rows(j, k));
+    // In blocks of a's rows small enough to stay in cache until scanned.
+    constexpr int kBlock = 64;
+    const size_t stride = size_t(blocks) * kDotBlockRows;
+    std::vector<int32_t> dots(size_t(kBlock) * stride);
+    for (int start = 0; start < na; start += kBlock) {
+      const int rows = std::min(kBlock, na - start);
+      DescriptorDotsAvx2(a16.data() + size_t(start) * 128, rows, b_packed.data(), blocks,
+                         dots.data(), stride);
+      for (int i = 0; i < rows; ++i) {
+        const int32_t* row = dots.data() + size_t(i) * stride;
+        for (int j = 0; j < nb; ++j) {
+          const float d = float(row[j]);
+          a_to_b[start + i].Offer(d, j);
+          b_to_a[j].Offer(d, start + i);
+        }
       }
+    }
+  } else {
+    // In blocks of a's rows, to bound the memory of the dot products.
+    constexpr int kBlock = 1024;
+    Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> dots;
+    for (int start = 0; start < na; start += kBlock) {
+      const int rows = std::min(kBlock, na - start);
+      dots.noalias() = a.rows.middleRows(start, rows) * b.rows.transpose();
+      for (int i = 0; i < rows; ++i)
+        for (int j = 0; j < nb; ++j) {
+          const float d = dots(i, j);
+          a_to_b[start + i].Offer(d, j);
+          b_to_a[j].Offer(d, start + i);
+        }
+    }
   }
   const std::vector<int> ab = OneWay(a_to_b, criteria);
   const std::vector<int> ba =

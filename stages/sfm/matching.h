@@ -44,11 +44,20 @@ struct MatchCriteria {
   bool cross_check = true;    // keep only mutual best matches
 };
 
+// How the dot products are computed; both give the same exact values.
+enum class DotKernel {
+  kAuto,      // AVX2 integer instructions where the CPU has them (~3.5x), else kPortable
+  kPortable,  // Eigen's float matrix product (exact: integer sums below 2^24)
+};
+
 // Index pairs (row of a, row of b) that pass `criteria`, in order of a's
 // rows. Distances are the angles between descriptors, as COLMAP's.
 std::vector<std::pair<int, int>> MatchDescriptors(
     const ImageDescriptors& a, const ImageDescriptors& b,
-    const MatchCriteria& criteria);
+    const MatchCriteria& criteria, DotKernel kernel = DotKernel::kAuto);
+
+// The kernel kAuto takes on this machine: "avx2" or "portable".
+const char* AutoDotKernelName();
 
 // MatchDescriptors for every pair (a, b) with a < b, in that order: pair
 // (0,1), (0,2), ..., (1,2), ... Pairs run on `threads` threads (< 1: every

@@ -481,7 +481,7 @@ SfmResult RunSfm(const SfmOptions& o) {
       Log("an image name has a space, which COLMAP's match list cannot carry: COLMAP's "
           "exhaustive matcher is used instead (its matches differ a little between runs)");
     Log("matching features: " + std::to_string(pairs) + " pairs of views (" +
-        (exact ? "exact" : "colmap") + ")");
+        (exact ? std::string("exact, ") + AutoDotKernelName() : std::string("colmap")) + ")");
     if (exact) {
       NumberImagesByName(database);
       const std::vector<ImageDescriptors> images = ReadDatabaseDescriptors(database);

@@ -17,6 +17,7 @@
 
 #include "common/errors.h"
 #include "stages/sfm/colmap_model.h"
+#include "stages/sfm/descriptor_dots.h"
 #include "stages/sfm/matching.h"
 #include "stages/sfm/reference_view.h"
 #include "stages/sfm/sfm.h"
@@ -573,6 +574,49 @@ TEST(ExactMatchingTest, FindsTheSameFeaturesAndRejectsAmbiguousOnes) {
   sfm::ImageDescriptors c;
   c.rows = RandomDescriptors(300, &rng);
   EXPECT_LT(sfm::MatchDescriptors(a, c, sfm::MatchCriteria{}).size(), 5u);
+}
+
+TEST(ExactMatchingTest, TheAvx2KernelGivesThePortableOnesMatches) {
+  if (std::string(sfm::AutoDotKernelName()) != "avx2")
+    GTEST_SKIP() << "this build or CPU has no AVX2 kernel";
+  std::mt19937 rng(11);
+  // The dot products themselves, against plain sums, with row counts that
+  // leave partial blocks (4 rows of a, 8 of b) and the extreme values.
+  {
+    const int na = 7, nb = 13, blocks = 2;
+    std::uniform_int_distribution<int> byte(0, 255);
+    std::vector<int16_t> a(na * 128), b(nb * 128), packed(blocks * sfm::kDotBlockValues, 0);
+    for (auto& v : a) v = int16_t(byte(rng));
+    for (auto& v : b) v = int16_t(byte(rng));
+    std::fill(a.begin(), a.begin() + 128, int16_t(255));
+    std::fill(b.end() - 128, b.end(), int16_t(255));
+    for (int j = 0; j < nb; ++j)
+      for (int k = 0; k < 128; ++k)
+        packed[(j / 8) * sfm::kDotBlockValues + (k / 2) * 16 + (j % 8) * 2 + k % 2] =
+            b[j * 128 + k];
+    const size_t stride = 16;
+    std::vector<int32_t> dots(na * stride, -1);
+    sfm::DescriptorDotsAvx2(a.data(), na, packed.data(), blocks, dots.data(), stride);
+    for (int i = 0; i < na; ++i)
+      for (int j = 0; j < int(stride); ++j) {
+        int32_t want = 0;
+        for (int k = 0; j < nb && k < 128; ++k) want += a[i * 128 + k] * b[j * 128 + k];
+        EXPECT_EQ(dots[i * stride + j], want) << i << ", " << j;
+      }
+    EXPECT_EQ(dots[nb - 1], 255 * 255 * 128);
+  }
+  // The matches, on SIFT-like descriptors some of which recur.
+  for (const auto& [na, nb] : {std::pair{1, 1}, {7, 13}, {203, 97}, {64, 64}, {130, 1029}}) {
+    sfm::ImageDescriptors a, b;
+    a.rows = RandomDescriptors(na, &rng);
+    b.rows = RandomDescriptors(nb, &rng);
+    for (int j = 0; j < std::min(na, nb); j += 3) b.rows.row(j) = a.rows.row(j);
+    const auto fast = sfm::MatchDescriptors(a, b, sfm::MatchCriteria{}, sfm::DotKernel::kAuto);
+    const auto portable =
+        sfm::MatchDescriptors(a, b, sfm::MatchCriteria{}, sfm::DotKernel::kPortable);
+    EXPECT_EQ(fast, portable) << na << " x " << nb;
+    EXPECT_GE(fast.size(), size_t((std::min(na, nb) + 2) / 3)) << na << " x " << nb;
+  }
 }
 
 // A COLMAP-like database: images, keypoints and descriptors tables.
