@@ -33,8 +33,8 @@
 #
 # Per set, the front end (20_boundary/, 30_features/) is measured against the
 # truth in sfm's reference view (evaluate --front-end -> 70_eval/front_end.json).
-# Rows per set: homography and oracle (build/bin/baseline), docunfold
-# (60_render/rectified.png) when render ran, and, when the binaries exist,
+# Rows per set: homography, oracle and oracle-seen (build/bin/baseline),
+# docunfold (60_render/rectified.png) when render ran, and, when the binaries exist,
 # docunfold-init (render on 40_init), docunfold-nofeatures and
 # docunfold-boundary (optimize --no-features / --boundary-only, then render),
 # and docunfold-deshaded and oracle-deshaded (render / baseline --shading
@@ -154,6 +154,16 @@ make_row_oracle() {
   image=$work/bench/oracle.png
   timed oracle "$bin/baseline" --method oracle --data "$data" --work "$work" --out "$image"
 }
+# The oracle cropped to the part of the page some photo sees: where a page is
+# cut off in every photo, the plain oracle still knows from the true surface
+# where it ends; no method working from the photos can.
+make_row_oracle-seen() {
+  [[ -f $work/10_sfm/cameras.json ]] || { reason="no 10_sfm/cameras.json"; return 1; }
+  [[ -f $data/ground_truth/mesh.ply ]] || { reason="no ground_truth/mesh.ply"; return 1; }
+  image=$work/bench/oracle-seen.png
+  timed oracle-seen "$bin/baseline" --method oracle --crop-to-seen --data "$data" \
+    --work "$work" --out "$image"
+}
 make_row_docunfold() {
   [[ -f $work/60_render/rectified.png ]] || { reason="render did not run"; return 1; }
   image=$work/60_render/rectified.png
@@ -209,7 +219,7 @@ optimize_variant() {  # optimize_variant <row> <suffix> <optimize flag>
 make_row_docunfold-nofeatures() { optimize_variant docunfold-nofeatures nofeatures --no-features; }
 make_row_docunfold-boundary() { optimize_variant docunfold-boundary boundary --boundary-only; }
 
-ROWS=(homography oracle docunfold docunfold-init docunfold-nofeatures docunfold-boundary
+ROWS=(homography oracle oracle-seen docunfold docunfold-init docunfold-nofeatures docunfold-boundary
       oracle-deshaded docunfold-deshaded)
 if [[ -n ${BENCH_ONLY:-} ]]; then read -r -a ROWS <<< "$BENCH_ONLY"; fi
 read -r -a extra_rows <<< "${BENCH_ROWS:-}"

@@ -28,7 +28,7 @@ FIGURES = [("ms_ssim", "MS-SSIM ↑", "%.4f"), ("ld", "LD ↓", "%.2f"), ("li_d"
            ("cer", "CER ↓", "%.4f"), ("wer", "WER ↓", "%.4f"),
            ("surface_mean_pct", "surface mean % ↓", "%.3f"),
            ("isometry_mean", "isometry ↓", "%.4f")]
-ROW_ORDER = ["homography", "oracle", "docunfold", "docunfold-init", "docunfold-nofeatures",
+ROW_ORDER = ["homography", "oracle", "oracle-seen", "docunfold", "docunfold-init", "docunfold-nofeatures",
              "docunfold-boundary", "oracle-deshaded", "docunfold-deshaded"]
 
 
@@ -307,7 +307,10 @@ def markdown(result):
               "relative edge-length error between M and M'. "
               "Rows: `homography` = reference photo warped by the 4 page corners (scanner app), turned the way render turned docunfold's page; "
               "`oracle` = reference photo textured through the true surface and camera (ceiling "
-              "for one-view texturing); `docunfold` = 60_render/rectified.png; `-deshaded` = "
+              "for one-view texturing); `oracle-seen` = the oracle cropped to the part of the page "
+              "some photo sees (the same image where the page is seen whole; the ceiling for a "
+              "method that has only the photos when a page is cut off in all of them); "
+              "`docunfold` = 60_render/rectified.png; `-deshaded` = "
               "the same with the light's shading divided out (render/baseline `--shading "
               "remove`): compare `docunfold-deshaded` with `oracle-deshaded`, not with "
               "`oracle`." % (

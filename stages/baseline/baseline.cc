@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <vector>
 
 #include <Eigen/Dense>
@@ -200,6 +201,25 @@ cv::Mat TextureFromTruth(const cv::Mat& photo, const PinholeCamera& camera,
   return out;
 }
 
+cv::Rect SeenPageRect(const std::vector<PinholeCamera>& cameras, const PlyData& mesh,
+                      cv::Size size) {
+  if (!mesh.FindProperty("s") || !mesh.FindProperty("t"))
+    throw InputError("true mesh has no per-vertex s, t");
+  const std::vector<Triangle> triangles = Triangulate(mesh.faces);
+  cv::Mat1b seen(size, 0);
+  for (const PinholeCamera& camera : cameras) {
+    const cv::Mat2f map = TrueMap(camera, mesh, triangles, size, 1);
+    for (int y = 0; y < map.rows; ++y)
+      for (int x = 0; x < map.cols; ++x) {
+        const cv::Vec2f p = map(y, x);  // NaN behind the camera or off the mesh
+        if (p[0] >= -0.5f && p[1] >= -0.5f && p[0] <= camera.width - 0.5f &&
+            p[1] <= camera.height - 0.5f)
+          seen(y, x) = 255;
+      }
+  }
+  return cv::boundingRect(seen);
+}
+
 BaselineResult Run(const BaselineInputs& in, const BaselineOptions& options) {
   const fs::path sfm_cameras =
       MustExist(in.work / "10_sfm" / "cameras.json", "run sfm first");
@@ -276,6 +296,17 @@ BaselineResult Run(const BaselineInputs& in, const BaselineOptions& options) {
     out.image = TextureFromTruth(photo, *camera, mesh, size);
     std::snprintf(buf, sizeof buf, "oracle: %s through the true surface and camera, %dx%d",
                   cameras.reference.c_str(), size.width, size.height);
+    if (options.crop_to_seen) {
+      const cv::Rect seen = SeenPageRect(truth.views, mesh, size);
+      if (seen.empty())
+        throw InputError((gt / "cameras.json").string() + ": no photo sees the true page");
+      out.image = out.image(seen).clone();
+      const size_t n = std::strlen(buf);
+      std::snprintf(buf + n, sizeof buf - n,
+                    ", cropped to the part the photos see: x %d..%d, y %d..%d (%dx%d)", seen.x,
+                    seen.x + seen.width, seen.y, seen.y + seen.height, seen.width,
+                    seen.height);
+    }
   }
   out.summary = buf;
   if (options.remove_shading) {

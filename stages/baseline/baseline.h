@@ -3,13 +3,16 @@
 //  - homography: the reference view warped by the four detected page corners
 //    onto a rectangle of the page's aspect (what a phone scanner app does);
 //  - oracle: the page textured from the reference photo through the TRUE
-//    surface and TRUE camera (the ceiling for any single-view texturing).
+//    surface and TRUE camera (the ceiling for any single-view texturing);
+//    cropped to the part of the page some photo sees (`crop_to_seen`), the
+//    ceiling for a method that cannot know how far a cut-off page goes.
 #pragma once
 
 #include <array>
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
@@ -43,6 +46,14 @@ cv::Mat WarpByCorners(const cv::Mat& image, const Corners& corners, cv::Size siz
 cv::Mat TextureFromTruth(const cv::Mat& photo, const PinholeCamera& camera,
                          const PlyData& mesh, cv::Size size);
 
+// Pixel rectangle of the flat page rendered at `size` that holds every point
+// of the true surface inside the frame of at least one of `cameras` (and in
+// front of it; the page hiding part of itself is not considered). All of
+// `size` when some photo sees each part of the page; empty when none sees
+// any. `mesh` as for TextureFromTruth.
+cv::Rect SeenPageRect(const std::vector<PinholeCamera>& cameras, const PlyData& mesh,
+                      cv::Size size);
+
 enum class Method { kHomography, kOracle };
 
 struct BaselineOptions {
@@ -55,6 +66,11 @@ struct BaselineOptions {
   // Divide out the light's shading afterwards (common/shading.h), as render
   // --shading remove does: the ceiling for results rendered that way.
   bool remove_shading = false;
+  // Oracle: keep only SeenPageRect over all true cameras. Where no photo
+  // sees some part of the page (cut-off pages), no method working from the
+  // photos can know where the page ends: the plain oracle knows it from the
+  // true surface. The same image as the plain oracle on a page seen whole.
+  bool crop_to_seen = false;
   // Homography: turn the page clockwise by this many quarter turns (render's
   // orientation.quarter_turns_clockwise in 60_render/render.json), so that
   // it reads the same way up as docunfold's result, as a scanner app's page

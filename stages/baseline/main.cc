@@ -13,7 +13,8 @@ int main(int argc, char** argv) {
       "(ground_truth/page.json, else estimated from the corners and K). "
       "oracle: the photo images/<reference> textured through the TRUE surface "
       "and camera (ground_truth/mesh.ply, cameras.json) at the size of "
-      "flat.png: the ceiling for any method that textures from one view."};
+      "flat.png: the ceiling for any method that textures from one view; with "
+      "--crop-to-seen, only the part of the page some photo sees."};
   baseline::BaselineInputs in;
   baseline::BaselineOptions options;
   std::string method;
@@ -36,6 +37,11 @@ int main(int argc, char** argv) {
                  "reads the same way up as docunfold's result)")
       ->capture_default_str()
       ->check(CLI::Range(0, 3));
+  app.add_flag("--crop-to-seen", options.crop_to_seen,
+               "oracle: keep the smallest rectangle of the page that holds all of it any photo "
+               "sees (ground_truth/cameras.json): the ceiling for a method that cannot know "
+               "where a page cut off in every photo ends; the plain oracle where the page is "
+               "seen whole");
   std::string shading = "keep";
   app.add_option("--shading", shading,
                  "remove: divide out the light's shading afterwards, as render --shading "
@@ -47,6 +53,8 @@ int main(int argc, char** argv) {
     options.method = method == "oracle" ? baseline::Method::kOracle
                                         : baseline::Method::kHomography;
     options.remove_shading = shading == "remove";
+    if (options.crop_to_seen && options.method != baseline::Method::kOracle)
+      throw UsageError("--crop-to-seen applies to --method oracle only");
     const baseline::BaselineResult r = baseline::Run(in, options);
     EnsureDirectory(out.parent_path().empty() ? fs::path(".") : out.parent_path());
     WriteImageAtomic(out, r.image);

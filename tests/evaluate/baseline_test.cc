@@ -87,6 +87,11 @@ TEST_P(Baselines, OracleClearlyBeatsHomographyOnFoldedPages) {
                  c.y() <= camera->height - 1;
   if (whole_page) {
     EXPECT_GT(o, 0.8) << "the oracle textures through the true surface";
+    // Seen whole by the reference, the crop to what the photos see is no crop.
+    options.crop_to_seen = true;
+    const cv::Mat seen = baseline::Run({data, work}, options).image;
+    ASSERT_EQ(seen.size(), oracle.image.size());
+    EXPECT_EQ(cv::norm(seen, oracle.image, cv::NORM_INF), 0);
   }
   if (folds != 0) {
     EXPECT_GT(o, h + 0.05) << "the oracle must clearly beat the homography";
@@ -150,6 +155,51 @@ TEST(AspectFromCorners, RecoversTheRectangleAspect) {
   baseline::Corners c;
   for (int i = 0; i < 4; ++i) c[i] = cam.Project(world[i]);
   EXPECT_NEAR(baseline::AspectFromCorners(c, cam.K), w / hgt, 1e-6);
+}
+
+// SeenPageRect on a flat page (0.2 x 0.3 m in z = 0, s along x, t along y)
+// under a camera looking straight down: the rows that leave its frame are
+// cut, a second camera that sees them brings them back, and a camera behind
+// the page sees nothing.
+TEST(SeenPageRect, CutsWhatNoPhotoSees) {
+  PlyData page;
+  std::vector<double> s, t;
+  const int nx = 21, ny = 31;
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      s.push_back(double(i) / (nx - 1));
+      t.push_back(double(j) / (ny - 1));
+      page.vertices.emplace_back(0.2 * s.back(), 0.3 * t.back(), 0);
+    }
+  for (int j = 0; j + 1 < ny; ++j)
+    for (int i = 0; i + 1 < nx; ++i)
+      page.faces.push_back({j * nx + i, j * nx + i + 1, (j + 1) * nx + i + 1, (j + 1) * nx + i});
+  page.SetProperty("s", s);
+  page.SetProperty("t", t);
+  const cv::Size size(200, 300);  // 1 mm per pixel
+
+  // 1000 px focal length at 1 m: 1 px per mm. The frame is 400 x 200 px
+  // centred on y = 0.25 m: it sees y from 0.15 to 0.35 m, the page's last
+  // 0.15 m (rows 150..299) and all its columns.
+  PinholeCamera low;
+  low.width = 400;
+  low.height = 200;
+  low.K << 1000, 0, 199.5, 0, 1000, 99.5, 0, 0, 1;
+  low.t = Eigen::Vector3d(-0.1, -0.25, 1.0);
+  cv::Rect r = baseline::SeenPageRect({low}, page, size);
+  EXPECT_EQ(r.x, 0);
+  EXPECT_EQ(r.width, 200);
+  EXPECT_NEAR(r.y, 150, 1);
+  EXPECT_EQ(r.y + r.height, 300);
+
+  PinholeCamera high = low;  // sees y from -0.05 to 0.15 m
+  high.t = Eigen::Vector3d(-0.1, -0.05, 1.0);
+  r = baseline::SeenPageRect({low, high}, page, size);
+  EXPECT_EQ(r, cv::Rect(0, 0, 200, 300));
+
+  PinholeCamera behind = low;
+  behind.t = Eigen::Vector3d(-0.1, -0.25, -1.0);
+  EXPECT_TRUE(baseline::SeenPageRect({behind}, page, size).empty());
 }
 
 // Geometry metrics of evaluate: the true meshes themselves are at distance

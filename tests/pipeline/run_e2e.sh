@@ -2,7 +2,8 @@
 # run_e2e.sh SOURCE BUILD OUT: the run behind the end-to-end tests. The whole
 # pipeline on every data set with ground truth (samples/*, and the
 # independently rendered ../shared/realistic/* when present), with the rows
-# the checks compare against (homography, oracle, docunfold-init, and both
+# the checks compare against (homography, oracle and its crop to what the
+# photos see, docunfold-init, and both
 # with the light's shading removed), through
 # scripts/bench.sh; two sets side by side. OCR is left out (the metrics
 # reference test covers it). Exits non-zero only when the run itself fails;
@@ -18,7 +19,7 @@ fi
 rm -rf "$out"
 mkdir -p "$out"
 BUILD=$build BENCH_WORK=$out/work BENCH_OUT=$out BENCH_JOBS=${E2E_JOBS:-2} \
-  BENCH_ONLY="homography oracle docunfold docunfold-init oracle-deshaded docunfold-deshaded" BENCH_EVAL_FLAGS=--no-ocr \
+  BENCH_ONLY="homography oracle oracle-seen docunfold docunfold-init oracle-deshaded docunfold-deshaded" BENCH_EVAL_FLAGS=--no-ocr \
   BENCH_OCR_SIZE=native "$src/scripts/bench.sh" "${sets[@]}" > "$out/bench.log" 2>&1
 rc=$?
 tail -n 40 "$out/bench.log"
