@@ -205,19 +205,43 @@ cv::Rect SeenPageRect(const std::vector<PinholeCamera>& cameras, const PlyData& 
                       cv::Size size) {
   if (!mesh.FindProperty("s") || !mesh.FindProperty("t"))
     throw InputError("true mesh has no per-vertex s, t");
+  const auto& s = mesh.FindProperty("s")->values;
+  const auto& t = mesh.FindProperty("t")->values;
   const std::vector<Triangle> triangles = Triangulate(mesh.faces);
-  cv::Mat1b seen(size, 0);
-  for (const PinholeCamera& camera : cameras) {
-    const cv::Mat2f map = TrueMap(camera, mesh, triangles, size, 1);
-    for (int y = 0; y < map.rows; ++y)
-      for (int x = 0; x < map.cols; ++x) {
-        const cv::Vec2f p = map(y, x);  // NaN behind the camera or off the mesh
-        if (p[0] >= -0.5f && p[1] >= -0.5f && p[0] <= camera.width - 0.5f &&
-            p[1] <= camera.height - 0.5f)
+  std::vector<Eigen::Vector3d> screen(mesh.vertices.size());
+  for (size_t i = 0; i < screen.size(); ++i)
+    screen[i] = {s[i] * size.width - 0.5, t[i] * size.height - 0.5, 1.0};
+  const RasterResult raster = Rasterize(screen, triangles, size.width, size.height);
+  cv::Mat1b covered(size, 0), seen(size, 0);
+  for (int y = 0; y < size.height; ++y)
+    for (int x = 0; x < size.width; ++x) {
+      const int f = raster.face(y, x);
+      if (f < 0) continue;
+      covered(y, x) = 255;
+      const double b1 = raster.bary(y, x)[0], b2 = raster.bary(y, x)[1];
+      const Triangle& tri = triangles[f];
+      const Eigen::Vector3d p = (1 - b1 - b2) * mesh.vertices[tri[0]] +
+                                b1 * mesh.vertices[tri[1]] + b2 * mesh.vertices[tri[2]];
+      for (const PinholeCamera& camera : cameras) {
+        const Eigen::Vector3d xc = camera.CamFromWorld(p);
+        if (xc.z() <= 0) continue;
+        const Eigen::Vector2d px = camera.ProjectCam(xc);
+        if (px.x() >= -0.5 && px.y() >= -0.5 && px.x() <= camera.width - 0.5 &&
+            px.y() <= camera.height - 0.5) {
           seen(y, x) = 255;
+          break;
+        }
       }
-  }
-  return cv::boundingRect(seen);
+    }
+  // Only the mesh can be unseen: a side the photos see as far as the mesh
+  // reaches keeps the page's edge (a mesh that stops short of s, t = 0 or 1
+  // leaves pixels on no triangle, which TextureFromTruth fills).
+  const cv::Rect on_mesh = cv::boundingRect(covered), r = cv::boundingRect(seen);
+  if (r.empty()) return r;
+  const int x0 = r.x <= on_mesh.x ? 0 : r.x, y0 = r.y <= on_mesh.y ? 0 : r.y;
+  const int x1 = r.br().x >= on_mesh.br().x ? size.width : r.br().x;
+  const int y1 = r.br().y >= on_mesh.br().y ? size.height : r.br().y;
+  return cv::Rect(x0, y0, x1 - x0, y1 - y0);
 }
 
 BaselineResult Run(const BaselineInputs& in, const BaselineOptions& options) {
@@ -303,9 +327,9 @@ BaselineResult Run(const BaselineInputs& in, const BaselineOptions& options) {
       out.image = out.image(seen).clone();
       const size_t n = std::strlen(buf);
       std::snprintf(buf + n, sizeof buf - n,
-                    ", cropped to the part the photos see: x %d..%d, y %d..%d (%dx%d)", seen.x,
-                    seen.x + seen.width, seen.y, seen.y + seen.height, seen.width,
-                    seen.height);
+                    ", cropped to the part the photos see: x %d..%d, y %d..%d of %dx%d", seen.x,
+                    seen.x + seen.width, seen.y, seen.y + seen.height, size.width,
+                    size.height);
     }
   }
   out.summary = buf;
