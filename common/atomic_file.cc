@@ -1,19 +1,18 @@
 #include "common/atomic_file.h"
 
+#include <unistd.h>
+
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
-#include <unistd.h>
 
 #include "common/errors.h"
 
 namespace docunfold {
 
 AtomicOutput::AtomicOutput(const fs::path& target) : target_(target) {
-  EnsureDirectory(target.has_parent_path() ? target.parent_path()
-                                           : fs::path("."));
+  EnsureDirectory(target.has_parent_path() ? target.parent_path() : fs::path("."));
   temp_ = target;
-  temp_.replace_filename("." + target.stem().string() + ".tmp." +
-                         std::to_string(::getpid()) +
+  temp_.replace_filename("." + target.stem().string() + ".tmp." + std::to_string(::getpid()) +
                          target.extension().string());
 }
 
@@ -26,12 +25,9 @@ AtomicOutput::~AtomicOutput() {
 
 void AtomicOutput::Commit() {
   std::error_code ec;
-  if (!fs::exists(temp_, ec))
-    throw OutputError(target_.string() + ": nothing was written");
+  if (!fs::exists(temp_, ec)) throw OutputError(target_.string() + ": nothing was written");
   fs::rename(temp_, target_, ec);
-  if (ec)
-    throw OutputError(target_.string() + ": cannot rename temporary file: " +
-                      ec.message());
+  if (ec) throw OutputError(target_.string() + ": cannot rename temporary file: " + ec.message());
   committed_ = true;
 }
 
@@ -55,8 +51,7 @@ void WriteTextAtomic(const fs::path& path, const std::string& text) {
   out.Commit();
 }
 
-void WriteImageAtomic(const fs::path& path, const cv::Mat& image,
-                      const std::vector<int>& params) {
+void WriteImageAtomic(const fs::path& path, const cv::Mat& image, const std::vector<int>& params) {
   if (image.empty()) throw OutputError(path.string() + ": empty image");
   AtomicOutput out(path);
   bool ok = false;
@@ -71,15 +66,13 @@ void WriteImageAtomic(const fs::path& path, const cv::Mat& image,
 
 cv::Mat ReadImage(const fs::path& path, int flags) {
   std::error_code ec;
-  if (!fs::is_regular_file(path, ec))
-    throw InputError(path.string() + ": no such file");
+  if (!fs::is_regular_file(path, ec)) throw InputError(path.string() + ": no such file");
   cv::Mat image;
   try {
     image = cv::imread(path.string(), flags);
   } catch (const cv::Exception&) {
   }
-  if (image.empty())
-    throw InputError(path.string() + ": not a readable image");
+  if (image.empty()) throw InputError(path.string() + ": not a readable image");
   return image;
 }
 

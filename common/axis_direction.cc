@@ -1,9 +1,8 @@
 #include "common/axis_direction.h"
 
+#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
-
-#include <Eigen/Dense>
 
 namespace docunfold {
 
@@ -47,7 +46,8 @@ AxisDirection DominantAxisDirection(const std::vector<DirectionVote>& votes, dou
   for (const DirectionVote& v : votes) {
     const int bin = int(std::floor((WrapToQuarterTurn(v.angle_deg) + 45) * 2));
     for (int k = -6; k <= 6; ++k)
-      hist[((bin + k) % kBins + kBins) % kBins] += v.length * std::exp(-0.5 * (k / 3.0) * (k / 3.0));
+      hist[((bin + k) % kBins + kBins) % kBins] +=
+          v.length * std::exp(-0.5 * (k / 3.0) * (k / 3.0));
   }
   const int peak = int(std::max_element(hist.begin(), hist.end()) - hist.begin());
   const double centre = WrapToQuarterTurn(peak / 2.0 - 45 + 0.25);

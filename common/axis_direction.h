@@ -2,10 +2,9 @@
 // length follows: on a page, printed rows and rules run along its axes.
 #pragma once
 
+#include <Eigen/Core>
 #include <optional>
 #include <vector>
-
-#include <Eigen/Core>
 
 namespace docunfold {
 
@@ -26,8 +25,7 @@ struct AxisDirection {
 // The mode of the votes' length over directions modulo 90 degrees (a
 // histogram smoothed over +-1.5 degrees), refined by the length-weighted mean
 // of the votes within `agree_deg` of it. No votes: all zero.
-AxisDirection DominantAxisDirection(const std::vector<DirectionVote>& votes,
-                                    double agree_deg = 3);
+AxisDirection DominantAxisDirection(const std::vector<DirectionVote>& votes, double agree_deg = 3);
 
 // `angle_deg` reduced modulo 90 to (-45, 45].
 double WrapToQuarterTurn(double angle_deg);
@@ -39,7 +37,6 @@ double WrapToQuarterTurn(double angle_deg);
 // direction the map sends to nothing.
 std::optional<Eigen::Vector2d> CarryDirection(const std::vector<Eigen::Vector2d>& from,
                                               const std::vector<Eigen::Vector2d>& to,
-                                              const Eigen::Vector2d& direction,
-                                              int min_pairs = 10);
+                                              const Eigen::Vector2d& direction, int min_pairs = 10);
 
 }  // namespace docunfold

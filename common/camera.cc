@@ -18,14 +18,15 @@ CameraSet ReadCameras(const fs::path& path) {
   JsonReader r(doc, path);
   std::string format = r.String("/format");
   if (format != "docunfold.gt-cameras" && format != "docunfold.cameras")
-    r.Fail("/format", "expected \"docunfold.cameras\" or "
-                      "\"docunfold.gt-cameras\", found \"" + format + "\"");
+    r.Fail("/format",
+           "expected \"docunfold.cameras\" or "
+           "\"docunfold.gt-cameras\", found \"" +
+               format + "\"");
   CheckFormat(doc, path, format, 1);
   CameraSet set;
   if (format == "docunfold.cameras") set.reference = r.String("/reference");
   const Json& views = r.At("/views");
-  if (!views.is_array() || views.empty())
-    r.Fail("/views", "expected a non-empty array");
+  if (!views.is_array() || views.empty()) r.Fail("/views", "expected a non-empty array");
   for (size_t i = 0; i < views.size(); ++i) {
     std::string p = "/views/" + std::to_string(i);
     PinholeCamera c;
@@ -38,8 +39,7 @@ CameraSet ReadCameras(const fs::path& path) {
     c.t = r.Vector3(p + "/t");
     if (!((c.R * c.R.transpose() - Eigen::Matrix3d::Identity()).norm() < 1e-4))
       r.Fail(p + "/R", "not a rotation matrix");
-    if (!(c.K(0, 0) > 0 && c.K(1, 1) > 0))
-      r.Fail(p + "/K", "focal lengths must be positive");
+    if (!(c.K(0, 0) > 0 && c.K(1, 1) > 0)) r.Fail(p + "/K", "focal lengths must be positive");
     set.views.push_back(c);
   }
   if (!set.reference.empty() && !set.Find(set.reference))
@@ -75,8 +75,8 @@ std::optional<Eigen::Vector2d> ProjectDistorted(const PinholeCamera& camera,
   return pixel;
 }
 
-cv::Mat ReadViewPhoto(const fs::path& path, const PinholeCamera& view,
-                      const fs::path& cameras_file, int flags) {
+cv::Mat ReadViewPhoto(const fs::path& path, const PinholeCamera& view, const fs::path& cameras_file,
+                      int flags) {
   cv::Mat photo = ReadImage(path, flags);
   if (photo.cols != view.width || photo.rows != view.height)
     throw InputError(path.string() + ": " + std::to_string(photo.cols) + "x" +

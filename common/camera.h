@@ -2,15 +2,14 @@
 // at integer coordinates) and the cameras.json files that hold sets of them.
 #pragma once
 
+#include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <array>
 #include <filesystem>
+#include <opencv2/core.hpp>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
-#include <Eigen/Geometry>
-#include <opencv2/core.hpp>
 
 #include "common/json_io.h"
 
@@ -24,9 +23,7 @@ struct PinholeCamera {
   Eigen::Matrix3d R = Eigen::Matrix3d::Identity();  // cam_from_world rotation
   Eigen::Vector3d t = Eigen::Vector3d::Zero();      // cam_from_world translation
 
-  Eigen::Vector3d CamFromWorld(const Eigen::Vector3d& x_world) const {
-    return R * x_world + t;
-  }
+  Eigen::Vector3d CamFromWorld(const Eigen::Vector3d& x_world) const { return R * x_world + t; }
   // Camera centre in world coordinates.
   Eigen::Vector3d Center() const { return -R.transpose() * t; }
   // Pixel of a point given in camera coordinates (z must be > 0).
@@ -80,8 +77,8 @@ std::optional<Eigen::Vector2d> ProjectDistorted(const PinholeCamera& camera,
 // The photo `path` of `view`, read with cv::imread's `flags`; InputError
 // naming the file when it is missing, unreadable or not the size its camera
 // in `cameras_file` says.
-cv::Mat ReadViewPhoto(const fs::path& path, const PinholeCamera& view,
-                      const fs::path& cameras_file, int flags);
+cv::Mat ReadViewPhoto(const fs::path& path, const PinholeCamera& view, const fs::path& cameras_file,
+                      int flags);
 
 // JSON for one camera: {"image","width","height","K","R","t"}.
 Json CameraToJson(const PinholeCamera& camera);

@@ -1,10 +1,9 @@
 #include "common/cli.h"
 
-#include <cstdlib>
-#include <iostream>
-
 #include <unistd.h>
 
+#include <cstdlib>
+#include <iostream>
 #include <opencv2/core.hpp>
 
 #include "nlohmann/json.hpp"
@@ -28,9 +27,7 @@ void LimitOpenMpThreads(char** argv) {
   ::execv("/proc/self/exe", argv);  // returns only on failure: run as we are
 }
 
-void Log(const std::string& message) {
-  std::cerr << ProgramName() << ": " << message << std::endl;
-}
+void Log(const std::string& message) { std::cerr << ProgramName() << ": " << message << std::endl; }
 
 int RunStage(const std::string& program, CLI::App& app, int argc, char** argv,
              const std::function<void()>& body) {
@@ -48,8 +45,7 @@ int RunStage(const std::string& program, CLI::App& app, int argc, char** argv,
     std::cout << program << " " << ProgramVersion() << "\n";
     return kExitOk;
   } catch (const CLI::ParseError& e) {
-    std::cerr << program << ": usage error: " << e.what()
-              << " (see --help)" << std::endl;
+    std::cerr << program << ": usage error: " << e.what() << " (see --help)" << std::endl;
     return kExitUsage;
   }
   auto fail = [&](int code, const char* kind, const std::string& what) {
@@ -92,33 +88,32 @@ void Progress::Update(long done) {
 void Progress::Done() {
   char buf[64];
   std::snprintf(buf, sizeof buf, " in %.1f s", SecondsSince(start_));
-  Log(what_ + " " + std::to_string(total_) + "/" + std::to_string(total_) +
-      buf);
+  Log(what_ + " " + std::to_string(total_) + "/" + std::to_string(total_) + buf);
 }
 
 double SecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() -
-                                       start)
-      .count();
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-void AddFairnessBoostOptions(CLI::App& app, double* unsupported_fairness,
-                             double* support_radius) {
+void AddFairnessBoostOptions(CLI::App& app, double* unsupported_fairness, double* support_radius) {
   app.add_option("--unsupported-fairness", *unsupported_fairness,
                  "lambda3 is multiplied by up to this where M has no point within "
                  "--support-radius (blank paper keeps its panel's plane); 1 = off")
-      ->capture_default_str()->check(CLI::Range(1.0, 1e9));
+      ->capture_default_str()
+      ->check(CLI::Range(1.0, 1e9));
   app.add_option("--support-radius", *support_radius,
                  "distance to the nearest point, along M, beyond which fairness stiffens "
                  "(fraction of the model size; full at twice this)")
-      ->capture_default_str()->check(CLI::Range(0.0, 1.0));
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
 }
 
 void AddIsoEdgesOption(CLI::App& app, double* iso_edges) {
   app.add_option("--iso-edges", *iso_edges,
                  "weight of E_iso's edge-length rows next to the paper's diagonal rows "
                  "(0 = diagonals only, as in the paper)")
-      ->capture_default_str()->check(CLI::Range(0.0, 100.0));
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 100.0));
 }
 
 void AddFair2dAlongOption(CLI::App& app, double* fair2d_along) {

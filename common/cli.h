@@ -33,8 +33,7 @@ void LimitOpenMpThreads(char** argv);
 
 // --unsupported-fairness and --support-radius, the same in every stage that
 // runs the isometric solver (isometry::SolveOptions documents them).
-void AddFairnessBoostOptions(CLI::App& app, double* unsupported_fairness,
-                             double* support_radius);
+void AddFairnessBoostOptions(CLI::App& app, double* unsupported_fairness, double* support_radius);
 
 // --iso-edges, the same in every stage that runs the isometric solver
 // (isometry::SolveOptions::iso_edges documents it).

@@ -50,15 +50,11 @@ CpuSample SampleCpu() {
   while (std::getline(in, line)) {
     // Per-CPU lines "cpuN user nice system idle iowait irq softirq steal ...";
     // the aggregate "cpu " line would count cores this process cannot use.
-    if (line.compare(0, 3, "cpu") != 0 || line.size() < 4 ||
-        !std::isdigit(line[3]))
-      continue;
+    if (line.compare(0, 3, "cpu") != 0 || line.size() < 4 || !std::isdigit(line[3])) continue;
     std::istringstream fields(line.substr(3));
     int cpu = -1;
-    double user = 0, nice = 0, system = 0, idle = 0, iowait = 0, irq = 0,
-           softirq = 0, steal = 0;
-    fields >> cpu >> user >> nice >> system >> idle >> iowait >> irq >>
-        softirq >> steal;
+    double user = 0, nice = 0, system = 0, idle = 0, iowait = 0, irq = 0, softirq = 0, steal = 0;
+    fields >> cpu >> user >> nice >> system >> idle >> iowait >> irq >> softirq >> steal;
     if (cpu < 0) continue;
     if (have_set && !InAffinity(cpu, set)) continue;
     ticks += user + nice + system + irq + softirq + steal;
@@ -71,18 +67,15 @@ CpuSample SampleCpu() {
 }
 
 double OthersCores(const CpuSample& before, const CpuSample& after) {
-  const double wall =
-      std::chrono::duration<double>(after.wall - before.wall).count();
+  const double wall = std::chrono::duration<double>(after.wall - before.wall).count();
   if (!before.valid || !after.valid || wall <= 0) return 0;
-  const double others = (after.busy_seconds - before.busy_seconds) -
-                        (after.self_seconds - before.self_seconds);
+  const double others =
+      (after.busy_seconds - before.busy_seconds) - (after.self_seconds - before.self_seconds);
   return std::max(0.0, others / wall);
 }
 
 CpuShare::CpuShare(double min_interval_seconds)
-    : min_interval_(min_interval_seconds),
-      cores_(AvailableCores()),
-      last_(SampleCpu()) {}
+    : min_interval_(min_interval_seconds), cores_(AvailableCores()), last_(SampleCpu()) {}
 
 int CpuShare::Threads(int wanted) {
   wanted = std::max(1, wanted);
@@ -93,8 +86,7 @@ int CpuShare::Threads(int wanted) {
     last_ = now;
     return wanted;
   }
-  if (std::chrono::duration<double>(now.wall - last_.wall).count() >=
-      min_interval_) {
+  if (std::chrono::duration<double>(now.wall - last_.wall).count() >= min_interval_) {
     others_ = OthersCores(last_, now);
     last_ = now;
     measured_ = true;

@@ -11,22 +11,19 @@ bool IsImageFile(const fs::path& path) {
   std::string ext = path.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(),
                  [](unsigned char c) { return std::tolower(c); });
-  return ext == ".jpg" || ext == ".jpeg" || ext == ".png" || ext == ".tif" ||
-         ext == ".tiff";
+  return ext == ".jpg" || ext == ".jpeg" || ext == ".png" || ext == ".tif" || ext == ".tiff";
 }
 
 DataSet OpenDataSet(const fs::path& root) {
   std::error_code ec;
-  if (!fs::is_directory(root, ec))
-    throw InputError(root.string() + ": no such data set folder");
+  if (!fs::is_directory(root, ec)) throw InputError(root.string() + ": no such data set folder");
   if (!fs::is_directory(root / "images", ec))
     throw InputError((root / "images").string() +
                      ": missing (a data set keeps its photos in images/)");
   DataSet set;
   set.root = root;
   for (const auto& entry : fs::directory_iterator(root / "images", ec))
-    if (entry.is_regular_file() && IsImageFile(entry.path()))
-      set.images.push_back(entry.path());
+    if (entry.is_regular_file() && IsImageFile(entry.path())) set.images.push_back(entry.path());
   std::sort(set.images.begin(), set.images.end());
   set.has_ground_truth = fs::is_directory(root / "ground_truth", ec);
   return set;

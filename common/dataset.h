@@ -15,9 +15,7 @@ struct DataSet {
   std::vector<fs::path> images;  // sorted by file name
   bool has_ground_truth = false;
 
-  fs::path ground_truth(const std::string& file) const {
-    return root / "ground_truth" / file;
-  }
+  fs::path ground_truth(const std::string& file) const { return root / "ground_truth" / file; }
 };
 
 // True for the photo extensions we accept (jpg, jpeg, png, tif, tiff; any case).

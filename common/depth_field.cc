@@ -8,9 +8,8 @@
 
 namespace docunfold {
 
-DepthField::DepthField(std::vector<Eigen::Vector2d> pixels,
-                       std::vector<double> depths, int k, double scale,
-                       DepthModel model, int planar_k, double planar_guard)
+DepthField::DepthField(std::vector<Eigen::Vector2d> pixels, std::vector<double> depths, int k,
+                       double scale, DepthModel model, int planar_k, double planar_guard)
     : pixels_(std::move(pixels)),
       depths_(std::move(depths)),
       k_(k),
@@ -35,22 +34,20 @@ double DepthField::At(const Eigen::Vector2d& px) const {
   }
   const double average = sz / sw;
   if (!planar) return average;
-  double inv = PlanarInverseDepth(
-      px, nearest, std::min<size_t>(nearest.size(), size_t(planar_k_)));
+  double inv = PlanarInverseDepth(px, nearest, std::min<size_t>(nearest.size(), size_t(planar_k_)));
   if (planar_guard_ > 0 && nearest.size() > size_t(planar_k_)) {
-    const double wide = PlanarInverseDepth(
-        px, nearest, std::min<size_t>(nearest.size(), size_t(fit_k)));
+    const double wide =
+        PlanarInverseDepth(px, nearest, std::min<size_t>(nearest.size(), size_t(fit_k)));
     // Compared as depths: |1/inv - 1/wide| > guard / wide.
-    if (std::isfinite(wide) &&
-        (!std::isfinite(inv) || std::abs(wide / inv - 1) > planar_guard_))
+    if (std::isfinite(wide) && (!std::isfinite(inv) || std::abs(wide / inv - 1) > planar_guard_))
       inv = wide;
   }
   return std::isfinite(inv) ? 1 / inv : average;
 }
 
-double DepthField::PlanarInverseDepth(
-    const Eigen::Vector2d& px,
-    const std::vector<std::pair<int, double>>& nearest, size_t n) const {
+double DepthField::PlanarInverseDepth(const Eigen::Vector2d& px,
+                                      const std::vector<std::pair<int, double>>& nearest,
+                                      size_t n) const {
   constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
   if (n < 6) return kNaN;
   // 1/z = c + a·du + b·dv around px (weighted normal equations). The

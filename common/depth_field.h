@@ -26,9 +26,8 @@ enum class DepthModel { kAverage, kPlanar };
 class DepthField {
  public:
   // `pixels` and `depths` (> 0) correspond; at least one point.
-  DepthField(std::vector<Eigen::Vector2d> pixels, std::vector<double> depths,
-             int k, double scale, DepthModel model, int planar_k,
-             double planar_guard = 0);
+  DepthField(std::vector<Eigen::Vector2d> pixels, std::vector<double> depths, int k, double scale,
+             DepthModel model, int planar_k, double planar_guard = 0);
   ~DepthField();
   DepthField(const DepthField&) = delete;
   DepthField& operator=(const DepthField&) = delete;
@@ -40,8 +39,7 @@ class DepthField {
   // point index and squared pixel distance, nearest first); NaN where the
   // points leave the slope free (nearly collinear) or the fit is not positive.
   double PlanarInverseDepth(const Eigen::Vector2d& px,
-                            const std::vector<std::pair<int, double>>& nearest,
-                            size_t n) const;
+                            const std::vector<std::pair<int, double>>& nearest, size_t n) const;
 
   std::vector<Eigen::Vector2d> pixels_;
   std::vector<double> depths_;

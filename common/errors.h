@@ -9,10 +9,10 @@ namespace docunfold {
 
 enum ExitCode : int {
   kExitOk = 0,
-  kExitOther = 1,      // anything not covered below (a bug, a failed solver)
-  kExitUsage = 2,      // bad command line
-  kExitBadInput = 3,   // missing, unreadable or invalid input
-  kExitCannotWrite = 4 // output cannot be written
+  kExitOther = 1,       // anything not covered below (a bug, a failed solver)
+  kExitUsage = 2,       // bad command line
+  kExitBadInput = 3,    // missing, unreadable or invalid input
+  kExitCannotWrite = 4  // output cannot be written
 };
 
 // Bad command line (exit 2).

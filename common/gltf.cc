@@ -32,9 +32,8 @@ int AddView(tinygltf::Model* model, const void* data, size_t bytes, int target) 
   return int(model->bufferViews.size() - 1);
 }
 
-int AddAccessor(tinygltf::Model* model, int view, int component, int type,
-                size_t count, std::vector<double> min = {},
-                std::vector<double> max = {}) {
+int AddAccessor(tinygltf::Model* model, int view, int component, int type, size_t count,
+                std::vector<double> min = {}, std::vector<double> max = {}) {
   tinygltf::Accessor a;
   a.bufferView = view;
   a.componentType = component;
@@ -59,9 +58,9 @@ int AddPositions(tinygltf::Model* model, const std::vector<Eigen::Vector3d>& pos
       hi[k] = std::max(hi[k], double(float(q[k])));
     }
   }
-  return AddAccessor(
-      model, AddView(model, pos.data(), pos.size() * 4, TINYGLTF_TARGET_ARRAY_BUFFER),
-      TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, positions.size(), lo, hi);
+  return AddAccessor(model,
+                     AddView(model, pos.data(), pos.size() * 4, TINYGLTF_TARGET_ARRAY_BUFFER),
+                     TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, positions.size(), lo, hi);
 }
 
 // One primitive with its material, as a named mesh in a node of `scene`.
@@ -82,8 +81,7 @@ void AddNode(tinygltf::Model* model, tinygltf::Scene* scene, const std::string& 
 
 }  // namespace
 
-void WriteGlb(const std::filesystem::path& path,
-              const std::vector<GltfMesh>& meshes,
+void WriteGlb(const std::filesystem::path& path, const std::vector<GltfMesh>& meshes,
               const std::vector<GltfPoints>& clouds) {
   tinygltf::Model model;
   model.asset.version = "2.0";
@@ -103,8 +101,8 @@ void WriteGlb(const std::filesystem::path& path,
     prim.attributes["POSITION"] = AddPositions(&model, m.positions);
     prim.indices = AddAccessor(
         &model, AddView(&model, idx.data(), idx.size() * 4, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER),
-        TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR, idx.size(),
-        {0.0}, {double(m.positions.size() - 1)});
+        TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR, idx.size(), {0.0},
+        {double(m.positions.size() - 1)});
     tinygltf::Material material;
     material.name = m.name;
     material.doubleSided = true;
@@ -137,8 +135,7 @@ void WriteGlb(const std::filesystem::path& path,
       texture.source = int(model.images.size() - 1);
       texture.sampler = int(model.samplers.size() - 1);
       model.textures.push_back(texture);
-      material.pbrMetallicRoughness.baseColorTexture.index =
-          int(model.textures.size() - 1);
+      material.pbrMetallicRoughness.baseColorTexture.index = int(model.textures.size() - 1);
     }
     AddNode(&model, &scene, m.name, prim, material);
   }

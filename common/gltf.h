@@ -2,12 +2,11 @@
 // glTF viewers and the browser report.
 #pragma once
 
+#include <Eigen/Core>
 #include <filesystem>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
-#include <opencv2/core.hpp>
 
 #include "common/raster.h"
 
@@ -31,8 +30,7 @@ struct GltfPoints {
 // Writes one .glb with all meshes and point clouds as nodes of one scene
 // (atomic; throws OutputError). Positions are turned from OpenCV axes (y
 // down, z forward) into glTF's (y up, z backward) by flipping y and z.
-void WriteGlb(const std::filesystem::path& path,
-              const std::vector<GltfMesh>& meshes,
+void WriteGlb(const std::filesystem::path& path, const std::vector<GltfMesh>& meshes,
               const std::vector<GltfPoints>& points = {});
 
 }  // namespace docunfold

@@ -60,9 +60,8 @@ QuadGrid GridOf(const PlyData& ply, const fs::path& path) {
   QuadGrid grid{(*size)[0], (*size)[1]};
   if (ply.faces.size() != size_t(grid.NumQuads()))
     throw InputError(path.string() + ": expected " + std::to_string(grid.NumQuads()) +
-                     " quads for a " + std::to_string(grid.nx) + "x" +
-                     std::to_string(grid.ny) + " grid, found " +
-                     std::to_string(ply.faces.size()) + " faces");
+                     " quads for a " + std::to_string(grid.nx) + "x" + std::to_string(grid.ny) +
+                     " grid, found " + std::to_string(ply.faces.size()) + " faces");
   return grid;
 }
 
@@ -86,9 +85,9 @@ MeshPair ReadMeshPair(const fs::path& dir) {
   m.grid = GridOf(m3, p3);
   const QuadGrid g2 = GridOf(m2, p2);
   if (g2.nx != m.grid.nx || g2.ny != m.grid.ny)
-    throw InputError(p2.string() + ": grid " + std::to_string(g2.nx) + "x" +
-                     std::to_string(g2.ny) + " differs from mesh3d.ply's " +
-                     std::to_string(m.grid.nx) + "x" + std::to_string(m.grid.ny));
+    throw InputError(p2.string() + ": grid " + std::to_string(g2.nx) + "x" + std::to_string(g2.ny) +
+                     " differs from mesh3d.ply's " + std::to_string(m.grid.nx) + "x" +
+                     std::to_string(m.grid.ny));
   const auto faces = m.grid.Faces();
   if (m3.faces != faces)
     throw InputError(p3.string() + ": faces are not the row-major quads of the grid");
@@ -103,8 +102,7 @@ MeshPair ReadMeshPair(const fs::path& dir) {
   return m;
 }
 
-void WriteMeshPair(const fs::path& dir, const MeshPair& m,
-                   const MeshPairWriteOptions& options) {
+void WriteMeshPair(const fs::path& dir, const MeshPair& m, const MeshPairWriteOptions& options) {
   PlyData m3, m2;
   m3.vertices = m.mesh3d;
   for (const Eigen::Vector2d& v : m.mesh2d) m2.vertices.emplace_back(v.x(), v.y(), 0.0);
@@ -127,8 +125,7 @@ void WriteMeshPair(const fs::path& dir, const MeshPair& m,
     m3.SetProperty("texture_u", u);
     m3.SetProperty("texture_v", v);
     if (!options.reference_image.empty()) {
-      fs::path rel = fs::absolute(options.reference_image)
-                         .lexically_relative(fs::absolute(dir));
+      fs::path rel = fs::absolute(options.reference_image).lexically_relative(fs::absolute(dir));
       m3.comments.push_back("TextureFile " + rel.generic_string());
     }
   }

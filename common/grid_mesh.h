@@ -12,13 +12,12 @@
 //    reference image and `comment TextureFile <path relative to the PLY>`.
 #pragma once
 
+#include <Eigen/Core>
 #include <array>
 #include <filesystem>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "common/camera.h"
 #include "common/ply.h"

@@ -10,8 +10,8 @@
 
 namespace docunfold {
 
-Json MakeHeader(const std::string& format, int version,
-                const std::string& stage, const Json& options) {
+Json MakeHeader(const std::string& format, int version, const std::string& stage,
+                const Json& options) {
   Json header;
   header["format"] = format;
   header["version"] = version;
@@ -32,33 +32,28 @@ Json ReadJsonFile(const fs::path& path) {
   try {
     return Json::parse(buffer.str());
   } catch (const Json::parse_error& e) {
-    throw InputError(path.string() + ": not valid JSON (byte " +
-                     std::to_string(e.byte) + ")");
+    throw InputError(path.string() + ": not valid JSON (byte " + std::to_string(e.byte) + ")");
   }
 }
 
-void CheckFormat(const Json& doc, const fs::path& path,
-                 const std::string& format, int max_version) {
+void CheckFormat(const Json& doc, const fs::path& path, const std::string& format,
+                 int max_version) {
   JsonReader r(doc, path);
   if (!doc.is_object()) r.Fail("", "expected a JSON object");
   std::string found = r.String("/format");
-  if (found != format)
-    r.Fail("/format", "expected \"" + format + "\", found \"" + found + "\"");
+  if (found != format) r.Fail("/format", "expected \"" + format + "\", found \"" + found + "\"");
   int version = r.Integer("/version");
   if (version < 1 || version > max_version)
     r.Fail("/version", "unsupported version " + std::to_string(version) +
-                           " (this program reads up to " +
-                           std::to_string(max_version) + ")");
+                           " (this program reads up to " + std::to_string(max_version) + ")");
 }
 
 void WriteJsonAtomic(const fs::path& path, const Json& doc) {
   WriteTextAtomic(path, doc.dump(1) + "\n");
 }
 
-void JsonReader::Fail(const std::string& pointer,
-                      const std::string& problem) const {
-  throw InputError(file_.string() + ":" + (pointer.empty() ? "/" : pointer) +
-                   ": " + problem);
+void JsonReader::Fail(const std::string& pointer, const std::string& problem) const {
+  throw InputError(file_.string() + ":" + (pointer.empty() ? "/" : pointer) + ": " + problem);
 }
 
 bool JsonReader::Has(const std::string& pointer) const {
@@ -126,7 +121,8 @@ std::vector<Eigen::Vector2d> JsonReader::Points(const std::string& pointer,
   if (!points.is_array() || points.size() < min_points)
     Fail(pointer, "expected at least " + std::to_string(min_points) + " points");
   std::vector<Eigen::Vector2d> out;
-  for (size_t k = 0; k < points.size(); ++k) out.push_back(Vector2(pointer + "/" + std::to_string(k)));
+  for (size_t k = 0; k < points.size(); ++k)
+    out.push_back(Vector2(pointer + "/" + std::to_string(k)));
   return out;
 }
 

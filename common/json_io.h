@@ -3,12 +3,11 @@
 // Readers report problems as "<file>:<json pointer>: <what is wrong>".
 #pragma once
 
+#include <Eigen/Core>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
-#include <nlohmann/json.hpp>
 
 namespace docunfold {
 
@@ -16,15 +15,14 @@ using Json = nlohmann::json;
 namespace fs = std::filesystem;
 
 // Header fields for a file written by `stage` with the given options.
-Json MakeHeader(const std::string& format, int version,
-                const std::string& stage, const Json& options = Json::object());
+Json MakeHeader(const std::string& format, int version, const std::string& stage,
+                const Json& options = Json::object());
 
 // Parses a JSON file; throws InputError on a missing or malformed file.
 Json ReadJsonFile(const fs::path& path);
 
 // Checks "format" and that "version" is an integer <= max_version.
-void CheckFormat(const Json& doc, const fs::path& path,
-                 const std::string& format, int max_version);
+void CheckFormat(const Json& doc, const fs::path& path, const std::string& format, int max_version);
 
 // Writes pretty JSON atomically (throws OutputError).
 void WriteJsonAtomic(const fs::path& path, const Json& doc);
@@ -46,8 +44,7 @@ class JsonReader {
   // An array of at least `min_points` [x, y] (a polyline).
   std::vector<Eigen::Vector2d> Points(const std::string& pointer, size_t min_points) const;
   // Throws InputError for `pointer` with the given problem.
-  [[noreturn]] void Fail(const std::string& pointer,
-                         const std::string& problem) const;
+  [[noreturn]] void Fail(const std::string& pointer, const std::string& problem) const;
   const fs::path& file() const { return file_; }
 
  private:

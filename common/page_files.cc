@@ -1,7 +1,6 @@
 #include "common/page_files.h"
 
 #include <cmath>
-
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 

@@ -5,14 +5,13 @@
 // Also: which 3D points belong to the document region of the reference view.
 #pragma once
 
+#include <Eigen/Core>
 #include <array>
 #include <filesystem>
+#include <opencv2/core.hpp>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
-#include <opencv2/core.hpp>
 
 #include "common/camera.h"
 #include "common/json_io.h"
@@ -25,7 +24,7 @@ inline const char* const kSideNames[4] = {"top", "right", "bottom", "left"};
 
 struct BoundarySide {
   std::vector<Eigen::Vector2d> points;  // reference-image pixels
-  bool real = false;  // false where the page is cut off by the image border
+  bool real = false;                    // false where the page is cut off by the image border
   // Pieces of `points` that are page edge: all of it when real; those of a
   // cut side when the file lists them (real_parts), else none.
   std::vector<std::vector<Eigen::Vector2d>> real_parts;
@@ -35,7 +34,7 @@ struct Boundary {
   fs::path file;
   int width = 0;  // size of the image the boundary was found in
   int height = 0;
-  std::vector<Eigen::Vector2d> contour;     // closed outline
+  std::vector<Eigen::Vector2d> contour;    // closed outline
   std::array<Eigen::Vector2d, 4> corners;  // TL TR BR BL
   std::array<BoundarySide, 4> sides;       // top, right, bottom, left
   int RealSides() const;

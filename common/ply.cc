@@ -15,29 +15,54 @@ namespace {
 
 const char* ScalarName(PlyScalar t) {
   switch (t) {
-    case PlyScalar::kFloat32: return "float";
-    case PlyScalar::kFloat64: return "double";
-    case PlyScalar::kInt32: return "int";
-    case PlyScalar::kUint32: return "uint";
-    case PlyScalar::kUint8: return "uchar";
+    case PlyScalar::kFloat32:
+      return "float";
+    case PlyScalar::kFloat64:
+      return "double";
+    case PlyScalar::kInt32:
+      return "int";
+    case PlyScalar::kUint32:
+      return "uint";
+    case PlyScalar::kUint8:
+      return "uchar";
   }
   return "float";
 }
 
 bool ParseScalar(const std::string& s, PlyScalar* t, int* size) {
-  struct Entry { const char* a; const char* b; PlyScalar t; int size; };
-  static const Entry kTable[] = {
-      {"float", "float32", PlyScalar::kFloat32, 4},
-      {"double", "float64", PlyScalar::kFloat64, 8},
-      {"int", "int32", PlyScalar::kInt32, 4},
-      {"uint", "uint32", PlyScalar::kUint32, 4},
-      {"uchar", "uint8", PlyScalar::kUint8, 1}};
+  struct Entry {
+    const char* a;
+    const char* b;
+    PlyScalar t;
+    int size;
+  };
+  static const Entry kTable[] = {{"float", "float32", PlyScalar::kFloat32, 4},
+                                 {"double", "float64", PlyScalar::kFloat64, 8},
+                                 {"int", "int32", PlyScalar::kInt32, 4},
+                                 {"uint", "uint32", PlyScalar::kUint32, 4},
+                                 {"uchar", "uint8", PlyScalar::kUint8, 1}};
   for (const Entry& e : kTable)
-    if (s == e.a || s == e.b) { *t = e.t; *size = e.size; return true; }
+    if (s == e.a || s == e.b) {
+      *t = e.t;
+      *size = e.size;
+      return true;
+    }
   // Types we read but never write.
-  if (s == "char" || s == "int8") { *t = PlyScalar::kInt32; *size = -1; return true; }
-  if (s == "short" || s == "int16") { *t = PlyScalar::kInt32; *size = -2; return true; }
-  if (s == "ushort" || s == "uint16") { *t = PlyScalar::kUint32; *size = -2; return true; }
+  if (s == "char" || s == "int8") {
+    *t = PlyScalar::kInt32;
+    *size = -1;
+    return true;
+  }
+  if (s == "short" || s == "int16") {
+    *t = PlyScalar::kInt32;
+    *size = -2;
+    return true;
+  }
+  if (s == "ushort" || s == "uint16") {
+    *t = PlyScalar::kUint32;
+    *size = -2;
+    return true;
+  }
   return false;
 }
 
@@ -54,8 +79,7 @@ FileType ToFileType(const std::string& name, bool* ok) {
   *ok = ParseScalar(name, &ft.t, &size);
   if (size < 0) {
     ft.bytes = -size;
-    ft.is_signed_small = (name == "char" || name == "int8" || name == "short" ||
-                          name == "int16");
+    ft.is_signed_small = (name == "char" || name == "int8" || name == "short" || name == "int16");
   } else {
     ft.bytes = size;
   }
@@ -75,8 +99,7 @@ T SwapIfNeeded(T v, bool swap) {
 double DecodeBinary(const unsigned char* p, const FileType& ft, bool swap) {
   switch (ft.bytes) {
     case 1:
-      return ft.is_signed_small ? double(*reinterpret_cast<const int8_t*>(p))
-                                : double(*p);
+      return ft.is_signed_small ? double(*reinterpret_cast<const int8_t*>(p)) : double(*p);
     case 2: {
       uint16_t u;
       std::memcpy(&u, p, 2);
@@ -87,7 +110,11 @@ double DecodeBinary(const unsigned char* p, const FileType& ft, bool swap) {
       uint32_t u;
       std::memcpy(&u, p, 4);
       u = SwapIfNeeded(u, swap);
-      if (ft.t == PlyScalar::kFloat32) { float f; std::memcpy(&f, &u, 4); return f; }
+      if (ft.t == PlyScalar::kFloat32) {
+        float f;
+        std::memcpy(&f, &u, 4);
+        return f;
+      }
       if (ft.t == PlyScalar::kInt32) return double(int32_t(u));
       return double(u);
     }
@@ -103,15 +130,31 @@ double DecodeBinary(const unsigned char* p, const FileType& ft, bool swap) {
 }
 
 void EncodeBinary(std::string* out, double v, PlyScalar t) {
-  auto put = [out](const void* p, size_t n) {
-    out->append(static_cast<const char*>(p), n);
-  };
+  auto put = [out](const void* p, size_t n) { out->append(static_cast<const char*>(p), n); };
   switch (t) {
-    case PlyScalar::kFloat32: { float f = float(v); put(&f, 4); break; }
-    case PlyScalar::kFloat64: put(&v, 8); break;
-    case PlyScalar::kInt32: { int32_t i = int32_t(std::lround(v)); put(&i, 4); break; }
-    case PlyScalar::kUint32: { uint32_t i = uint32_t(std::llround(v)); put(&i, 4); break; }
-    case PlyScalar::kUint8: { uint8_t i = uint8_t(std::lround(v)); put(&i, 1); break; }
+    case PlyScalar::kFloat32: {
+      float f = float(v);
+      put(&f, 4);
+      break;
+    }
+    case PlyScalar::kFloat64:
+      put(&v, 8);
+      break;
+    case PlyScalar::kInt32: {
+      int32_t i = int32_t(std::lround(v));
+      put(&i, 4);
+      break;
+    }
+    case PlyScalar::kUint32: {
+      uint32_t i = uint32_t(std::llround(v));
+      put(&i, 4);
+      break;
+    }
+    case PlyScalar::kUint8: {
+      uint8_t i = uint8_t(std::lround(v));
+      put(&i, 1);
+      break;
+    }
   }
 }
 
@@ -130,17 +173,19 @@ const PlyProperty* PlyData::FindProperty(const std::string& name) const {
   return nullptr;
 }
 
-void PlyData::SetProperty(const std::string& name, std::vector<double> values,
-                          PlyScalar type) {
+void PlyData::SetProperty(const std::string& name, std::vector<double> values, PlyScalar type) {
   for (PlyProperty& p : properties)
-    if (p.name == name) { p.values = std::move(values); p.type = type; return; }
+    if (p.name == name) {
+      p.values = std::move(values);
+      p.type = type;
+      return;
+    }
   properties.push_back({name, type, std::move(values)});
 }
 
 std::optional<std::string> PlyData::CommentValue(const std::string& key) const {
   for (const std::string& c : comments) {
-    if (c.compare(0, key.size(), key) == 0 &&
-        (c.size() == key.size() || c[key.size()] == ' '))
+    if (c.compare(0, key.size(), key) == 0 && (c.size() == key.size() || c[key.size()] == ' '))
       return c.size() > key.size() ? c.substr(key.size() + 1) : std::string();
   }
   return std::nullopt;
@@ -151,8 +196,7 @@ std::optional<std::array<int, 2>> PlyData::GridSize() const {
   if (!v) return std::nullopt;
   std::istringstream s(*v);
   int nx = 0, ny = 0;
-  if (!(s >> nx >> ny) || nx < 2 || ny < 2 ||
-      size_t(nx) * size_t(ny) != vertices.size())
+  if (!(s >> nx >> ny) || nx < 2 || ny < 2 || size_t(nx) * size_t(ny) != vertices.size())
     return std::nullopt;
   return std::array<int, 2>{nx, ny};
 }
@@ -169,24 +213,20 @@ void WritePly(const fs::path& path, const PlyData& ply, PlyEncoding encoding) {
     throw std::invalid_argument("WritePly: colors size differs from vertices");
   for (const PlyProperty& p : ply.properties)
     if (p.values.size() != n)
-      throw std::invalid_argument("WritePly: property " + p.name +
-                                  " size differs from vertices");
+      throw std::invalid_argument("WritePly: property " + p.name + " size differs from vertices");
   for (const auto& f : ply.faces)
     for (int i : f)
-      if (i < 0 || size_t(i) >= n)
-        throw std::invalid_argument("WritePly: face index out of range");
+      if (i < 0 || size_t(i) >= n) throw std::invalid_argument("WritePly: face index out of range");
 
   const bool binary = encoding == PlyEncoding::kBinary;
   std::string out;
   out += "ply\nformat ";
-  out += binary ? (HostIsLittleEndian() ? "binary_little_endian" : "binary_big_endian")
-                : "ascii";
+  out += binary ? (HostIsLittleEndian() ? "binary_little_endian" : "binary_big_endian") : "ascii";
   out += " 1.0\n";
   for (const std::string& c : ply.comments) out += "comment " + c + "\n";
   out += "element vertex " + std::to_string(n) + "\n";
   out += "property float x\nproperty float y\nproperty float z\n";
-  if (!ply.colors.empty())
-    out += "property uchar red\nproperty uchar green\nproperty uchar blue\n";
+  if (!ply.colors.empty()) out += "property uchar red\nproperty uchar green\nproperty uchar blue\n";
   for (const PlyProperty& p : ply.properties)
     out += std::string("property ") + ScalarName(p.type) + " " + p.name + "\n";
   if (!ply.faces.empty()) {
@@ -203,16 +243,18 @@ void WritePly(const fs::path& path, const PlyData& ply, PlyEncoding encoding) {
       for (int k = 0; k < 3; ++k) EncodeBinary(&out, v[k], PlyScalar::kFloat32);
       if (!ply.colors.empty())
         for (int k = 0; k < 3; ++k) out.push_back(char(ply.colors[i][k]));
-      for (const PlyProperty& p : ply.properties)
-        EncodeBinary(&out, p.values[i], p.type);
+      for (const PlyProperty& p : ply.properties) EncodeBinary(&out, p.values[i], p.type);
     } else {
       text << float(v[0]) << ' ' << float(v[1]) << ' ' << float(v[2]);
       if (!ply.colors.empty())
         for (int k = 0; k < 3; ++k) text << ' ' << int(ply.colors[i][k]);
       for (const PlyProperty& p : ply.properties) {
-        if (p.type == PlyScalar::kFloat32) text << ' ' << float(p.values[i]);
-        else if (p.type == PlyScalar::kFloat64) text << ' ' << p.values[i];
-        else text << ' ' << std::llround(p.values[i]);
+        if (p.type == PlyScalar::kFloat32)
+          text << ' ' << float(p.values[i]);
+        else if (p.type == PlyScalar::kFloat64)
+          text << ' ' << p.values[i];
+        else
+          text << ' ' << std::llround(p.values[i]);
       }
       text << '\n';
     }
@@ -241,8 +283,17 @@ PlyData ReadPly(const fs::path& path) {
   if (!std::getline(f, line) || line.rfind("ply", 0) != 0)
     fail(line.empty() && f.eof() ? "empty file" : "not a PLY file");
 
-  struct Prop { std::string name; FileType type; bool is_list = false; FileType count_type; };
-  struct Element { std::string name; size_t count = 0; std::vector<Prop> props; };
+  struct Prop {
+    std::string name;
+    FileType type;
+    bool is_list = false;
+    FileType count_type;
+  };
+  struct Element {
+    std::string name;
+    size_t count = 0;
+    std::vector<Prop> props;
+  };
   std::vector<Element> elements;
   std::string format;
   PlyData ply;
@@ -302,8 +353,7 @@ PlyData ReadPly(const fs::path& path) {
       if (!(f >> token)) fail("truncated data");
       char* end = nullptr;
       double v = std::strtod(token.c_str(), &end);
-      if (end == token.c_str() || *end != '\0')
-        fail("malformed number '" + token + "'");
+      if (end == token.c_str() || *end != '\0') fail("malformed number '" + token + "'");
       return v;
     }
     unsigned char buf[8];
@@ -316,9 +366,18 @@ PlyData ReadPly(const fs::path& path) {
       int ix = -1, iy = -1, iz = -1, ir = -1, ig = -1, ib = -1;
       for (size_t k = 0; k < e.props.size(); ++k) {
         const std::string& nm = e.props[k].name;
-        if (nm == "x") ix = int(k); else if (nm == "y") iy = int(k);
-        else if (nm == "z") iz = int(k); else if (nm == "red") ir = int(k);
-        else if (nm == "green") ig = int(k); else if (nm == "blue") ib = int(k);
+        if (nm == "x")
+          ix = int(k);
+        else if (nm == "y")
+          iy = int(k);
+        else if (nm == "z")
+          iz = int(k);
+        else if (nm == "red")
+          ir = int(k);
+        else if (nm == "green")
+          ig = int(k);
+        else if (nm == "blue")
+          ib = int(k);
         else if (!e.props[k].is_list)
           ply.properties.push_back({nm, e.props[k].type.t, {}});
       }
@@ -337,21 +396,23 @@ PlyData ReadPly(const fs::path& path) {
             continue;
           }
           row[k] = read_value(e.props[k].type);
-          if (int(k) != ix && int(k) != iy && int(k) != iz && int(k) != ir &&
-              int(k) != ig && int(k) != ib)
+          if (int(k) != ix && int(k) != iy && int(k) != iz && int(k) != ir && int(k) != ig &&
+              int(k) != ib)
             ply.properties[extra++].values[i] = row[k];
         }
         ply.vertices[i] = {row[ix], row[iy], row[iz]};
         if (!ply.vertices[i].allFinite())
           fail("vertex " + std::to_string(i) + " has a non-finite coordinate");
-        if (has_color)
-          ply.colors[i] = {uint8_t(row[ir]), uint8_t(row[ig]), uint8_t(row[ib])};
+        if (has_color) ply.colors[i] = {uint8_t(row[ir]), uint8_t(row[ig]), uint8_t(row[ib])};
       }
     } else {
       const bool is_face = e.name == "face";
       for (size_t i = 0; i < e.count; ++i) {
         for (const Prop& p : e.props) {
-          if (!p.is_list) { read_value(p.type); continue; }
+          if (!p.is_list) {
+            read_value(p.type);
+            continue;
+          }
           double m = read_value(p.count_type);
           if (m < 0 || m > 1e6) fail("bad list length in element " + e.name);
           std::vector<int> idx(static_cast<size_t>(m));

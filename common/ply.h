@@ -3,14 +3,13 @@
 // scalar properties (s, t, track_length, ...); polygon faces of any size.
 #pragma once
 
+#include <Eigen/Core>
 #include <array>
 #include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
 
 namespace docunfold {
 

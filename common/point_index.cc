@@ -9,19 +9,16 @@ struct PointIndex2d::Tree {
   struct Cloud {
     const std::vector<Eigen::Vector2d>* points;
     size_t kdtree_get_point_count() const { return points->size(); }
-    double kdtree_get_pt(size_t i, size_t d) const {
-      return (*points)[i][int(d)];
-    }
+    double kdtree_get_pt(size_t i, size_t d) const { return (*points)[i][int(d)]; }
     template <class Box>
     bool kdtree_get_bbox(Box&) const {
       return false;
     }
   };
-  using Index = nanoflann::KDTreeSingleIndexAdaptor<
-      nanoflann::L2_Simple_Adaptor<double, Cloud>, Cloud, 2, uint32_t>;
+  using Index = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, Cloud>,
+                                                    Cloud, 2, uint32_t>;
   explicit Tree(const std::vector<Eigen::Vector2d>* points)
-      : cloud{points},
-        index(2, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(10)) {
+      : cloud{points}, index(2, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(10)) {
     index.buildIndex();
   }
   Cloud cloud;
@@ -33,8 +30,8 @@ PointIndex2d::PointIndex2d(std::vector<Eigen::Vector2d> points)
 
 PointIndex2d::~PointIndex2d() = default;
 
-std::vector<std::pair<int, double>> PointIndex2d::Nearest(
-    const Eigen::Vector2d& query, int k) const {
+std::vector<std::pair<int, double>> PointIndex2d::Nearest(const Eigen::Vector2d& query,
+                                                          int k) const {
   std::vector<std::pair<int, double>> out;
   const size_t n = std::min<size_t>(size_t(std::max(k, 0)), points_.size());
   if (n == 0) return out;

@@ -17,8 +17,7 @@ class PointIndex2d {
 
   // The `k` points nearest to `query` (fewer when there are fewer), nearest
   // first: (index, squared distance).
-  std::vector<std::pair<int, double>> Nearest(const Eigen::Vector2d& query,
-                                              int k) const;
+  std::vector<std::pair<int, double>> Nearest(const Eigen::Vector2d& query, int k) const;
   const std::vector<Eigen::Vector2d>& points() const { return points_; }
 
  private:

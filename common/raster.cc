@@ -7,8 +7,8 @@
 namespace docunfold {
 
 RasterResult Rasterize(const std::vector<Eigen::Vector3d>& v,
-                       const std::vector<Triangle>& triangles, int width,
-                       int height, double near_depth) {
+                       const std::vector<Triangle>& triangles, int width, int height,
+                       double near_depth) {
   RasterResult r;
   r.depth = cv::Mat1f(height, width, std::numeric_limits<float>::infinity());
   r.face = cv::Mat1i(height, width, -1);
@@ -17,11 +17,9 @@ RasterResult Rasterize(const std::vector<Eigen::Vector3d>& v,
     const Eigen::Vector3d& a = v[triangles[f][0]];
     const Eigen::Vector3d& b = v[triangles[f][1]];
     const Eigen::Vector3d& c = v[triangles[f][2]];
-    if (a.z() <= near_depth || b.z() <= near_depth || c.z() <= near_depth)
-      continue;
+    if (a.z() <= near_depth || b.z() <= near_depth || c.z() <= near_depth) continue;
     if (!a.allFinite() || !b.allFinite() || !c.allFinite()) continue;
-    const double area = (b.x() - a.x()) * (c.y() - a.y()) -
-                        (b.y() - a.y()) * (c.x() - a.x());
+    const double area = (b.x() - a.x()) * (c.y() - a.y()) - (b.y() - a.y()) * (c.x() - a.x());
     if (std::abs(area) < 1e-12) continue;
     const int x0 = std::max(0, int(std::ceil(std::min({a.x(), b.x(), c.x()}))));
     const int x1 = std::min(width - 1, int(std::floor(std::max({a.x(), b.x(), c.x()}))));
@@ -38,10 +36,10 @@ RasterResult Rasterize(const std::vector<Eigen::Vector3d>& v,
       cv::Vec2f* bary_row = r.bary.ptr<cv::Vec2f>(y);
       for (int x = x0; x <= x1; ++x) {
         // Screen-space barycentrics of the pixel centre.
-        const double l1 = ((x - a.x()) * (c.y() - a.y()) -
-                           (y - a.y()) * (c.x() - a.x())) * inv_area;
-        const double l2 = ((b.x() - a.x()) * (y - a.y()) -
-                           (b.y() - a.y()) * (x - a.x())) * inv_area;
+        const double l1 =
+            ((x - a.x()) * (c.y() - a.y()) - (y - a.y()) * (c.x() - a.x())) * inv_area;
+        const double l2 =
+            ((b.x() - a.x()) * (y - a.y()) - (b.y() - a.y()) * (x - a.x())) * inv_area;
         const double l0 = 1.0 - l1 - l2;
         if (l0 < e_eps || l1 < e_eps || l2 < e_eps) continue;
         const double inv_z = l0 * iza + l1 * izb + l2 * izc;
@@ -58,22 +56,19 @@ RasterResult Rasterize(const std::vector<Eigen::Vector3d>& v,
 
 RasterResult RasterizeMesh(const PinholeCamera& camera,
                            const std::vector<Eigen::Vector3d>& vertices,
-                           const std::vector<Triangle>& triangles,
-                           double scale) {
+                           const std::vector<Triangle>& triangles, double scale) {
   std::vector<Eigen::Vector3d> screen(vertices.size());
   for (size_t i = 0; i < vertices.size(); ++i) {
     const Eigen::Vector3d x_cam = camera.CamFromWorld(vertices[i]);
     const Eigen::Vector2d p = camera.ProjectCam(x_cam);
     // Pixel centres stay at integer coordinates under scaling.
-    screen[i] = {(p.x() + 0.5) * scale - 0.5, (p.y() + 0.5) * scale - 0.5,
-                 x_cam.z()};
+    screen[i] = {(p.x() + 0.5) * scale - 0.5, (p.y() + 0.5) * scale - 0.5, x_cam.z()};
   }
   return Rasterize(screen, triangles, int(std::lround(camera.width * scale)),
                    int(std::lround(camera.height * scale)));
 }
 
-cv::Mat InterpolateAttributes(const RasterResult& raster,
-                              const std::vector<Triangle>& triangles,
+cv::Mat InterpolateAttributes(const RasterResult& raster, const std::vector<Triangle>& triangles,
                               const Eigen::MatrixXf& attributes) {
   const int channels = int(attributes.cols());
   cv::Mat out(raster.face.size(), CV_32FC(channels));
@@ -89,9 +84,8 @@ cv::Mat InterpolateAttributes(const RasterResult& raster,
       const float b1 = bary_row[x][0], b2 = bary_row[x][1], b0 = 1 - b1 - b2;
       const Triangle& t = triangles[f];
       for (int c = 0; c < channels; ++c)
-        out_row[x * channels + c] = b0 * attributes(t[0], c) +
-                                    b1 * attributes(t[1], c) +
-                                    b2 * attributes(t[2], c);
+        out_row[x * channels + c] =
+            b0 * attributes(t[0], c) + b1 * attributes(t[1], c) + b2 * attributes(t[2], c);
     }
   }
   return out;

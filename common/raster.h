@@ -4,11 +4,10 @@
 // (texture coordinates for synth and render, face ids for markers, ...).
 #pragma once
 
-#include <array>
-#include <vector>
-
 #include <Eigen/Core>
+#include <array>
 #include <opencv2/core.hpp>
+#include <vector>
 
 #include "common/camera.h"
 
@@ -26,20 +25,18 @@ using Triangle = std::array<int, 3>;
 // pixel y, camera depth z). Pixel centres are at integer coordinates.
 // Triangles with a vertex at depth <= `near_depth` are skipped.
 RasterResult Rasterize(const std::vector<Eigen::Vector3d>& screen_vertices,
-                       const std::vector<Triangle>& triangles, int width,
-                       int height, double near_depth = 1e-6);
+                       const std::vector<Triangle>& triangles, int width, int height,
+                       double near_depth = 1e-6);
 
 // Projects world-space vertices through `camera` and rasterizes them at
 // the camera's image size scaled by `scale` (e.g. 2 for supersampling).
 RasterResult RasterizeMesh(const PinholeCamera& camera,
                            const std::vector<Eigen::Vector3d>& vertices,
-                           const std::vector<Triangle>& triangles,
-                           double scale = 1.0);
+                           const std::vector<Triangle>& triangles, double scale = 1.0);
 
 // Interpolates per-vertex attributes (one row per vertex, one column per
 // channel) over the raster; returns CV_32FC(channels), NaN where empty.
-cv::Mat InterpolateAttributes(const RasterResult& raster,
-                              const std::vector<Triangle>& triangles,
+cv::Mat InterpolateAttributes(const RasterResult& raster, const std::vector<Triangle>& triangles,
                               const Eigen::MatrixXf& attributes);
 
 // Splits polygons (quads from PLY files) into triangles by fanning.

@@ -12,8 +12,7 @@ namespace docunfold {
 namespace {
 
 cv::Mat Disc(int radius) {
-  return cv::getStructuringElement(cv::MORPH_ELLIPSE,
-                                   cv::Size(2 * radius + 1, 2 * radius + 1));
+  return cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * radius + 1, 2 * radius + 1));
 }
 
 // Mean of the three channels.
@@ -32,8 +31,7 @@ cv::Mat1f Envelope(const cv::Mat1f& grey, int radius) {
   cv::resize(grey, small, cv::Size(), shrink, shrink, cv::INTER_AREA);
   const int r = std::max(1, int(std::lround(radius * shrink)));
   cv::dilate(small, small,
-             cv::getStructuringElement(cv::MORPH_RECT,
-                                       cv::Size(2 * r + 1, 2 * r + 1)));
+             cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * r + 1, 2 * r + 1)));
   cv::GaussianBlur(small, small, cv::Size(), std::max(0.5, r / 2.0));
   cv::Mat1f envelope;
   cv::resize(small, envelope, grey.size(), 0, 0, cv::INTER_LINEAR);
@@ -63,15 +61,13 @@ ShadingRemoval RemoveShading(const cv::Mat& input, const ShadingOptions& o) {
   ShadingRemoval out;
   out.image = input.clone();
   if (input.empty()) return out;
-  CV_Assert(input.depth() == CV_8U &&
-            (input.channels() == 1 || input.channels() == 3));
+  CV_Assert(input.depth() == CV_8U && (input.channels() == 1 || input.channels() == 3));
   cv::Mat bgr = input;
   if (input.channels() == 1) cv::cvtColor(input, bgr, cv::COLOR_GRAY2BGR);
 
   // Working copy.
   const int long_side = std::max(bgr.cols, bgr.rows);
-  const double scale =
-      std::min(1.0, double(std::max(o.work_size, 16)) / long_side);
+  const double scale = std::min(1.0, double(std::max(o.work_size, 16)) / long_side);
   cv::Mat small_bytes;
   if (scale < 1)
     cv::resize(bgr, small_bytes, cv::Size(), scale, scale, cv::INTER_AREA);
@@ -80,8 +76,7 @@ ShadingRemoval RemoveShading(const cv::Mat& input, const ShadingOptions& o) {
   const int work_long = std::max(small_bytes.cols, small_bytes.rows);
 
   // Print lifted out: a closing wider than its strokes (on bytes: fast).
-  const int stroke =
-      std::max(2, int(std::lround(o.stroke_fraction * work_long)));
+  const int stroke = std::max(2, int(std::lround(o.stroke_fraction * work_long)));
   cv::Mat closed_bytes;
   cv::morphologyEx(small_bytes, closed_bytes, cv::MORPH_CLOSE, Disc(stroke));
   cv::Mat3f closed;
@@ -89,8 +84,8 @@ ShadingRemoval RemoveShading(const cv::Mat& input, const ShadingOptions& o) {
   const cv::Mat1f grey = Grey(closed);
 
   // Paper: bright for its neighbourhood and of the paper's chromaticity.
-  const cv::Mat1f envelope = Envelope(
-      grey, std::max(3, int(std::lround(o.envelope_fraction * work_long))));
+  const cv::Mat1f envelope =
+      Envelope(grey, std::max(3, int(std::lround(o.envelope_fraction * work_long))));
   cv::Mat3f chroma(closed.size());
   for (int y = 0; y < closed.rows; ++y)
     for (int x = 0; x < closed.cols; ++x) {
@@ -154,8 +149,7 @@ ShadingRemoval RemoveShading(const cv::Mat& input, const ShadingOptions& o) {
     for (int x = 0; x < light.cols; x += 2)
       if (paper(y, x) > 0)
         for (int c = 0; c < 3; ++c) paper_light[c].push_back(light(y, x)[c]);
-  for (int c = 0; c < 3; ++c)
-    out.paper_white[c] = Quantile(paper_light[c], o.white_quantile);
+  for (int c = 0; c < 3; ++c) out.paper_white[c] = Quantile(paper_light[c], o.white_quantile);
 
   cv::Mat3f full_light;
   cv::resize(light, full_light, bgr.size(), 0, 0, cv::INTER_LINEAR);
@@ -163,10 +157,8 @@ ShadingRemoval RemoveShading(const cv::Mat& input, const ShadingOptions& o) {
   cv::Mat3f image;
   bgr.convertTo(image, CV_32FC3);
   cv::divide(image, full_light, image);
-  cv::multiply(
-      image,
-      cv::Scalar(out.paper_white[0], out.paper_white[1], out.paper_white[2]),
-      image);
+  cv::multiply(image, cv::Scalar(out.paper_white[0], out.paper_white[1], out.paper_white[2]),
+               image);
   cv::Mat3b result;
   image.convertTo(result, CV_8UC3);
   if (input.channels() == 1)

@@ -40,7 +40,6 @@ struct ShadingRemoval {
 
 // `bgr`: 8-bit, 1 or 3 channels (a grey image is returned grey). An empty
 // image or one without any paper is returned unchanged (paper_fraction 0).
-ShadingRemoval RemoveShading(const cv::Mat& bgr,
-                             const ShadingOptions& options = {});
+ShadingRemoval RemoveShading(const cv::Mat& bgr, const ShadingOptions& options = {});
 
 }  // namespace docunfold

@@ -5,8 +5,7 @@
 
 namespace docunfold::isometry::internal {
 
-GridBlockMatrix::GridBlockMatrix(const QuadGrid& grid)
-    : grid_(grid), n_(grid.NumVertices()) {
+GridBlockMatrix::GridBlockMatrix(const QuadGrid& grid) : grid_(grid), n_(grid.NumVertices()) {
   neighbour_.assign(size_t(n_) * kSlots, -1);
   for (int r = 0; r < grid.ny; ++r)
     for (int c = 0; c < grid.nx; ++c)
@@ -56,8 +55,7 @@ void GridBlockMatrix::AddOuter(int vi, const Vec5d& a, int vj, const Vec5d& b) {
     Block(vj, Slot(vj, vi)).noalias() += b * a.transpose();
 }
 
-void GridBlockMatrix::Multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y,
-                               int threads) const {
+void GridBlockMatrix::Multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y, int threads) const {
   y.resize(5 * n_);
   // Row by row (upper blocks of row i, transposed upper blocks of the rows
   // above that reach i): no two threads write the same entry.
@@ -98,8 +96,8 @@ void GridBlockMatrix::ToSparseUpper(Eigen::SparseMatrix<double>& out,
     return count;
   };
   std::array<std::pair<int, int>, kSlots> list;
-  const bool have_pattern = out.rows() == dofs && out.cols() == dofs && out.isCompressed() &&
-                            out.nonZeros() > 0;
+  const bool have_pattern =
+      out.rows() == dofs && out.cols() == dofs && out.isCompressed() && out.nonZeros() > 0;
   if (!have_pattern) {
     std::vector<int> outer(dofs + 1, 0);
     std::vector<int> inner;

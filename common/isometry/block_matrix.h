@@ -5,11 +5,10 @@
 // (fairness). Only the upper half (j >= i) is stored: 7 blocks per vertex.
 #pragma once
 
-#include <array>
-#include <vector>
-
 #include <Eigen/Core>
 #include <Eigen/Sparse>
+#include <array>
+#include <vector>
 
 #include "common/grid_mesh.h"
 

@@ -42,13 +42,12 @@
 // the caller's units.
 #pragma once
 
+#include <Eigen/Core>
 #include <cmath>
 #include <functional>
 #include <limits>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "common/grid_mesh.h"
 #include "common/json_io.h"
@@ -87,8 +86,8 @@ struct FeatureLine {
 // belongs to. p = Σ ω_i v_i on M, p' = Σ ω_i v'_i on M'.
 struct Marker {
   SurfacePoint where;
-  Eigen::Vector3d ray_origin = Eigen::Vector3d::Zero();     // world frame
-  Eigen::Vector3d ray_direction = Eigen::Vector3d::UnitZ(); // unit, world frame
+  Eigen::Vector3d ray_origin = Eigen::Vector3d::Zero();      // world frame
+  Eigen::Vector3d ray_direction = Eigen::Vector3d::UnitZ();  // unit, world frame
   int line = -1;  // index into Problem::lines; -1: only E_ray applies
   // Non-zero (unit, orthogonal to the ray): E_ray keeps only the component
   // of p - ray_origin along it, so the point is held to the plane through
@@ -168,10 +167,10 @@ struct SolveOptions {
   // factorisation costs ~0.3 s, a 81x121 one ~5 s with the reference BLAS).
   LinearSolver linear_solver = LinearSolver::kAuto;
   int direct_max_vertices = 1000;
-  int cg_max_iterations = 40;      // per Gauss-Newton step
-  double cg_tolerance = 3e-2;      // relative residual of the normal equations
-  double initial_damping = 1e-4;   // Levenberg-Marquardt μ (× diag(JᵀJ))
-  int lbfgs_iterations = 30;       // L-BFGS iterations per outer iteration
+  int cg_max_iterations = 40;     // per Gauss-Newton step
+  double cg_tolerance = 3e-2;     // relative residual of the normal equations
+  double initial_damping = 1e-4;  // Levenberg-Marquardt μ (× diag(JᵀJ))
+  int lbfgs_iterations = 30;      // L-BFGS iterations per outer iteration
   int lbfgs_memory = 10;
 
   // Outer loop: footpoints/outliers/lines are recomputed, then one step; it
@@ -224,20 +223,20 @@ struct SolveOptions {
 struct TermValues {
   double iso = 0, dist = 0, fair3d = 0, fair2d = 0, line = 0, ray = 0;
   double Weighted(const Weights& w) const {
-    return w.iso * iso + w.dist * dist + w.fair3d * fair3d + w.fair2d * fair2d +
-           w.line * line + w.ray * ray;
+    return w.iso * iso + w.dist * dist + w.fair3d * fair3d + w.fair2d * fair2d + w.line * line +
+           w.ray * ray;
   }
 };
 
 struct IterationReport {
   int iteration = 0;
-  double F = 0;         // Σ λ_k E_k after footpoints/outliers/lines were updated
+  double F = 0;  // Σ λ_k E_k after footpoints/outliers/lines were updated
   // F after this iteration's step with the same footpoints, outliers,
   // markers and lines (what the step minimises): never above F. The next
   // iteration's F differs from it by re-deciding those (NaN: no step taken).
   double F_after_step = std::numeric_limits<double>::quiet_NaN();
   TermValues terms;
-  int inliers = 0;      // points within φ of M
+  int inliers = 0;  // points within φ of M
   int outliers = 0;
   int markers = 0;
   int lines = 0;
@@ -249,7 +248,7 @@ struct IterationReport {
   int linear_iterations = 0;     // factorisations, CG iterations or L-BFGS iterations
   double damping = 0;            // Levenberg-Marquardt μ after the step
   bool step_accepted = false;
-  int threads = 1;               // OpenMP threads used (fewer than asked when other work is running)
+  int threads = 1;  // OpenMP threads used (fewer than asked when other work is running)
 };
 
 struct SolveReport {
@@ -266,8 +265,8 @@ struct SolveReport {
 struct Result {
   MeshPair meshes;
   std::vector<FeatureLine> lines;
-  std::vector<Marker> markers;       // moved when project_markers is set
-  std::vector<bool> point_inlier;    // final decision per Problem::points
+  std::vector<Marker> markers;         // moved when project_markers is set
+  std::vector<bool> point_inlier;      // final decision per Problem::points
   std::vector<double> point_distance;  // distance to the final M (caller's units; +inf when far)
   SolveReport report;
 };

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-
 #include <nanoflann.hpp>
 
 namespace docunfold::isometry {
@@ -15,12 +14,15 @@ struct CloudAdaptor {
   size_t kdtree_get_point_count() const { return points->size(); }
   double kdtree_get_pt(size_t i, size_t dim) const { return (*points)[i][int(dim)]; }
   template <class BBox>
-  bool kdtree_get_bbox(BBox&) const { return false; }
+  bool kdtree_get_bbox(BBox&) const {
+    return false;
+  }
 };
 
 template <int D>
-using KdTree = nanoflann::KDTreeSingleIndexAdaptor<
-    nanoflann::L2_Simple_Adaptor<double, CloudAdaptor<D>>, CloudAdaptor<D>, D, uint32_t>;
+using KdTree =
+    nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, CloudAdaptor<D>>,
+                                        CloudAdaptor<D>, D, uint32_t>;
 using Matches = std::vector<std::pair<uint32_t, double>>;
 
 }  // namespace
@@ -90,8 +92,7 @@ TriangleMeshIndex::TriangleMeshIndex(const std::vector<Eigen::Vector3d>& vertice
   for (const Triangle& t : triangles_) {
     const Eigen::Vector3d g = (vertices_[t[0]] + vertices_[t[1]] + vertices_[t[2]]) / 3;
     centroids_.push_back(g);
-    for (int k = 0; k < 3; ++k)
-      max_radius_ = std::max(max_radius_, (vertices_[t[k]] - g).norm());
+    for (int k = 0; k < 3; ++k) max_radius_ = std::max(max_radius_, (vertices_[t[k]] - g).norm());
   }
   tree_ = std::make_unique<Tree>(&centroids_);
 }
@@ -103,8 +104,8 @@ std::optional<ClosestPoint> TriangleMeshIndex::Closest(const Eigen::Vector3d& p,
   if (triangles_.empty()) return std::nullopt;
   auto exact = [&](size_t t) {
     const Triangle& tri = triangles_[t];
-    ClosestPoint c = ClosestPointOnTriangle(p, vertices_[tri[0]], vertices_[tri[1]],
-                                            vertices_[tri[2]]);
+    ClosestPoint c =
+        ClosestPointOnTriangle(p, vertices_[tri[0]], vertices_[tri[1]], vertices_[tri[2]]);
     c.triangle = int(t);
     return c;
   };
@@ -143,8 +144,7 @@ FlatMeshLocator::FlatMeshLocator(const MeshPair& meshes)
   for (const Triangle& t : triangles_) {
     const Eigen::Vector2d g = (vertices_[t[0]] + vertices_[t[1]] + vertices_[t[2]]) / 3;
     centroids_.push_back(g);
-    for (int k = 0; k < 3; ++k)
-      max_radius_ = std::max(max_radius_, (vertices_[t[k]] - g).norm());
+    for (int k = 0; k < 3; ++k) max_radius_ = std::max(max_radius_, (vertices_[t[k]] - g).norm());
   }
   tree_ = std::make_unique<Tree>(&centroids_);
 }

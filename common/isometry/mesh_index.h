@@ -4,12 +4,11 @@
 // triangle centroids (nanoflann) narrows the search; results are exact.
 #pragma once
 
+#include <Eigen/Core>
 #include <limits>
 #include <memory>
 #include <optional>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "common/grid_mesh.h"
 #include "common/raster.h"

@@ -5,10 +5,9 @@
 // of M') and on at most one line (θ, offset).
 #pragma once
 
+#include <Eigen/Core>
 #include <array>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "common/grid_mesh.h"
 #include "common/isometry/isometry.h"
@@ -221,8 +220,7 @@ inline int FairRows(const State& s, const StepData& data, int t, bool flat, Row*
     return 2;
   }
   const int first = flat ? 3 : 0, n = flat ? 2 : 3;
-  const double scale =
-      flat || data.fair3d_scale.empty() ? 1.0 : std::sqrt(data.fair3d_scale[v[1]]);
+  const double scale = flat || data.fair3d_scale.empty() ? 1.0 : std::sqrt(data.fair3d_scale[v[1]]);
   for (int k = 0; k < n; ++k) {
     const int dim = first + k;
     Row& r = rows[k];
@@ -319,12 +317,18 @@ void ForEachRow(const State& s, const StepData& data, Sink&& sink) {
 
 inline double WeightOf(const Weights& w, int term) {
   switch (term) {
-    case kIso: return w.iso;
-    case kDist: return w.dist;
-    case kFair3d: return w.fair3d;
-    case kFair2d: return w.fair2d;
-    case kLine: return w.line;
-    default: return w.ray;
+    case kIso:
+      return w.iso;
+    case kDist:
+      return w.dist;
+    case kFair3d:
+      return w.fair3d;
+    case kFair2d:
+      return w.fair2d;
+    case kLine:
+      return w.line;
+    default:
+      return w.ray;
   }
 }
 

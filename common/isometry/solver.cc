@@ -15,10 +15,11 @@
 #include <omp.h>
 #endif
 
+#include <LBFGS.h>
+
 #include <Eigen/CholmodSupport>
 #include <Eigen/Eigenvalues>
 #include <Eigen/Sparse>
-#include <LBFGS.h>
 
 #include "common/cpu_share.h"
 #include "common/isometry/block_matrix.h"
@@ -63,13 +64,11 @@ template <int K, class Add>
 std::array<double, K> OrderedSums(int n, int threads, Add&& add) {
   const int chunks = (n + kSumChunk - 1) / kSumChunk;
   std::vector<std::array<double, K>> part(static_cast<size_t>(chunks));
-#pragma omp parallel for num_threads(threads) \
-    schedule(static) if (threads > 1 && chunks > 1)
+#pragma omp parallel for num_threads(threads) schedule(static) if (threads > 1 && chunks > 1)
   for (int c = 0; c < chunks; ++c) {
     std::array<double, K> acc{};
     Row rows[kMaxRowsPerItem];
-    for (int i = c * kSumChunk; i < std::min(n, (c + 1) * kSumChunk); ++i)
-      add(i, rows, acc);
+    for (int i = c * kSumChunk; i < std::min(n, (c + 1) * kSumChunk); ++i) add(i, rows, acc);
     part[size_t(c)] = acc;
   }
   std::array<double, K> total{};
@@ -84,26 +83,21 @@ TermValues EvaluateTerms(const State& s, const StepData& data, int threads) {
   const int quads = s.grid.NumQuads(), points = int(data.points.size());
   const int triplets = NumFairTriplets(s.grid), markers = int(data.markers.size());
   threads = quads > 2000 ? threads : 1;
-  const double iso =
-      OrderedSums<1>(quads, threads, [&](int q, Row* rows, auto& acc) {
-        AddSquares(rows, IsoRows(s, data, q, rows), &acc[0]);
-      })[0];
-  const double dist =
-      OrderedSums<1>(points, threads, [&](int p, Row* rows, auto& acc) {
-        AddSquares(rows, DistRows(s, data, p, rows), &acc[0]);
-      })[0];
-  const auto fair =
-      OrderedSums<2>(triplets, threads, [&](int t, Row* rows, auto& acc) {
-        AddSquares(rows, FairRows(s, data, t, false, rows), &acc[0]);
-        AddSquares(rows, FairRows(s, data, t, true, rows), &acc[1]);
-      });
-  const auto feature =
-      OrderedSums<2>(markers, threads, [&](int m, Row* rows, auto& acc) {
-        AddSquares(rows, LineRows(s, data, m, rows), &acc[0]);
-        AddSquares(rows, RayRows(s, data, m, rows), &acc[1]);
-      });
-  const double fair3d = fair[0], fair2d = fair[1], line = feature[0],
-               ray = feature[1];
+  const double iso = OrderedSums<1>(quads, threads, [&](int q, Row* rows, auto& acc) {
+    AddSquares(rows, IsoRows(s, data, q, rows), &acc[0]);
+  })[0];
+  const double dist = OrderedSums<1>(points, threads, [&](int p, Row* rows, auto& acc) {
+    AddSquares(rows, DistRows(s, data, p, rows), &acc[0]);
+  })[0];
+  const auto fair = OrderedSums<2>(triplets, threads, [&](int t, Row* rows, auto& acc) {
+    AddSquares(rows, FairRows(s, data, t, false, rows), &acc[0]);
+    AddSquares(rows, FairRows(s, data, t, true, rows), &acc[1]);
+  });
+  const auto feature = OrderedSums<2>(markers, threads, [&](int m, Row* rows, auto& acc) {
+    AddSquares(rows, LineRows(s, data, m, rows), &acc[0]);
+    AddSquares(rows, RayRows(s, data, m, rows), &acc[1]);
+  });
+  const double fair3d = fair[0], fair2d = fair[1], line = feature[0], ray = feature[1];
   TermValues t;
   t.iso = iso;
   t.dist = dist;
@@ -119,7 +113,9 @@ TermValues EvaluateTerms(const State& s, const StepData& data, int threads) {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double Since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+double Since(Clock::time_point t) {
+  return std::chrono::duration<double>(Clock::now() - t).count();
+}
 
 // The normalised frame: lengths divided by the bounding-box diagonal of M,
 // M and M' centred on their vertex centroids.
@@ -166,8 +162,8 @@ void Validate(const Problem& p) {
       throw std::invalid_argument("isometry: marker on triangle " +
                                   std::to_string(m.where.triangle) + " outside the grid");
     if (m.line >= int(p.lines.size()))
-      throw std::invalid_argument("isometry: marker on line " + std::to_string(m.line) +
-                                  " of " + std::to_string(p.lines.size()));
+      throw std::invalid_argument("isometry: marker on line " + std::to_string(m.line) + " of " +
+                                  std::to_string(p.lines.size()));
     if (!m.ray_origin.allFinite() || !(m.ray_direction.norm() > 0) || !m.where.bary.allFinite() ||
         !m.across.allFinite())
       throw std::invalid_argument("isometry: marker with a bad ray or barycentrics");
@@ -382,8 +378,7 @@ void FitLines(State& s, const StepData& data) {
 // both sides overlap it along its length, with gaps within max_ratio of each
 // other and of the page's row pitch, moves `strength` of the way to their
 // middle (all from the offsets as fitted). Returns how many rows moved.
-int EvenTextRowSpacing(State& s, const StepData& data, double strength,
-                       double max_ratio) {
+int EvenTextRowSpacing(State& s, const StepData& data, double strength, double max_ratio) {
   const int n = int(s.lines.size());
   constexpr double kInf = std::numeric_limits<double>::infinity();
   std::vector<double> lo(n, kInf), hi(n, -kInf);
@@ -393,9 +388,7 @@ int EvenTextRowSpacing(State& s, const StepData& data, double strength,
     const Eigen::Vector2d nrm = s.lines[l].Normal();
     return std::abs(nrm.y()) > std::abs(nrm.x());
   };
-  auto along = [&](int l, const Eigen::Vector2d& p) {
-    return horizontal(l) ? p.x() : p.y();
-  };
+  auto along = [&](int l, const Eigen::Vector2d& p) { return horizontal(l) ? p.x() : p.y(); };
   // The sign that turns the normal into +x or +y.
   auto sign = [&](int l) {
     const Eigen::Vector2d nrm = s.lines[l].Normal();
@@ -416,8 +409,7 @@ int EvenTextRowSpacing(State& s, const StepData& data, double strength,
   };
   std::vector<int> rows;
   for (int l = 0; l < n; ++l)
-    if (s.lines[l].text_row && s.lines[l].axis_aligned && count[l] >= 2 &&
-        hi[l] > lo[l])
+    if (s.lines[l].text_row && s.lines[l].axis_aligned && count[l] >= 2 && hi[l] > lo[l])
       rows.push_back(l);
   // Nearest parallel, overlapping rows on either side of each row.
   std::vector<int> below(n, -1), above(n, -1);
@@ -426,8 +418,7 @@ int EvenTextRowSpacing(State& s, const StepData& data, double strength,
     const double cb = axis_offset(b);
     double ca = -kInf, cc = kInf;
     for (const int x : rows) {
-      if (x == b || horizontal(x) != horizontal(b) || !overlapping(x, b))
-        continue;
+      if (x == b || horizontal(x) != horizontal(b) || !overlapping(x, b)) continue;
       const double cx = axis_offset(x);
       if (cx < cb && cx > ca) ca = cx, below[b] = x;
       if (cx > cb && cx < cc) cc = cx, above[b] = x;
@@ -442,11 +433,9 @@ int EvenTextRowSpacing(State& s, const StepData& data, double strength,
   std::vector<double> target(n, kInf);
   for (const int b : rows) {
     if (below[b] < 0 || above[b] < 0) continue;
-    const double ca = axis_offset(below[b]), cb = axis_offset(b),
-                 cc = axis_offset(above[b]);
+    const double ca = axis_offset(below[b]), cb = axis_offset(b), cc = axis_offset(above[b]);
     const double g1 = cb - ca, g2 = cc - cb;
-    if (std::max(g1, g2) > max_ratio * std::min(g1, g2) ||
-        std::max(g1, g2) > max_ratio * pitch)
+    if (std::max(g1, g2) > max_ratio * std::min(g1, g2) || std::max(g1, g2) > max_ratio * pitch)
       continue;
     target[b] = cb + strength * (0.5 * (ca + cc) - cb);
   }
@@ -639,8 +628,8 @@ class GaussNewton {
                    int* iterations) {
     H_.ToSparseUpper(sparse_, shift);
     if (!cholmod_) {
-      cholmod_ = std::make_unique<Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>,
-                                                               Eigen::Upper>>();
+      cholmod_ = std::make_unique<
+          Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Upper>>();
       cholmod_->analyzePattern(sparse_);
     }
     cholmod_->factorize(sparse_);
@@ -931,8 +920,7 @@ Result Solve(const Problem& problem, const SolveOptions& o) {
         if (l.axis_aligned) l.theta = NearestAxisTheta(l.theta);
       if (o.refit_lines) FitLines(w.state, w.data);
       if (o.line_spacing > 0)
-        ir.spaced_rows = EvenTextRowSpacing(w.state, w.data, o.line_spacing,
-                                            o.max_spacing_ratio);
+        ir.spaced_rows = EvenTextRowSpacing(w.state, w.data, o.line_spacing, o.max_spacing_ratio);
       if (o.project_markers) ProjectMarkers(w.state, w.data);
     }
     ir.terms = internal::EvaluateTerms(w.state, w.data, threads);
@@ -945,9 +933,11 @@ Result Solve(const Problem& problem, const SolveOptions& o) {
 
     // A step Levenberg-Marquardt damped hard lowers F little without F being
     // near a minimum: that is no convergence (optionally).
-    const bool damped = gn && o.converged_max_damping > 0 && gn->damping() > o.converged_max_damping;
-    const bool small_change = it > 0 && !damped &&
-                              std::abs(ir.F - f_previous) <= o.relative_tolerance * std::abs(f_previous);
+    const bool damped =
+        gn && o.converged_max_damping > 0 && gn->damping() > o.converged_max_damping;
+    const bool small_change =
+        it > 0 && !damped &&
+        std::abs(ir.F - f_previous) <= o.relative_tolerance * std::abs(f_previous);
     small_changes += small_change;
     const bool converged = small_change && small_changes >= std::max(1, o.converged_iterations);
     // F measured after re-deciding footpoints and markers can oscillate

@@ -1,17 +1,15 @@
 #include "common/isometry/unfold.h"
 
-#include <cmath>
-#include <stdexcept>
-
 #include <Eigen/SVD>
 #include <Eigen/Sparse>
 #include <Eigen/SparseCholesky>
+#include <cmath>
+#include <stdexcept>
 
 namespace docunfold::isometry {
 
 UnfoldResult UnfoldArap(const QuadGrid& grid, const std::vector<Eigen::Vector3d>& x3,
-                        const std::vector<Eigen::Vector2d>& initial,
-                        const UnfoldOptions& options) {
+                        const std::vector<Eigen::Vector2d>& initial, const UnfoldOptions& options) {
   const int n = grid.NumVertices();
   if (int(x3.size()) != n || int(initial.size()) != n || n < 4)
     throw std::invalid_argument("UnfoldArap: sizes do not match the grid");

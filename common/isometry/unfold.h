@@ -6,9 +6,8 @@
 // so M' is never a mirror image of it.
 #pragma once
 
-#include <vector>
-
 #include <Eigen/Core>
+#include <vector>
 
 #include "common/grid_mesh.h"
 

@@ -1,19 +1,18 @@
 #include "stages/baseline/baseline.h"
 
+#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <vector>
-
-#include <Eigen/Dense>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <vector>
 
 #include "common/atomic_file.h"
 #include "common/errors.h"
-#include "common/shading.h"
 #include "common/json_io.h"
 #include "common/raster.h"
+#include "common/shading.h"
 
 namespace docunfold::baseline {
 namespace {
@@ -60,14 +59,12 @@ void FillHoles(cv::Mat2f& map) {
 // `size` * `scale`: rasterize the true mesh in (s, t) space, interpolate the
 // 3D point, project it with the true camera. NaN where the mesh is absent.
 cv::Mat2f TrueMap(const PinholeCamera& camera, const PlyData& mesh,
-                  const std::vector<Triangle>& triangles, cv::Size size,
-                  int scale) {
+                  const std::vector<Triangle>& triangles, cv::Size size, int scale) {
   const auto& s = mesh.FindProperty("s")->values;
   const auto& t = mesh.FindProperty("t")->values;
   const int w = size.width * scale, h = size.height * scale;
   std::vector<Eigen::Vector3d> screen(mesh.vertices.size());
-  for (size_t i = 0; i < screen.size(); ++i)
-    screen[i] = {s[i] * w - 0.5, t[i] * h - 0.5, 1.0};
+  for (size_t i = 0; i < screen.size(); ++i) screen[i] = {s[i] * w - 0.5, t[i] * h - 0.5, 1.0};
   const RasterResult raster = Rasterize(screen, triangles, w, h);
   cv::Mat2f map(h, w, cv::Vec2f(NAN, NAN));
   for (int y = 0; y < h; ++y) {
@@ -76,8 +73,8 @@ cv::Mat2f TrueMap(const PinholeCamera& camera, const PlyData& mesh,
       if (f < 0) continue;
       const double b1 = raster.bary(y, x)[0], b2 = raster.bary(y, x)[1];
       const Triangle& tri = triangles[f];
-      const Eigen::Vector3d p = (1 - b1 - b2) * mesh.vertices[tri[0]] +
-                                b1 * mesh.vertices[tri[1]] + b2 * mesh.vertices[tri[2]];
+      const Eigen::Vector3d p = (1 - b1 - b2) * mesh.vertices[tri[0]] + b1 * mesh.vertices[tri[1]] +
+                                b2 * mesh.vertices[tri[2]];
       const Eigen::Vector3d xc = camera.CamFromWorld(p);
       if (xc.z() <= 0) continue;
       const Eigen::Vector2d px = camera.ProjectCam(xc);
@@ -104,8 +101,7 @@ double MapFootprint(const cv::Mat2f& map) {
 
 fs::path MustExist(const fs::path& p, const std::string& why) {
   std::error_code ec;
-  if (!fs::is_regular_file(p, ec))
-    throw InputError(p.string() + ": no such file (" + why + ")");
+  if (!fs::is_regular_file(p, ec)) throw InputError(p.string() + ": no such file (" + why + ")");
   return p;
 }
 
@@ -141,9 +137,7 @@ double PageAspect(const fs::path& page_json) {
   return w / h;
 }
 
-cv::Size FlatSize(const fs::path& flat) {
-  return ReadImage(flat, cv::IMREAD_UNCHANGED).size();
-}
+cv::Size FlatSize(const fs::path& flat) { return ReadImage(flat, cv::IMREAD_UNCHANGED).size(); }
 
 }  // namespace
 
@@ -170,8 +164,10 @@ cv::Mat WarpByCorners(const cv::Mat& image, const Corners& corners, cv::Size siz
                std::max(SideLength(corners, 0, 3), SideLength(corners, 1, 2)) / size.height);
   const int k = Supersampling(footprint);
   const double w = size.width * k, hgt = size.height * k;
-  const cv::Point2f dst[4] = {{-0.5f, -0.5f}, {float(w - 0.5), -0.5f},
-                              {float(w - 0.5), float(hgt - 0.5)}, {-0.5f, float(hgt - 0.5)}};
+  const cv::Point2f dst[4] = {{-0.5f, -0.5f},
+                              {float(w - 0.5), -0.5f},
+                              {float(w - 0.5), float(hgt - 0.5)},
+                              {-0.5f, float(hgt - 0.5)}};
   cv::Point2f src[4];
   for (int i = 0; i < 4; ++i) src[i] = {float(corners[i].x()), float(corners[i].y())};
   const cv::Mat H = cv::getPerspectiveTransform(dst, src);  // output -> image
@@ -184,8 +180,8 @@ cv::Mat WarpByCorners(const cv::Mat& image, const Corners& corners, cv::Size siz
   return out;
 }
 
-cv::Mat TextureFromTruth(const cv::Mat& photo, const PinholeCamera& camera,
-                         const PlyData& mesh, cv::Size size) {
+cv::Mat TextureFromTruth(const cv::Mat& photo, const PinholeCamera& camera, const PlyData& mesh,
+                         cv::Size size) {
   if (!mesh.FindProperty("s") || !mesh.FindProperty("t"))
     throw InputError("true mesh has no per-vertex s, t");
   const std::vector<Triangle> triangles = Triangulate(mesh.faces);
@@ -220,8 +216,8 @@ cv::Rect SeenPageRect(const std::vector<PinholeCamera>& cameras, const PlyData& 
       covered(y, x) = 255;
       const double b1 = raster.bary(y, x)[0], b2 = raster.bary(y, x)[1];
       const Triangle& tri = triangles[f];
-      const Eigen::Vector3d p = (1 - b1 - b2) * mesh.vertices[tri[0]] +
-                                b1 * mesh.vertices[tri[1]] + b2 * mesh.vertices[tri[2]];
+      const Eigen::Vector3d p = (1 - b1 - b2) * mesh.vertices[tri[0]] + b1 * mesh.vertices[tri[1]] +
+                                b2 * mesh.vertices[tri[2]];
       for (const PinholeCamera& camera : cameras) {
         const Eigen::Vector3d xc = camera.CamFromWorld(p);
         if (xc.z() <= 0) continue;
@@ -245,8 +241,7 @@ cv::Rect SeenPageRect(const std::vector<PinholeCamera>& cameras, const PlyData& 
 }
 
 BaselineResult Run(const BaselineInputs& in, const BaselineOptions& options) {
-  const fs::path sfm_cameras =
-      MustExist(in.work / "10_sfm" / "cameras.json", "run sfm first");
+  const fs::path sfm_cameras = MustExist(in.work / "10_sfm" / "cameras.json", "run sfm first");
   const CameraSet cameras = ReadCameras(sfm_cameras);
   if (cameras.reference.empty())
     throw InputError(sfm_cameras.string() + ":/reference: no reference view named");
@@ -285,8 +280,8 @@ BaselineResult Run(const BaselineInputs& in, const BaselineOptions& options) {
     } else if (has_flat) {
       size = FlatSize(gt / "flat.png");
     } else {
-      const int width = int(std::lround(
-          0.5 * (SideLength(corners, 0, 1) + SideLength(corners, 3, 2))));
+      const int width =
+          int(std::lround(0.5 * (SideLength(corners, 0, 1) + SideLength(corners, 3, 2))));
       size = cv::Size(width, int(std::lround(width / aspect)));
     }
     size = cv::Size(std::max(1, size.width), std::max(1, size.height));
@@ -302,8 +297,8 @@ BaselineResult Run(const BaselineInputs& in, const BaselineOptions& options) {
     const CameraSet truth = ReadCameras(MustExist(gt / "cameras.json", "oracle"));
     const PinholeCamera* camera = truth.Find(cameras.reference);
     if (!camera)
-      throw InputError((gt / "cameras.json").string() + ": no view named " +
-                       cameras.reference + " (the reference of " + sfm_cameras.string() + ")");
+      throw InputError((gt / "cameras.json").string() + ": no view named " + cameras.reference +
+                       " (the reference of " + sfm_cameras.string() + ")");
     const fs::path photo_path = MustExist(in.data / "images" / cameras.reference, "oracle");
     const cv::Mat photo = ReadImage(photo_path, cv::IMREAD_COLOR | cv::IMREAD_IGNORE_ORIENTATION);
     if (photo.cols != camera->width || photo.rows != camera->height)
@@ -314,9 +309,9 @@ BaselineResult Run(const BaselineInputs& in, const BaselineOptions& options) {
       throw InputError((gt / "mesh.ply").string() + ": no per-vertex s, t");
     cv::Size size = FlatSize(gt / "flat.png");
     if (options.width > 0)
-      size = cv::Size(options.width,
-                      std::max(1, int(std::lround(double(options.width) * size.height /
-                                                   size.width))));
+      size =
+          cv::Size(options.width,
+                   std::max(1, int(std::lround(double(options.width) * size.height / size.width))));
     out.image = TextureFromTruth(photo, *camera, mesh, size);
     std::snprintf(buf, sizeof buf, "oracle: %s through the true surface and camera, %dx%d",
                   cameras.reference.c_str(), size.width, size.height);
@@ -328,8 +323,7 @@ BaselineResult Run(const BaselineInputs& in, const BaselineOptions& options) {
       const size_t n = std::strlen(buf);
       std::snprintf(buf + n, sizeof buf - n,
                     ", cropped to the part the photos see: x %d..%d, y %d..%d of %dx%d", seen.x,
-                    seen.x + seen.width, seen.y, seen.y + seen.height, size.width,
-                    size.height);
+                    seen.x + seen.width, seen.y, seen.y + seen.height, size.width, size.height);
     }
   }
   out.summary = buf;

@@ -8,14 +8,13 @@
 //    ceiling for a method that cannot know how far a cut-off page goes.
 #pragma once
 
+#include <Eigen/Core>
 #include <array>
 #include <filesystem>
+#include <opencv2/core.hpp>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
-#include <opencv2/core.hpp>
 
 #include "common/camera.h"
 #include "common/ply.h"
@@ -43,8 +42,8 @@ cv::Mat WarpByCorners(const cv::Mat& image, const Corners& corners, cv::Size siz
 // surface: `mesh` has per-vertex s, t (column/row fractions of flat.png) and
 // vertices in the world frame of `camera`. Bicubic, area-averaged when the
 // photo is minified. Throws InputError when the mesh lacks s, t.
-cv::Mat TextureFromTruth(const cv::Mat& photo, const PinholeCamera& camera,
-                         const PlyData& mesh, cv::Size size);
+cv::Mat TextureFromTruth(const cv::Mat& photo, const PinholeCamera& camera, const PlyData& mesh,
+                         cv::Size size);
 
 // Pixel rectangle of the flat page rendered at `size` that holds every point
 // of the true surface inside the frame of at least one of `cameras` (and in

@@ -23,8 +23,7 @@ int main(int argc, char** argv) {
       ->required()
       ->check(CLI::IsMember({"homography", "oracle"}));
   app.add_option("--data", in.data, "data set folder")->required();
-  app.add_option("--work", in.work, "work directory with 10_sfm/ (and 20_boundary/)")
-      ->required();
+  app.add_option("--work", in.work, "work directory with 10_sfm/ (and 20_boundary/)")->required();
   app.add_option("--out", out, "image to write (.png)")->required();
   app.add_option("--width", options.width,
                  "output width in pixels, height from the page aspect (default 0: "
@@ -50,8 +49,7 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"keep", "remove"}));
 
   return RunStage("baseline", app, argc, argv, [&] {
-    options.method = method == "oracle" ? baseline::Method::kOracle
-                                        : baseline::Method::kHomography;
+    options.method = method == "oracle" ? baseline::Method::kOracle : baseline::Method::kHomography;
     options.remove_shading = shading == "remove";
     if (options.crop_to_seen && options.method != baseline::Method::kOracle)
       throw UsageError("--crop-to-seen applies to --method oracle only");

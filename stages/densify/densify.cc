@@ -1,13 +1,12 @@
 #include "stages/densify/densify.h"
 
+#include <Eigen/SVD>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <functional>
 #include <limits>
 #include <memory>
-
-#include <Eigen/SVD>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -63,8 +62,8 @@ View MakeView(int index, const PinholeCamera& camera, const cv::Mat& grey_photo,
   } else {
     resized = grey_photo;
   }
-  const bool distorted = std::any_of(distortion.begin(), distortion.end(),
-                                     [](double d) { return d != 0; });
+  const bool distorted =
+      std::any_of(distortion.begin(), distortion.end(), [](double d) { return d != 0; });
   if (distorted) {
     cv::Mat K;
     cv::eigen2cv(v.camera.K, K);
@@ -85,9 +84,9 @@ Eigen::Vector2d ScalePixel(const Eigen::Vector2d& p, double scale) {
 }
 
 // Point of the reference camera's ray through `pixel` at camera depth `depth`.
-Eigen::Vector3d RayPoint(const PinholeCamera& camera, const Eigen::Vector2d& pixel,
-                         double depth) {
-  const Eigen::Vector3d xc = depth * (camera.K.inverse() * Eigen::Vector3d(pixel.x(), pixel.y(), 1));
+Eigen::Vector3d RayPoint(const PinholeCamera& camera, const Eigen::Vector2d& pixel, double depth) {
+  const Eigen::Vector3d xc =
+      depth * (camera.K.inverse() * Eigen::Vector3d(pixel.x(), pixel.y(), 1));
   return camera.R.transpose() * (xc - camera.t);
 }
 
@@ -116,8 +115,8 @@ void AppendPoint(const Eigen::Vector3d& X, const std::array<uint8_t, 3>& rgb, in
 
 // Triangulates and checks: in front of every camera, every reprojection
 // within `max_error`, rays at least `min_angle` apart. Returns false when not.
-bool TriangulateChecked(const std::vector<Observation>& obs, double max_error,
-                        double min_angle_rad, Eigen::Vector3d* point, double* mean_error) {
+bool TriangulateChecked(const std::vector<Observation>& obs, double max_error, double min_angle_rad,
+                        Eigen::Vector3d* point, double* mean_error) {
   std::vector<const PinholeCamera*> cameras;
   std::vector<Eigen::Vector2d> pixels;
   for (const Observation& o : obs) {
@@ -203,9 +202,8 @@ std::vector<Track> TextureSamples(const View& ref, const cv::Mat1b& region,
 // forwards and backwards; `to_view` takes a pixel of `warped` to the view's
 // pixel (false where it cannot). Returns the matches made.
 template <class ToView>
-int FollowFlow(const View& ref, const View& view, const cv::Mat1b& warped,
-               const cv::Mat1b& covered, const ToView& to_view, const TextureOptions& o,
-               std::vector<Track>* tracks) {
+int FollowFlow(const View& ref, const View& view, const cv::Mat1b& warped, const cv::Mat1b& covered,
+               const ToView& to_view, const TextureOptions& o, std::vector<Track>* tracks) {
   auto dis = cv::DISOpticalFlow::create(cv::DISOpticalFlow::PRESET_MEDIUM);
   cv::Mat forward, backward;
   dis->calc(ref.grey, warped, forward);
@@ -262,8 +260,8 @@ void FollowByHomography(const View& ref, const std::vector<View>& others,
     ViewStats& stats = result->views[view.index];
     const cv::Mat H = PageHomography(ref, view, page_points, &stats.page_points);
     if (H.empty()) continue;
-    const Eigen::Matrix3d He = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(
-        H.ptr<double>());
+    const Eigen::Matrix3d He =
+        Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(H.ptr<double>());
     cv::Mat1b warped, covered;
     cv::warpPerspective(view.grey, warped, H, ref.grey.size(),
                         cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_CONSTANT, 0);
@@ -326,8 +324,7 @@ void FollowBySurface(const View& ref, const std::vector<View>& others, const cv:
     cv::Mat1b warped;
     cv::remap(view.grey, warped, map, cv::noArray(), cv::INTER_LINEAR, cv::BORDER_CONSTANT, 0);
     cv::Mat1b covered;
-    cv::inRange(map, cv::Scalar(0, 0), cv::Scalar(view.grey.cols - 1, view.grey.rows - 1),
-                covered);
+    cv::inRange(map, cv::Scalar(0, 0), cv::Scalar(view.grey.cols - 1, view.grey.rows - 1), covered);
     auto to_view = [&](double x, double y, Eigen::Vector2d* p) {
       const int x0 = int(x), y0 = int(y);
       const float fx = float(x - x0), fy = float(y - y0);
@@ -350,8 +347,8 @@ void FollowBySurface(const View& ref, const std::vector<View>& others, const cv:
 
 // Strongest step of sign `sign` (grey rising along +n) within +-reach of c
 // along the unit normal n; returns its offset (sub-pixel) and strength.
-bool FindStep(const View& view, const Eigen::Vector2d& c, const Eigen::Vector2d& n,
-              double reach, int sign, double* offset, double* strength) {
+bool FindStep(const View& view, const Eigen::Vector2d& c, const Eigen::Vector2d& n, double reach,
+              int sign, double* offset, double* strength) {
   const int count = int(2 * reach / 0.5) + 1;
   std::vector<double> g(count, 0);
   int best = -1;
@@ -400,8 +397,7 @@ struct EdgeSample {
 };
 
 std::vector<EdgeSample> EdgeSamples(const View& ref, const Boundary& boundary,
-                                    const cv::Mat1b& page, double scale,
-                                    const OutlineOptions& o) {
+                                    const cv::Mat1b& page, double scale, const OutlineOptions& o) {
   std::vector<EdgeSample> samples;
   std::array<Eigen::Vector2d, 4> corners;
   for (int i = 0; i < 4; ++i) corners[i] = ScalePixel(boundary.corners[i], scale);
@@ -518,8 +514,9 @@ bool ContinuesSurface(const Eigen::Vector2d& pixel, double depth,
                       const std::vector<Eigen::Vector2d>& known_pixels,
                       const std::vector<double>& known_depths, const OutlineOptions& o) {
   Eigen::Vector3d c;
-  if (!FitInverseDepth(pixel, o.continuity_radius_px, known_pixels, known_depths,
-                       [](const Eigen::Vector2d&) { return true; }, &c))
+  if (!FitInverseDepth(
+          pixel, o.continuity_radius_px, known_pixels, known_depths,
+          [](const Eigen::Vector2d&) { return true; }, &c))
     return true;
   const double inverse_depth = c(2);
   return !(inverse_depth > 0 && std::abs(1 / inverse_depth - depth) > o.max_depth_jump * depth);
@@ -563,8 +560,10 @@ void MatchEdgeSamples(const View& ref, const std::vector<View>& others, int num_
   const double min_cos = std::sin(o.min_epipolar_angle_deg * M_PI / 180);
   for (const View& view : others) {
     for (EdgeSample& e : samples) {
-      const Eigen::Vector3d A = view.camera.CamFromWorld(RayPoint(ref.camera, e.pixel, e.near_depth));
-      const Eigen::Vector3d B = view.camera.CamFromWorld(RayPoint(ref.camera, e.pixel, e.far_depth));
+      const Eigen::Vector3d A =
+          view.camera.CamFromWorld(RayPoint(ref.camera, e.pixel, e.near_depth));
+      const Eigen::Vector3d B =
+          view.camera.CamFromWorld(RayPoint(ref.camera, e.pixel, e.far_depth));
       if (!(A.z() > 0) || !(B.z() > 0)) continue;
       const Eigen::Vector2d a = view.camera.ProjectCam(A), b = view.camera.ProjectCam(B);
       const double length = (b - a).norm();
@@ -613,8 +612,8 @@ void MatchEdgeSamples(const View& ref, const std::vector<View>& others, int num_
     // other views with a candidate where that depth projects.
     struct Hypothesis {
       Eigen::Vector3d point;
-      std::vector<Observation> obs;    // the reference first
-      std::vector<int> views;          // of obs[1...]
+      std::vector<Observation> obs;          // the reference first
+      std::vector<int> views;                // of obs[1...]
       std::vector<Eigen::Vector2d> normals;  // of obs[1...]
     };
     std::vector<Hypothesis> hypotheses;
@@ -808,14 +807,16 @@ bool SideSurface(const PinholeCamera& camera, const Eigen::Vector2d& pixel,
                  const std::vector<Eigen::Vector2d>& known_pixels,
                  const std::vector<double>& known_depths, double* depth, double* cos_ray) {
   Eigen::Vector3d c;  // 1/z = c0 du + c1 dv + c2
-  if (!FitInverseDepth(pixel, radius, known_pixels, known_depths,
-                       [&](const Eigen::Vector2d& d) { return side * d.dot(normal) >= 1; }, &c))
+  if (!FitInverseDepth(
+          pixel, radius, known_pixels, known_depths,
+          [&](const Eigen::Vector2d& d) { return side * d.dot(normal) >= 1; }, &c))
     return false;
   if (!(c(2) > 0)) return false;
   *depth = 1 / c(2);
   // 1/z = n.(K^-1 [u v 1]) / d for the plane n.X = d: n ~ K^T (c0, c1, c2 - c0 u - c1 v).
-  const Eigen::Vector3d plane = camera.K.transpose() *
-                                Eigen::Vector3d(c(0), c(1), c(2) - c(0) * pixel.x() - c(1) * pixel.y());
+  const Eigen::Vector3d plane =
+      camera.K.transpose() *
+      Eigen::Vector3d(c(0), c(1), c(2) - c(0) * pixel.x() - c(1) * pixel.y());
   const Eigen::Vector3d ray = camera.K.inverse() * Eigen::Vector3d(pixel.x(), pixel.y(), 1);
   *cos_ray = std::abs(plane.normalized().dot(ray.normalized()));
   return true;
@@ -833,8 +834,7 @@ void AddStepPoints(const View& ref, const std::vector<View>& others, int num_vie
   OutlineOptions o = outline;
   o.min_contrast = so.min_contrast;
   o.min_views = so.min_views;
-  std::vector<EdgeSample> samples =
-      StepSamples(blurred_ref, page, known_pixels, so, o.straight_px);
+  std::vector<EdgeSample> samples = StepSamples(blurred_ref, page, known_pixels, so, o.straight_px);
   result->steps.samples = int(samples.size());
   MatchEdgeSamples(
       blurred_ref, blurred, num_views, &samples, known_pixels, known_depths, o,
@@ -912,7 +912,8 @@ Eigen::Vector3d Triangulate(const std::vector<const PinholeCamera*>& cameras,
   }
   const Eigen::JacobiSVD<Eigen::MatrixXd> svd(A, Eigen::ComputeFullV);
   const Eigen::Vector4d X = svd.matrixV().col(3);
-  if (std::abs(X(3)) < 1e-12) return Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+  if (std::abs(X(3)) < 1e-12)
+    return Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
   return X.head<3>() / X(3);
 }
 
@@ -1042,7 +1043,8 @@ DensifyInputs ReadInputs(const DensifyOptions& o) {
       in.photos.emplace_back();
       continue;
     }
-    in.photos.push_back(ReadViewPhoto(images / view.image, view, cameras_path, cv::IMREAD_GRAYSCALE));
+    in.photos.push_back(
+        ReadViewPhoto(images / view.image, view, cameras_path, cv::IMREAD_GRAYSCALE));
   }
   const fs::path boundary_file =
       fs::is_directory(o.boundary) ? o.boundary / "boundary.json" : o.boundary;
@@ -1116,8 +1118,8 @@ DensifyResult Run(const DensifyInputs& in, const DensifyOptions& o) {
           " shows in another colour, behind the page, left out), then points triangulated "
           "from the texture of the page (1), from its outline (2) and from shading steps of "
           "blank paper (3), cameras of 10_sfm held fixed",
-      "frame: that of 10_sfm/cameras.json (camera of the reference view " +
-          in.cameras.reference + ")"};
+      "frame: that of 10_sfm/cameras.json (camera of the reference view " + in.cameras.reference +
+          ")"};
 
   // Working copies.
   auto t = Clock::now();
@@ -1130,8 +1132,8 @@ DensifyResult Run(const DensifyInputs& in, const DensifyOptions& o) {
   std::vector<View> others;
   for (int i = 0; i < num_views; ++i) {
     if (i == ref_index) continue;
-    others.push_back(MakeView(i, in.cameras.views[i], in.photos[i], in.distortion[i],
-                              r.working_scale));
+    others.push_back(
+        MakeView(i, in.cameras.views[i], in.photos[i], in.distortion[i], r.working_scale));
   }
   cv::Mat1b region, page;
   cv::resize(full_region, region, ref.grey.size(), 0, 0, cv::INTER_NEAREST);
@@ -1202,7 +1204,8 @@ DensifyResult Run(const DensifyInputs& in, const DensifyOptions& o) {
   if (o.texture.surface_prewarp)
     Log(std::to_string(r.texture_points_surface) +
         " texture points more with the other photos brought onto the reference through the "
-        "points' surface, " + std::to_string(r.seconds_surface).substr(0, 4) + " s");
+        "points' surface, " +
+        std::to_string(r.seconds_surface).substr(0, 4) + " s");
   r.seconds_total = SecondsSince(start);
   return r;
 }
@@ -1283,12 +1286,9 @@ void WriteOutputs(const DensifyInputs& in, const DensifyResult& r, const Densify
                             {"outline_candidates", v.outline_candidates},
                             {"outline_votes", v.outline_votes}});
   doc["warnings"] = r.warnings;
-  doc["seconds"] = {{"reading", r.seconds_reading},
-                    {"texture", r.seconds_texture},
-                    {"outline", r.seconds_outline},
-                    {"texture_surface_prewarp", r.seconds_surface},
-                    {"steps", r.seconds_steps},
-                    {"total", r.seconds_total}};
+  doc["seconds"] = {{"reading", r.seconds_reading}, {"texture", r.seconds_texture},
+                    {"outline", r.seconds_outline}, {"texture_surface_prewarp", r.seconds_surface},
+                    {"steps", r.seconds_steps},     {"total", r.seconds_total}};
   WriteJsonAtomic(o.out_dir / "points.json", doc);
 }
 

@@ -23,13 +23,12 @@
 //   overlay.png  the reference image with the points by source
 #pragma once
 
+#include <Eigen/Core>
 #include <array>
 #include <filesystem>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
-#include <opencv2/core.hpp>
 
 #include "common/camera.h"
 #include "common/json_io.h"
@@ -186,22 +185,22 @@ struct DensifyOptions {
 };
 
 struct DensifyInputs {
-  CameraSet cameras;  // every registered view, reference frame (sfm)
+  CameraSet cameras;                              // every registered view, reference frame (sfm)
   std::vector<std::array<double, 4>> distortion;  // per view: OpenCV k1 k2 p1 p2
-  cv::Mat reference;              // 10_sfm/reference.png (undistorted), BGR
-  std::vector<cv::Mat> photos;    // per view, greyscale as taken (empty for the reference)
+  cv::Mat reference;                              // 10_sfm/reference.png (undistorted), BGR
+  std::vector<cv::Mat> photos;  // per view, greyscale as taken (empty for the reference)
   Boundary boundary;
-  cv::Mat1b region;               // document region, reference pixels (mask.png)
-  PlyData points;                 // 10_sfm/points.ply
+  cv::Mat1b region;  // document region, reference pixels (mask.png)
+  PlyData points;    // 10_sfm/points.ply
 };
 
 struct ViewStats {
   std::string image;
-  int page_points = 0;        // sfm points of the page seen in both (homography)
-  int flow_matches = 0;       // texture samples followed into this view
+  int page_points = 0;           // sfm points of the page seen in both (homography)
+  int flow_matches = 0;          // texture samples followed into this view
   int surface_flow_matches = 0;  // ... in the second pass (surface prewarp)
-  int outline_candidates = 0; // edge crossings found on the epipolar segments
-  int outline_votes = 0;      // of those, in a triangulated outline point
+  int outline_candidates = 0;    // edge crossings found on the epipolar segments
+  int outline_votes = 0;         // of those, in a triangulated outline point
 };
 
 // What became of the edge samples of one kind (outline or shading steps).
@@ -216,12 +215,12 @@ struct EdgeCounts {
 struct DensifyResult {
   PlyData points;  // sfm's points, then texture, outline and step points
   int sfm_points = 0, sfm_points_in_region = 0, texture_points = 0;
-  int texture_points_surface = 0;  // of texture_points, from the second pass
+  int texture_points_surface = 0;       // of texture_points, from the second pass
   std::vector<Eigen::Vector3d> hidden;  // sfm points left out (HiddenOptions)
-  int texture_samples = 0;     // textured grid pixels in the region
-  EdgeCounts outline;          // samples on the real sides (OutlineOptions)
-  EdgeCounts steps;            // shading steps (StepOptions)
-  double working_scale = 1;    // working copies / photos
+  int texture_samples = 0;              // textured grid pixels in the region
+  EdgeCounts outline;                   // samples on the real sides (OutlineOptions)
+  EdgeCounts steps;                     // shading steps (StepOptions)
+  double working_scale = 1;             // working copies / photos
   std::vector<ViewStats> views;
   double seconds_reading = 0, seconds_texture = 0, seconds_outline = 0, seconds_surface = 0,
          seconds_steps = 0, seconds_total = 0;

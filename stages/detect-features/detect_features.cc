@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-
 #include <opencv2/imgproc.hpp>
 
 #include "common/cli.h"
@@ -60,8 +59,7 @@ Json FeaturesOptions::ToJson() const {
 
 FeaturesResult DetectFeatures(const cv::Mat& image, const cv::Mat& mask_in,
                               const FeaturesOptions& options) {
-  if (image.empty() || image.type() != CV_8UC3)
-    throw InputError("expected an 8-bit colour image");
+  if (image.empty() || image.type() != CV_8UC3) throw InputError("expected an 8-bit colour image");
   if (mask_in.size() != image.size())
     throw InputError("mask is " + std::to_string(mask_in.cols) + "x" +
                      std::to_string(mask_in.rows) + " but the image is " +
@@ -71,7 +69,8 @@ FeaturesResult DetectFeatures(const cv::Mat& image, const cv::Mat& mask_in,
   if (cv::countNonZero(mask) == 0) throw InputError("mask is empty (no document region)");
   const auto start = std::chrono::steady_clock::now();
   auto step = [&](const std::string& what) {
-    if (options.verbose) Log(what + " (" + std::to_string(SecondsSince(start)).substr(0, 5) + " s)");
+    if (options.verbose)
+      Log(what + " (" + std::to_string(SecondsSince(start)).substr(0, 5) + " s)");
   };
 
   const double diag = std::hypot(image.cols, image.rows);
@@ -83,7 +82,8 @@ FeaturesResult DetectFeatures(const cv::Mat& image, const cv::Mat& mask_in,
   cv::erode(mask, region,
             cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * margin + 1, 2 * margin + 1)));
   const int window = (options.sauvola_window > 0 ? options.sauvola_window
-                                                 : std::max(15, int(std::lround(0.015 * diag)))) | 1;
+                                                 : std::max(15, int(std::lround(0.015 * diag)))) |
+                     1;
   cv::Mat1b ink = detail::SauvolaInk(grey, window, options.sauvola_k);
   ink &= region;
   const detail::InkComponents components = detail::FindComponents(ink);
@@ -114,8 +114,8 @@ FeaturesResult DetectFeatures(const cv::Mat& image, const cv::Mat& mask_in,
   return result;
 }
 
-Json FeaturesToJson(const FeaturesResult& r, const std::string& image_name, int width,
-                    int height, const FeaturesOptions& options) {
+Json FeaturesToJson(const FeaturesResult& r, const std::string& image_name, int width, int height,
+                    const FeaturesOptions& options) {
   Json doc = MakeHeader("docunfold.features", 1, "detect-features", options.ToJson());
   doc["image"] = image_name;
   doc["width"] = width;
@@ -135,8 +135,8 @@ Json FeaturesToJson(const FeaturesResult& r, const std::string& image_name, int 
   return doc;
 }
 
-cv::Mat DrawFeaturesOverlay(const cv::Mat& image, const cv::Mat& mask,
-                            const FeaturesResult& r, int max_size) {
+cv::Mat DrawFeaturesOverlay(const cv::Mat& image, const cv::Mat& mask, const FeaturesResult& r,
+                            int max_size) {
   const double s = std::min(1.0, double(max_size) / std::max(image.cols, image.rows));
   cv::Mat out, small_mask;
   cv::resize(image, out, cv::Size(), s, s, cv::INTER_AREA);
@@ -145,7 +145,8 @@ cv::Mat DrawFeaturesOverlay(const cv::Mat& image, const cv::Mat& mask,
   dark.copyTo(out, small_mask <= 127);
   const int thick = std::max(1, int(std::lround(out.cols / 800.0)));
   for (const Segment& seg : r.segments) {
-    const cv::Scalar colour = seg.kind == "text" ? cv::Scalar(40, 40, 230) : cv::Scalar(230, 200, 0);
+    const cv::Scalar colour =
+        seg.kind == "text" ? cv::Scalar(40, 40, 230) : cv::Scalar(230, 200, 0);
     for (size_t k = 1; k < seg.points.size(); ++k) {
       const cv::Point2d a = (seg.points[k - 1] + cv::Point2d(0.5, 0.5)) * s - cv::Point2d(0.5, 0.5);
       const cv::Point2d b = (seg.points[k] + cv::Point2d(0.5, 0.5)) * s - cv::Point2d(0.5, 0.5);

@@ -15,11 +15,10 @@
 //     page, and precision comes first (paper, Remarks).
 #pragma once
 
+#include <opencv2/core.hpp>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "common/json_io.h"
 
@@ -64,17 +63,17 @@ struct FeaturesOptions {
 };
 
 struct Segment {
-  std::string kind;                  // "text" or "edge"
-  std::vector<cv::Point2d> points;   // a straight polyline, >= 2 points
-  int characters = 0;                // text: characters chained
+  std::string kind;                 // "text" or "edge"
+  std::vector<cv::Point2d> points;  // a straight polyline, >= 2 points
+  int characters = 0;               // text: characters chained
 };
 
 struct FeaturesResult {
   std::vector<Segment> segments;
-  double text_height = 0;       // median character height (pixels), 0 if no text
-  double text_direction = 0;    // degrees, of the text lines in the image
-  bool text_upside_down = false;  // baselines on the image-up side of the text
-  std::optional<cv::Point2d> text_down;  // unit, towards the baselines, when known
+  double text_height = 0;                        // median character height (pixels), 0 if no text
+  double text_direction = 0;                     // degrees, of the text lines in the image
+  bool text_upside_down = false;                 // baselines on the image-up side of the text
+  std::optional<cv::Point2d> text_down;          // unit, towards the baselines, when known
   int votes_upright = 0, votes_upside_down = 0;  // evidence for either
   int text_segments = 0;
   int edge_segments = 0;
@@ -86,12 +85,12 @@ FeaturesResult DetectFeatures(const cv::Mat& image, const cv::Mat& mask,
                               const FeaturesOptions& options);
 
 // features.json (format docunfold.features, version 1).
-Json FeaturesToJson(const FeaturesResult& result, const std::string& image_name,
-                    int width, int height, const FeaturesOptions& options);
+Json FeaturesToJson(const FeaturesResult& result, const std::string& image_name, int width,
+                    int height, const FeaturesOptions& options);
 
 // Segments drawn over the image (text red, edges cyan, outside the region
 // darkened); at most `max_size` pixels long.
-cv::Mat DrawFeaturesOverlay(const cv::Mat& image, const cv::Mat& mask,
-                            const FeaturesResult& result, int max_size = 2000);
+cv::Mat DrawFeaturesOverlay(const cv::Mat& image, const cv::Mat& mask, const FeaturesResult& result,
+                            int max_size = 2000);
 
 }  // namespace docunfold::features

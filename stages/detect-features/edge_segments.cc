@@ -35,8 +35,7 @@ bool ClipToRegion(const cv::Mat1b& region, cv::Point2d* a, cv::Point2d* b) {
     if (k <= steps) {
       const cv::Point2d p = *a + (*b - *a) * (double(k) / steps);
       const int x = int(std::lround(p.x)), y = int(std::lround(p.y));
-      inside = x >= 0 && y >= 0 && x < region.cols && y < region.rows &&
-               region(y, x);
+      inside = x >= 0 && y >= 0 && x < region.cols && y < region.rows && region(y, x);
     }
     if (inside && first < 0) first = k;
     if (!inside && first >= 0) {
@@ -58,9 +57,8 @@ bool ClipToRegion(const cv::Mat1b& region, cv::Point2d* a, cv::Point2d* b) {
 // A centre line found between two LSD edges.
 struct Piece {
   cv::Point2d a, b;
-  bool joined = false;  // taken into another piece
-  std::vector<std::pair<cv::Point2d, cv::Point2d>>
-      parts;  // as found, when joined
+  bool joined = false;                                     // taken into another piece
+  std::vector<std::pair<cv::Point2d, cv::Point2d>> parts;  // as found, when joined
 };
 
 // LSD ends an edge wherever another line crosses it, so a table's column
@@ -68,11 +66,9 @@ struct Piece {
 // centre lines of pieces of one straight rule (parallel within 2 degrees,
 // every end within `max_offset` px of the joined line) across gaps up to
 // `max_gap` px. A curved rule stays in pieces that are straight.
-std::vector<Piece> JoinCollinear(std::vector<Piece> pieces, double max_gap,
-                                 double max_offset) {
+std::vector<Piece> JoinCollinear(std::vector<Piece> pieces, double max_gap, double max_offset) {
   const double max_sin = std::sin(2.0 * CV_PI / 180);
-  auto offset = [](const cv::Point2d& a, const cv::Point2d& b,
-                   const cv::Point2d& p) {
+  auto offset = [](const cv::Point2d& a, const cv::Point2d& b, const cv::Point2d& p) {
     const cv::Point2d d = b - a;
     return std::abs(d.x * (p.y - a.y) - d.y * (p.x - a.x)) / cv::norm(d);
   };
@@ -88,9 +84,7 @@ std::vector<Piece> JoinCollinear(std::vector<Piece> pieces, double max_gap,
         const cv::Point2d dir = (s.b - s.a) * (1.0 / length);
         const cv::Point2d t_dir = (t.b - t.a) * (1.0 / cv::norm(t.b - t.a));
         if (std::abs(dir.x * t_dir.y - dir.y * t_dir.x) > max_sin) continue;
-        if (offset(s.a, s.b, t.a) > max_offset ||
-            offset(s.a, s.b, t.b) > max_offset)
-          continue;
+        if (offset(s.a, s.b, t.a) > max_offset || offset(s.a, s.b, t.b) > max_offset) continue;
         const double ua = (t.a - s.a).dot(dir), ub = (t.b - s.a).dot(dir);
         const double u0 = std::min(ua, ub), u1 = std::max(ua, ub);
         if (std::max(u0 - length, -u1) > max_gap) continue;
@@ -119,27 +113,20 @@ std::vector<Piece> JoinCollinear(std::vector<Piece> pieces, double max_gap,
 
 }  // namespace
 
-std::vector<Segment> DetectEdgeSegments(const cv::Mat1b& grey,
-                                        const cv::Mat1b& ink,
-                                        const InkComponents& components,
-                                        const TextResult& text,
-                                        const cv::Mat1b& region,
-                                        const FeaturesOptions& options) {
+std::vector<Segment> DetectEdgeSegments(const cv::Mat1b& grey, const cv::Mat1b& ink,
+                                        const InkComponents& components, const TextResult& text,
+                                        const cv::Mat1b& region, const FeaturesOptions& options) {
   std::vector<cv::Vec4f> lines;
-  cv::Ptr<cv::LineSegmentDetector> lsd =
-      cv::createLineSegmentDetector(cv::LSD_REFINE_STD);
+  cv::Ptr<cv::LineSegmentDetector> lsd = cv::createLineSegmentDetector(cv::LSD_REFINE_STD);
   // LSD smooths before it looks for gradients, which wipes out rules one
   // pixel wide (a table's column rules, seen obliquely): with small text it
   // runs on the region's box enlarged.
-  const cv::Rect box =
-      cv::boundingRect(region) & cv::Rect(0, 0, grey.cols, grey.rows);
+  const cv::Rect box = cv::boundingRect(region) & cv::Rect(0, 0, grey.cols, grey.rows);
   double upscale = options.lsd_upscale;
-  if (upscale <= 0)
-    upscale = text.height > 0 && text.height < 12 && box.area() <= 4e6 ? 2 : 1;
+  if (upscale <= 0) upscale = text.height > 0 && text.height < 12 && box.area() <= 4e6 ? 2 : 1;
   if (upscale > 1 && !box.empty()) {
     cv::Mat1b enlarged;
-    cv::resize(grey(box), enlarged, cv::Size(), upscale, upscale,
-               cv::INTER_CUBIC);
+    cv::resize(grey(box), enlarged, cv::Size(), upscale, upscale, cv::INTER_CUBIC);
     lsd->detect(enlarged, lines);
     for (cv::Vec4f& l : lines)
       for (int k = 0; k < 4; k += 2) {
@@ -151,8 +138,8 @@ std::vector<Segment> DetectEdgeSegments(const cv::Mat1b& grey,
     lsd->detect(grey, lines);
   }
   // Character strokes are shorter than a few text heights.
-  const double min_length = std::max(options.min_length_px,
-                                     text.height > 0 ? 3.0 * text.height : 0.0);
+  const double min_length =
+      std::max(options.min_length_px, text.height > 0 ? 3.0 * text.height : 0.0);
   const double max_width = std::max(4.0, 0.6 * text.height);
   // Pieces shorter than this are pixel noise even where a gap is bridged.
   constexpr double kShortestPiece = 4.0;
@@ -184,8 +171,7 @@ std::vector<Segment> DetectEdgeSegments(const cv::Mat1b& grey,
   std::vector<Piece> pieces;
   // The ink a line runs along: none (a faint rule), or one component that
   // is not a character and is line-like (long and thin, or a large grid).
-  auto along_printed_line = [&](const cv::Point2d& a, const cv::Point2d& b,
-                                double length) {
+  auto along_printed_line = [&](const cv::Point2d& a, const cv::Point2d& b, double length) {
     std::map<int, int> votes;
     const int steps = std::max(2, int(length / 3.0));
     for (int k = 0; k <= steps; ++k) {
@@ -195,8 +181,7 @@ std::vector<Segment> DetectEdgeSegments(const cv::Mat1b& grey,
       for (int dy = -1; dy <= 1 && !label; ++dy)
         for (int dx = -1; dx <= 1 && !label; ++dx) {
           const int xx = x + dx, yy = y + dy;
-          if (xx >= 0 && yy >= 0 && xx < ink.cols && yy < ink.rows &&
-              ink(yy, xx))
+          if (xx >= 0 && yy >= 0 && xx < ink.cols && yy < ink.rows && ink(yy, xx))
             label = components.labels(yy, xx);
         }
       ++votes[label];
@@ -210,8 +195,7 @@ std::vector<Segment> DetectEdgeSegments(const cv::Mat1b& grey,
     // A faint rule may be too light to count as ink; text never is.
     if (best == 0) return true;
     if (best_votes < 0.8 * (steps + 1)) return false;
-    if (best < int(text.is_character.size()) && text.is_character[size_t(best)])
-      return false;
+    if (best < int(text.is_character.size()) && text.is_character[size_t(best)]) return false;
     // Longer than the line found (a grid, a frame), or thin: for a line of
     // length L and width w the box's diagonal is about L and the area L w,
     // so diagonal^2 / area is about L / w, whatever the line's slant.
@@ -225,8 +209,7 @@ std::vector<Segment> DetectEdgeSegments(const cv::Mat1b& grey,
   // Where t lies along s: the range of s (distances from s.a) it overlaps.
   auto overlap_along = [](const Edge& s, const Edge& t) {
     const double ua = (t.a - s.a).dot(s.dir), ub = (t.b - s.a).dot(s.dir);
-    return std::pair(std::max(0.0, std::min(ua, ub)),
-                     std::min(s.length, std::max(ua, ub)));
+    return std::pair(std::max(0.0, std::min(ua, ub)), std::min(s.length, std::max(ua, ub)));
   };
   int paired = 0, rejected = 0;
   // First the edges long enough to give a segment on their own, then (to be
@@ -242,18 +225,13 @@ std::vector<Segment> DetectEdgeSegments(const cv::Mat1b& grey,
       int partner = -1;
       double best_overlap = 0;
       for (size_t j = 0; j < edges.size(); ++j) {
-        if (j == i || edges[j].used || edges[j].length < shortest_edge)
-          continue;
+        if (j == i || edges[j].used || edges[j].length < shortest_edge) continue;
         const Edge& t = edges[j];
-        if (std::abs(s.dir.x * t.dir.y - s.dir.y * t.dir.x) >
-            std::sin(4.0 * CV_PI / 180))
-          continue;
+        if (std::abs(s.dir.x * t.dir.y - s.dir.y * t.dir.x) > std::sin(4.0 * CV_PI / 180)) continue;
         const cv::Point2d tm = 0.5 * (t.a + t.b);
-        const double offset =
-            (tm - s.a).dot(s.normal);  // > 0: on s's dark side
+        const double offset = (tm - s.a).dot(s.normal);  // > 0: on s's dark side
         if (offset < 0.5 || offset > max_width) continue;
-        if (t.normal.dot(s.normal) > -0.9)
-          continue;  // dark sides face each other
+        if (t.normal.dot(s.normal) > -0.9) continue;  // dark sides face each other
         const auto [u0, u1] = overlap_along(s, t);
         const double overlap = u1 - u0;
         if (overlap < 0.5 * std::min(s.length, t.length)) continue;
@@ -292,8 +270,7 @@ std::vector<Segment> DetectEdgeSegments(const cv::Mat1b& grey,
       }
   const size_t paired_pieces = pieces.size();
   if (options.join_gap > 0) {
-    const double max_gap =
-        std::max(options.join_gap, text.height > 0 ? 0.5 * text.height : 0.0);
+    const double max_gap = std::max(options.join_gap, text.height > 0 ? 0.5 * text.height : 0.0);
     pieces = JoinCollinear(std::move(pieces), max_gap, 1.0);
   }
   int kept_lines = 0;
@@ -301,8 +278,7 @@ std::vector<Segment> DetectEdgeSegments(const cv::Mat1b& grey,
   // must do so as a whole, and where it does not, its pieces stand as found.
   auto keep = [&](const cv::Point2d& a, const cv::Point2d& b, bool joined) {
     const double length = cv::norm(b - a);
-    if (length < min_length || (joined && !along_printed_line(a, b, length)))
-      return false;
+    if (length < min_length || (joined && !along_printed_line(a, b, length))) return false;
     out.push_back({"edge", {a, b}, 0});
     ++kept_lines;
     return true;
@@ -311,12 +287,10 @@ std::vector<Segment> DetectEdgeSegments(const cv::Mat1b& grey,
     if (!keep(p.a, p.b, !p.parts.empty()))
       for (const auto& [a, b] : p.parts) keep(a, b, false);
   if (options.verbose)
-    Log("LSD: " + std::to_string(lines.size()) + " edges, " +
-        std::to_string(edges.size()) + " inside the region, " +
-        std::to_string(paired_pieces) + " lines between them, " +
-        std::to_string(pieces.size()) + " after joining, " +
-        std::to_string(kept_lines) + " long enough; " + std::to_string(paired) +
-        " pairs, " + std::to_string(rejected) +
+    Log("LSD: " + std::to_string(lines.size()) + " edges, " + std::to_string(edges.size()) +
+        " inside the region, " + std::to_string(paired_pieces) + " lines between them, " +
+        std::to_string(pieces.size()) + " after joining, " + std::to_string(kept_lines) +
+        " long enough; " + std::to_string(paired) + " pairs, " + std::to_string(rejected) +
         " of them not along a printed line");
   return out;
 }

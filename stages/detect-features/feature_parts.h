@@ -2,9 +2,8 @@
 // to the stage; tests may call them).
 #pragma once
 
-#include <vector>
-
 #include <opencv2/core.hpp>
+#include <vector>
 
 #include "stages/detect-features/detect_features.h"
 
@@ -24,8 +23,8 @@ InkComponents FindComponents(const cv::Mat1b& ink);
 
 struct TextResult {
   std::vector<Segment> segments;
-  double height = 0;          // median character height across the lines (px)
-  double direction_deg = 0;   // text line direction in the image
+  double height = 0;         // median character height across the lines (px)
+  double direction_deg = 0;  // text line direction in the image
   bool upside_down = false;  // baselines on the image-up side of the letters
   // How far (pixels, summed) the outlines on the -n side and on the +n side
   // stray from straight: the baseline side strays less.
@@ -41,9 +40,8 @@ TextResult DetectTextSegments(const InkComponents& ink, const FeaturesOptions& o
 // Centre lines of thin dark lines (and, if asked, single step edges) found by
 // LSD in `grey`, inside `region`, that are not character strokes.
 std::vector<Segment> DetectEdgeSegments(const cv::Mat1b& grey, const cv::Mat1b& ink,
-                                        const InkComponents& components,
-                                        const TextResult& text, const cv::Mat1b& region,
-                                        const FeaturesOptions& options);
+                                        const InkComponents& components, const TextResult& text,
+                                        const cv::Mat1b& region, const FeaturesOptions& options);
 
 // Least-squares line through points: unit direction, a point on it, and the
 // RMS of the perpendicular residuals.

@@ -4,7 +4,6 @@
 #include <cmath>
 #include <map>
 #include <numeric>
-
 #include <opencv2/imgproc.hpp>
 
 #include "common/statistics.h"
@@ -40,8 +39,10 @@ double TextDirection(const std::vector<Mark>& marks, double char_size) {
   if (points.size() < 3) return 0;
   double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
   for (const auto& p : points) {
-    x0 = std::min(x0, p.x); y0 = std::min(y0, p.y);
-    x1 = std::max(x1, p.x); y1 = std::max(y1, p.y);
+    x0 = std::min(x0, p.x);
+    y0 = std::min(y0, p.y);
+    x1 = std::max(x1, p.x);
+    y1 = std::max(y1, p.y);
   }
   constexpr int kTiles = 3;
   std::vector<std::vector<cv::Point2d>> tiles(kTiles * kTiles);
@@ -68,13 +69,19 @@ double TextDirection(const std::vector<Mark>& marks, double char_size) {
   double best = 0, best_score = -1;
   for (int deg = 0; deg < 180; ++deg) {
     const double sc = score(deg * CV_PI / 180);
-    if (sc > best_score) { best_score = sc; best = deg * CV_PI / 180; }
+    if (sc > best_score) {
+      best_score = sc;
+      best = deg * CV_PI / 180;
+    }
   }
   const double coarse = best;
   for (int k = -10; k <= 10; ++k) {
     const double theta = coarse + k * 0.1 * CV_PI / 180;
     const double sc = score(theta);
-    if (sc > best_score) { best_score = sc; best = theta; }
+    if (sc > best_score) {
+      best_score = sc;
+      best = theta;
+    }
   }
   best = std::fmod(best + CV_PI, CV_PI);
   // Monospaced text (receipts) also piles up sharply across its columns.
@@ -86,7 +93,10 @@ double TextDirection(const std::vector<Mark>& marks, double char_size) {
   for (int deg = 65; deg <= 115; ++deg) {
     const double theta = best + deg * CV_PI / 180;
     const double sc = score(theta);
-    if (sc > across_score) { across_score = sc; across = theta; }
+    if (sc > across_score) {
+      across_score = sc;
+      across = theta;
+    }
   }
   if (across_score < 0.6 * best_score) return best;
   auto median_spacing = [&](double theta) {
@@ -119,7 +129,9 @@ LineFit FitLine(const std::vector<cv::Point2d>& points) {
   double sxx = 0, sxy = 0, syy = 0;
   for (const auto& p : points) {
     const cv::Point2d d = p - mean;
-    sxx += d.x * d.x; sxy += d.x * d.y; syy += d.y * d.y;
+    sxx += d.x * d.x;
+    sxy += d.x * d.y;
+    syy += d.y * d.y;
   }
   const double angle = 0.5 * std::atan2(2 * sxy, sxx - syy);
   fit.direction = {std::cos(angle), std::sin(angle)};
@@ -152,7 +164,10 @@ std::vector<std::pair<int, int>> SplitWhereBent(const std::vector<cv::Point2d>& 
     for (int k = a + 1; k < b; ++k) {
       const cv::Point2d v = points[k] - points[a];
       const double d = len > 1e-9 ? std::abs(chord.x * v.y - chord.y * v.x) / len : cv::norm(v);
-      if (d > worst_d) { worst_d = d; worst = k; }
+      if (d > worst_d) {
+        worst_d = d;
+        worst = k;
+      }
     }
     if (worst < 0) {
       out.emplace_back(a, b);
@@ -209,8 +224,10 @@ TextResult DetectTextSegments(const InkComponents& ink, const FeaturesOptions& o
     m.a1 = m.c1 = -1e300;
     for (const cv::Point& p : m.pixels) {
       const double a = p.x * d.x + p.y * d.y, c = p.x * n.x + p.y * n.y;
-      m.a0 = std::min(m.a0, a); m.a1 = std::max(m.a1, a);
-      m.c0 = std::min(m.c0, c); m.c1 = std::max(m.c1, c);
+      m.a0 = std::min(m.a0, a);
+      m.a1 = std::max(m.a1, a);
+      m.c0 = std::min(m.c0, c);
+      m.c1 = std::max(m.c1, c);
     }
   }
   std::vector<double> heights;
@@ -226,7 +243,10 @@ TextResult DetectTextSegments(const InkComponents& ink, const FeaturesOptions& o
   //    whose across-extent overlaps, if each is the other's choice.
   const double cell = 4.0 * h_med;
   double ax0 = 1e300, cy0 = 1e300;
-  for (int i : usable) { ax0 = std::min(ax0, marks[i].a0); cy0 = std::min(cy0, marks[i].c0); }
+  for (int i : usable) {
+    ax0 = std::min(ax0, marks[i].a0);
+    cy0 = std::min(cy0, marks[i].c0);
+  }
   std::map<std::pair<int, int>, std::vector<int>> grid;
   for (int i : usable) {
     const Mark& m = marks[i];
@@ -254,8 +274,14 @@ TextResult DetectTextSegments(const InkComponents& ink, const FeaturesOptions& o
           if (o.along_mid() <= m.along_mid()) continue;
           const double overlap = std::min(m.c1, o.c1) - std::max(m.c0, o.c0) + 1;
           if (overlap < 0.5 * hmin) continue;
-          if (gap < next_gap[i]) { next_gap[i] = gap; next[i] = j; }
-          if (gap < prev_gap[j]) { prev_gap[j] = gap; prev[j] = i; }
+          if (gap < next_gap[i]) {
+            next_gap[i] = gap;
+            next[i] = j;
+          }
+          if (gap < prev_gap[j]) {
+            prev_gap[j] = gap;
+            prev[j] = i;
+          }
         }
       }
   }
@@ -276,7 +302,8 @@ TextResult DetectTextSegments(const InkComponents& ink, const FeaturesOptions& o
     std::vector<cv::Point2d> mids;
     for (int k : chain) mids.emplace_back(marks[k].along_mid(), marks[k].across_mid());
     const LineFit fit = FitLine(mids);
-    const double slope = fit.direction.y / (std::abs(fit.direction.x) > 1e-9 ? fit.direction.x : 1e-9);
+    const double slope =
+        fit.direction.y / (std::abs(fit.direction.x) > 1e-9 ? fit.direction.x : 1e-9);
     std::vector<double> tops, bottoms;
     for (int k : chain) {
       const double trend = fit.point.y + slope * (marks[k].along_mid() - fit.point.x);
@@ -291,7 +318,10 @@ TextResult DetectTextSegments(const InkComponents& ink, const FeaturesOptions& o
 
   // The outline of a chain on one side: in narrow bins along the line, the
   // ink's extreme towards sign * n (sign +1: the +n side).
-  struct Sample { double a, c; int mark; };
+  struct Sample {
+    double a, c;
+    int mark;
+  };
   auto outline = [&](const std::vector<int>& chain, double sign) {
     std::vector<Sample> samples;
     for (int k : chain) {
@@ -302,7 +332,10 @@ TextResult DetectTextSegments(const InkComponents& ink, const FeaturesOptions& o
       for (const cv::Point& p : m.pixels) {
         const double a = p.x * d.x + p.y * d.y, c = sign * (p.x * n.x + p.y * n.y);
         const int b = std::min(bins - 1, int((a - m.a0) / bin));
-        if (c > best[size_t(b)]) { best[size_t(b)] = c; best_a[size_t(b)] = a; }
+        if (c > best[size_t(b)]) {
+          best[size_t(b)] = c;
+          best_a[size_t(b)] = a;
+        }
         least[size_t(b)] = std::min(least[size_t(b)], c);
       }
       // Only bins the ink crosses nearly from one side of the x-height band
@@ -313,7 +346,8 @@ TextResult DetectTextSegments(const InkComponents& ink, const FeaturesOptions& o
         if (best[size_t(b)] > -1e299 && best[size_t(b)] - least[size_t(b)] >= 0.6 * x_height)
           samples.push_back({best_a[size_t(b)], best[size_t(b)] + 0.5, k});
     }
-    std::sort(samples.begin(), samples.end(), [](const Sample& p, const Sample& q) { return p.a < q.a; });
+    std::sort(samples.begin(), samples.end(),
+              [](const Sample& p, const Sample& q) { return p.a < q.a; });
     return samples;
   };
   // Each sample's offset from the median of its neighbours within
@@ -325,7 +359,8 @@ TextResult DetectTextSegments(const InkComponents& ink, const FeaturesOptions& o
     std::vector<cv::Point2d> raw;
     for (const Sample& s : samples) raw.emplace_back(s.a, s.c);
     const LineFit tilt = FitLine(raw);
-    const double slope = tilt.direction.y / (std::abs(tilt.direction.x) > 1e-9 ? tilt.direction.x : 1e-9);
+    const double slope =
+        tilt.direction.y / (std::abs(tilt.direction.x) > 1e-9 ? tilt.direction.x : 1e-9);
     std::vector<double> e(samples.size());
     for (size_t k = 0; k < samples.size(); ++k)
       e[k] = samples[k].c - (tilt.point.y + slope * (samples[k].a - tilt.point.x));
@@ -360,14 +395,17 @@ TextResult DetectTextSegments(const InkComponents& ink, const FeaturesOptions& o
     const int w = ink.stats(l, cv::CC_STAT_WIDTH), h = ink.stats(l, cv::CC_STAT_HEIGHT);
     if (ink.stats(l, cv::CC_STAT_AREA) < 2 || std::max(w, h) > 0.45 * x_height) continue;
     Mark m;
-    const double left = ink.stats(l, cv::CC_STAT_LEFT) - 0.5, top = ink.stats(l, cv::CC_STAT_TOP) - 0.5;
+    const double left = ink.stats(l, cv::CC_STAT_LEFT) - 0.5,
+                 top = ink.stats(l, cv::CC_STAT_TOP) - 0.5;
     m.a0 = m.c0 = 1e300;
     m.a1 = m.c1 = -1e300;
     for (const cv::Point2d corner : {cv::Point2d(left, top), cv::Point2d(left + w, top),
                                      cv::Point2d(left, top + h), cv::Point2d(left + w, top + h)}) {
       const double a = corner.dot(d), c = corner.dot(n);
-      m.a0 = std::min(m.a0, a); m.a1 = std::max(m.a1, a);
-      m.c0 = std::min(m.c0, c); m.c1 = std::max(m.c1, c);
+      m.a0 = std::min(m.a0, a);
+      m.a1 = std::max(m.a1, a);
+      m.c0 = std::min(m.c0, c);
+      m.c1 = std::max(m.c1, c);
     }
     small.push_back(m);
   }
@@ -381,7 +419,8 @@ TextResult DetectTextSegments(const InkComponents& ink, const FeaturesOptions& o
     std::vector<cv::Point2d> mids;
     for (int k : chain) mids.emplace_back(marks[k].along_mid(), marks[k].across_mid());
     const LineFit fit = FitLine(mids);
-    const double slope = fit.direction.y / (std::abs(fit.direction.x) > 1e-9 ? fit.direction.x : 1e-9);
+    const double slope =
+        fit.direction.y / (std::abs(fit.direction.x) > 1e-9 ? fit.direction.x : 1e-9);
     auto trend = [&](double a) { return fit.point.y + slope * (a - fit.point.x); };
     std::vector<double> tops, bottoms;
     for (int k : chain) {
@@ -393,7 +432,8 @@ TextResult DetectTextSegments(const InkComponents& ink, const FeaturesOptions& o
     const double a_first = marks[chain.front()].a0, a_last = marks[chain.back()].a1;
     const double mid = trend(0.5 * (a_first + a_last));
     for (int gx = int(std::floor(a_first / cell)); gx <= int(std::floor(a_last / cell)); ++gx)
-      for (int gy = int(std::floor((mid + t - x) / cell)); gy <= int(std::floor((mid + b + x) / cell)); ++gy) {
+      for (int gy = int(std::floor((mid + t - x) / cell));
+           gy <= int(std::floor((mid + b + x) / cell)); ++gy) {
         auto it = small_grid.find({gx, gy});
         if (it == small_grid.end()) continue;
         for (const Mark* m : it->second) {
@@ -401,10 +441,14 @@ TextResult DetectTextSegments(const InkComponents& ink, const FeaturesOptions& o
           const double base = trend(m->along_mid());
           const double c0 = m->c0 - base, c1 = m->c1 - base, c = 0.5 * (c0 + c1);
           if (c < t - 0.9 * x || c > b + 0.9 * x) continue;
-          if (c1 < t + 0.1 * x) ++dots_plus;        // a dot above the band (-n side)
-          else if (c0 > b - 0.1 * x) ++dots_minus;  // a dot beyond the +n side
-          else if (c1 >= b - 0.25 * x && c0 > t + 0.4 * x) ++dots_plus;   // a period on +n
-          else if (c0 <= t + 0.25 * x && c1 < b - 0.4 * x) ++dots_minus;  // a period on -n
+          if (c1 < t + 0.1 * x)
+            ++dots_plus;  // a dot above the band (-n side)
+          else if (c0 > b - 0.1 * x)
+            ++dots_minus;  // a dot beyond the +n side
+          else if (c1 >= b - 0.25 * x && c0 > t + 0.4 * x)
+            ++dots_plus;  // a period on +n
+          else if (c0 <= t + 0.25 * x && c1 < b - 0.4 * x)
+            ++dots_minus;  // a period on -n
         }
       }
   }
@@ -413,12 +457,16 @@ TextResult DetectTextSegments(const InkComponents& ink, const FeaturesOptions& o
   result.dots_upright = dots_plus;
   result.dots_upside_down = dots_minus;
   // -1: baseline on -n, +1: on +n, 0: unclear.
-  const int by_stray = stray_minus > 1.15 * stray_plus ? 1 : stray_plus > 1.15 * stray_minus ? -1 : 0;
+  const int by_stray = stray_minus > 1.15 * stray_plus   ? 1
+                       : stray_plus > 1.15 * stray_minus ? -1
+                                                         : 0;
   const int dots = dots_plus + dots_minus;
-  const int by_dots = dots >= 5 && dots_plus >= 0.75 * dots ? 1
-                      : dots >= 5 && dots_minus >= 0.75 * dots ? -1 : 0;
+  const int by_dots = dots >= 5 && dots_plus >= 0.75 * dots    ? 1
+                      : dots >= 5 && dots_minus >= 0.75 * dots ? -1
+                                                               : 0;
   const int side = by_stray != 0 && by_dots != 0 && by_stray != by_dots ? 0
-                   : by_stray != 0 ? by_stray : by_dots;
+                   : by_stray != 0                                      ? by_stray
+                                                                        : by_dots;
   const double sign = side < 0 ? -1.0 : 1.0;
   result.orientation_known = side != 0;
   if (side != 0) result.down = sign * n;
@@ -464,7 +512,8 @@ TextResult DetectTextSegments(const InkComponents& ink, const FeaturesOptions& o
       for (int k = first; k <= last; ++k)
         if (std::abs(noise[size_t(k)]) <= 0.5 * tolerance) piece.push_back(kept[size_t(k)]);
       int characters = 0;
-      for (int k = first; k <= last; ++k) characters += k == first || kept_mark[size_t(k)] != kept_mark[size_t(k - 1)];
+      for (int k = first; k <= last; ++k)
+        characters += k == first || kept_mark[size_t(k)] != kept_mark[size_t(k - 1)];
       if (piece.size() < 5 || characters < 3) continue;
       const LineFit fit = FitLine(piece);
       if (fit.rms > 0.5 * tolerance) continue;

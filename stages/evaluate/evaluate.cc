@@ -4,9 +4,8 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
-#include <sstream>
-
 #include <opencv2/imgproc.hpp>
+#include <sstream>
 
 #include "common/atomic_file.h"
 #include "common/camera.h"
@@ -51,8 +50,8 @@ Json SizeJson(cv::Size s) { return Json::array({s.width, s.height}); }
 Json Skipped(const std::string& why) { return Json{{"skipped", why}}; }
 
 // OCR of the ground truth, from the cache when it holds this file's text.
-std::string GroundTruthText(Ocr& ocr, const fs::path& flat, const fs::path& work,
-                            bool use_cache, bool* from_cache) {
+std::string GroundTruthText(Ocr& ocr, const fs::path& flat, const fs::path& work, bool use_cache,
+                            bool* from_cache) {
   *from_cache = false;
   if (!use_cache || work.empty()) return ocr.RecognizeFile(flat);
   const fs::path cache =
@@ -87,15 +86,13 @@ Json EvaluateOcr(const EvaluateInputs& in, const EvaluateOptions& options,
   Ocr ocr(options.ocr_language);
   bool cached = false;
   const fs::path flat = in.data / "ground_truth" / "flat.png";
-  const std::string reference =
-      GroundTruthText(ocr, flat, in.work, options.ocr_cache, &cached);
+  const std::string reference = GroundTruthText(ocr, flat, in.work, options.ocr_cache, &cached);
   const bool resize = options.ocr_at_truth_size && result_image.size() != truth_size;
   std::string result;
   if (resize) {
     cv::Mat resized;
     const bool enlarge = truth_size.area() > result_image.size().area();
-    cv::resize(result_image, resized, truth_size, 0, 0,
-               enlarge ? cv::INTER_CUBIC : cv::INTER_AREA);
+    cv::resize(result_image, resized, truth_size, 0, 0, enlarge ? cv::INTER_CUBIC : cv::INTER_AREA);
     result = ocr.RecognizeImage(resized);
   } else {
     result = ocr.RecognizeFile(in.result);
@@ -143,8 +140,7 @@ double PageDiagonal(const fs::path& page_json) {
   return std::hypot(w, h);
 }
 
-Json EvaluateGeometry(const EvaluateInputs& in, const EvaluateOptions& options,
-                      Metrics* m) {
+Json EvaluateGeometry(const EvaluateInputs& in, const EvaluateOptions& options, Metrics* m) {
   const fs::path gt = in.data / "ground_truth";
   std::error_code ec;
   fs::path mesh_dir = options.mesh_dir;
@@ -178,27 +174,28 @@ Json EvaluateGeometry(const EvaluateInputs& in, const EvaluateOptions& options,
     out["surface_distance"] = Skipped(why);
   } else {
     const SurfaceDistance surface(truth.vertices, Triangulate(truth.faces));
-    const DistanceStats d =
-        MeshToSurface(mesh3d.vertices, alignment->truth_from_sfm, surface);
+    const DistanceStats d = MeshToSurface(mesh3d.vertices, alignment->truth_from_sfm, surface);
     m->surface_mean_pct = 100 * d.mean / diagonal;
     m->surface_max_pct = 100 * d.max / diagonal;
-    out["alignment"] = {
-        {"method", "similarity (Eigen::umeyama) of the camera centres of "
-                   "10_sfm/cameras.json onto ground_truth/cameras.json"},
-        {"cameras", alignment->cameras},
-        {"scale", alignment->truth_from_sfm.scale},
-        {"residual_pct", 100 * alignment->rms_residual / diagonal}};
+    out["alignment"] = {{"method",
+                         "similarity (Eigen::umeyama) of the camera centres of "
+                         "10_sfm/cameras.json onto ground_truth/cameras.json"},
+                        {"cameras", alignment->cameras},
+                        {"scale", alignment->truth_from_sfm.scale},
+                        {"residual_pct", 100 * alignment->rms_residual / diagonal}};
     out["surface_distance"] = {{"mean_pct", NumberOrNull(m->surface_mean_pct)},
                                {"max_pct", NumberOrNull(m->surface_max_pct)},
                                {"vertices", d.samples}};
   }
   if (fs::is_regular_file(mesh_dir / "mesh2d.ply", ec)) {
     const PlyData mesh2d = ReadPly(mesh_dir / "mesh2d.ply");
-    const IsometryStats iso = IsometryError(
-        mesh3d, mesh2d, (mesh_dir / "mesh3d.ply").string() + " and mesh2d.ply");
+    const IsometryStats iso =
+        IsometryError(mesh3d, mesh2d, (mesh_dir / "mesh3d.ply").string() + " and mesh2d.ply");
     m->isometry_mean = iso.mean;
     m->isometry_max = iso.max;
-    out["isometry"] = {{"mean", iso.mean}, {"max", iso.max}, {"edges", iso.edges},
+    out["isometry"] = {{"mean", iso.mean},
+                       {"max", iso.max},
+                       {"edges", iso.edges},
                        {"definition", "|edge length in M - in M'| / length in M'"}};
   } else {
     out["isometry"] = Skipped("no mesh2d.ply beside mesh3d.ply");
@@ -244,8 +241,9 @@ EvaluateResult Run(const EvaluateInputs& in, const EvaluateOptions& options) {
     m.ld = flow.ld;
     m.li_d = flow.li_d;
     seconds["flow"] = SecondsSince(t);
-    flow_json = {{"method", "DeepFlow (OpenCV contrib optflow), a stand-in for "
-                            "the SIFT flow of the literature"},
+    flow_json = {{"method",
+                  "DeepFlow (OpenCV contrib optflow), a stand-in for "
+                  "the SIFT flow of the literature"},
                  {"size", SizeJson(flow.size)},
                  {"units", "pixels at the flow size (half the MS-SSIM size)"},
                  {"ld", flow.ld},

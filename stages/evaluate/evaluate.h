@@ -17,9 +17,9 @@ namespace fs = std::filesystem;
 
 struct EvaluateOptions {
   std::string method = "docunfold";  // label of the row in the benchmark
-  bool ocr = true;       // CER, ED, WER with Tesseract (the slowest part, ~seconds)
-  bool flow = true;      // LD, Li-D with DeepFlow (~seconds)
-  bool geometry = true;  // surface distance and isometry error, when possible
+  bool ocr = true;                   // CER, ED, WER with Tesseract (the slowest part, ~seconds)
+  bool flow = true;                  // LD, Li-D with DeepFlow (~seconds)
+  bool geometry = true;              // surface distance and isometry error, when possible
   // Meshes to measure; empty = <work>/50_optimize, else <work>/40_init.
   fs::path mesh_dir;
   // Keep the OCR text of flat.png in <work>/70_eval/ocr-cache/, keyed by a

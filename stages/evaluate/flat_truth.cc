@@ -1,12 +1,11 @@
 // LinesFromFlatScan (ground_truth.h): the true lines of a page read off its
 // flat scan.
-#include "stages/evaluate/ground_truth.h"
-
 #include <algorithm>
 #include <cmath>
-
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+
+#include "stages/evaluate/ground_truth.h"
 
 namespace docunfold::evaluate {
 namespace {
@@ -33,8 +32,10 @@ void AddRules(const cv::Mat1b& ink, bool transposed, double min_length, double m
     const double x0 = stats(i, cv::CC_STAT_LEFT) - 0.5, x1 = x0 + w;
     const double y = centroids(i, 1);
     TrueLine line{"rule", {}};
-    if (transposed) line.points = {{y, x0}, {y, x1}};
-    else line.points = {{x0, y}, {x1, y}};
+    if (transposed)
+      line.points = {{y, x0}, {y, x1}};
+    else
+      line.points = {{x0, y}, {x1, y}};
     out->push_back(line);
   }
 }
@@ -42,8 +43,8 @@ void AddRules(const cv::Mat1b& ink, bool transposed, double min_length, double m
 }  // namespace
 
 std::vector<TrueLine> LinesFromFlatScan(const GroundTruth& gt) {
-  cv::Mat1b grey = cv::imread((gt.root / "ground_truth" / "flat.png").string(),
-                              cv::IMREAD_GRAYSCALE);
+  cv::Mat1b grey =
+      cv::imread((gt.root / "ground_truth" / "flat.png").string(), cv::IMREAD_GRAYSCALE);
   std::vector<TrueLine> out;
   if (grey.empty()) return out;
   const cv::Mat1b ink = grey < 128;
@@ -58,7 +59,9 @@ std::vector<TrueLine> LinesFromFlatScan(const GroundTruth& gt) {
   cv::Mat1i labels, stats;
   cv::Mat1d centroids;
   const int n = cv::connectedComponentsWithStats(ink, labels, stats, centroids, 8);
-  struct Char { double x0, x1, y0, y1; };
+  struct Char {
+    double x0, x1, y0, y1;
+  };
   std::vector<Char> chars;
   for (int i = 1; i < n; ++i) {
     const int w = stats(i, cv::CC_STAT_WIDTH), h = stats(i, cv::CC_STAT_HEIGHT);

@@ -16,16 +16,13 @@ namespace {
 
 using Polyline = std::vector<Eigen::Vector2d>;
 
-double DistanceToPolylines(const Eigen::Vector2d& p,
-                           const std::vector<Polyline>& lines) {
+double DistanceToPolylines(const Eigen::Vector2d& p, const std::vector<Polyline>& lines) {
   double best = std::numeric_limits<double>::infinity();
   for (const Polyline& l : lines)
     for (size_t i = 0; i + 1 < l.size(); ++i) {
       const Eigen::Vector2d a = l[i], d = l[i + 1] - l[i];
       const double t =
-          d.squaredNorm() > 0
-              ? std::clamp((p - a).dot(d) / d.squaredNorm(), 0.0, 1.0)
-              : 0.0;
+          d.squaredNorm() > 0 ? std::clamp((p - a).dot(d) / d.squaredNorm(), 0.0, 1.0) : 0.0;
       best = std::min(best, (a + t * d - p).norm());
     }
   return best;
@@ -40,8 +37,7 @@ void WalkPolyline(const Polyline& line, double step_px, Visit visit) {
   for (size_t k = 0; k + 1 < line.size(); ++k) {
     const Eigen::Vector2d a = line[k], d = line[k + 1] - line[k];
     const int steps = std::max(1, int(std::ceil(d.norm() / step_px)));
-    for (int j = 0; j < steps; ++j)
-      visit(a + d * ((j + 0.5) / steps), d.norm() / steps);
+    for (int j = 0; j < steps; ++j) visit(a + d * ((j + 0.5) / steps), d.norm() / steps);
   }
 }
 
@@ -66,10 +62,8 @@ void SegmentIndex::AddPolyline(const std::vector<Eigen::Vector2d>& points) {
 void SegmentIndex::Add(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
   const int id = int(segments_.size());
   segments_.push_back({a, b});
-  const int x0 = Cell(std::min(a.x(), b.x())),
-            x1 = Cell(std::max(a.x(), b.x()));
-  const int y0 = Cell(std::min(a.y(), b.y())),
-            y1 = Cell(std::max(a.y(), b.y()));
+  const int x0 = Cell(std::min(a.x(), b.x())), x1 = Cell(std::max(a.x(), b.x()));
+  const int y0 = Cell(std::min(a.y(), b.y())), y1 = Cell(std::max(a.y(), b.y()));
   for (int y = y0; y <= y1; ++y)
     for (int x = x0; x <= x1; ++x) grid_[{x, y}].push_back(id);
 }
@@ -85,9 +79,7 @@ double SegmentIndex::Distance(const Eigen::Vector2d& p) const {
         const auto& [a, b] = segments_[size_t(id)];
         const Eigen::Vector2d d = b - a;
         const double t =
-            d.squaredNorm() > 0
-                ? std::clamp((p - a).dot(d) / d.squaredNorm(), 0.0, 1.0)
-                : 0.0;
+            d.squaredNorm() > 0 ? std::clamp((p - a).dot(d) / d.squaredNorm(), 0.0, 1.0) : 0.0;
         best = std::min(best, (a + t * d - p).norm());
       }
     }
@@ -107,22 +99,20 @@ TruthInView SeeTruth(const GroundTruth& gt, const PinholeCamera& camera) {
   with_lines.lines = TruthLines(gt);
   t.lines = TrueLinesInView(with_lines, camera, 2.0);
   for (const Eigen::Vector2d& c : t.corners)
-    t.page_cut = t.page_cut || c.x() < 0 || c.y() < 0 ||
-                 c.x() > camera.width - 1 || c.y() > camera.height - 1;
+    t.page_cut = t.page_cut || c.x() < 0 || c.y() < 0 || c.x() > camera.width - 1 ||
+                 c.y() > camera.height - 1;
   return t;
 }
 
 bool Undistortion::Any() const {
-  return std::any_of(coefficients.begin(), coefficients.end(),
-                     [](double c) { return c != 0; });
+  return std::any_of(coefficients.begin(), coefficients.end(), [](double c) { return c != 0; });
 }
 
 TruthInView Undistort(const TruthInView& truth, const Undistortion& lens) {
   if (!lens.Any()) return truth;
   const cv::Mat K = ToCvK(lens.K);
-  const cv::Mat dist =
-      (cv::Mat_<double>(1, 4) << lens.coefficients[0], lens.coefficients[1],
-       lens.coefficients[2], lens.coefficients[3]);
+  const cv::Mat dist = (cv::Mat_<double>(1, 4) << lens.coefficients[0], lens.coefficients[1],
+                        lens.coefficients[2], lens.coefficients[3]);
   auto move = [&](const Polyline& in) {
     if (in.empty()) return in;
     std::vector<cv::Point2d> from, to;
@@ -135,15 +125,11 @@ TruthInView Undistort(const TruthInView& truth, const Undistortion& lens) {
   TruthInView t = truth;
   // The same map sfm's UndistortPhoto applies to the photo.
   cv::Mat map1, map2;
-  cv::initUndistortRectifyMap(K, dist, cv::Mat(), K, truth.page.size(),
-                              CV_32FC1, map1, map2);
-  cv::remap(truth.page, t.page, map1, map2, cv::INTER_NEAREST,
-            cv::BORDER_CONSTANT);
-  const Polyline corners =
-      move(Polyline(truth.corners.begin(), truth.corners.end()));
+  cv::initUndistortRectifyMap(K, dist, cv::Mat(), K, truth.page.size(), CV_32FC1, map1, map2);
+  cv::remap(truth.page, t.page, map1, map2, cv::INTER_NEAREST, cv::BORDER_CONSTANT);
+  const Polyline corners = move(Polyline(truth.corners.begin(), truth.corners.end()));
   std::copy(corners.begin(), corners.end(), t.corners.begin());
-  t.diagonal = 0.5 * ((t.corners[2] - t.corners[0]).norm() +
-                      (t.corners[3] - t.corners[1]).norm());
+  t.diagonal = 0.5 * ((t.corners[2] - t.corners[0]).norm() + (t.corners[3] - t.corners[1]).norm());
   for (Polyline& piece : t.outline) piece = move(piece);
   for (TrueLine& line : t.lines) line.points = move(line.points);
   return t;
@@ -158,8 +144,7 @@ bool BoundaryFigures::SidesHold() const {
   // side may stray up to three times the tolerance.
   const double tol = kCornerTolerance * diagonal_px;
   return corner_hidden ||
-         (real_off_edge_px <= tol && real_off_edge_max_px <= 3 * tol &&
-          edge_recall >= 0.9);
+         (real_off_edge_px <= tol && real_off_edge_max_px <= 3 * tol && edge_recall >= 0.9);
 }
 
 BoundaryFigures MeasureBoundary(const TruthInView& truth, const cv::Mat1b& mask,
@@ -168,8 +153,7 @@ BoundaryFigures MeasureBoundary(const TruthInView& truth, const cv::Mat1b& mask,
   if (mask.size() != truth.page.size())
     throw InputError("boundary mask is " + std::to_string(mask.cols) + "x" +
                      std::to_string(mask.rows) + ", the reference view " +
-                     std::to_string(truth.width) + "x" +
-                     std::to_string(truth.height));
+                     std::to_string(truth.width) + "x" + std::to_string(truth.height));
   const cv::Mat1b detected = mask > 0;
   const double inter = cv::countNonZero(detected & truth.page);
   const double uni = cv::countNonZero(detected | truth.page);
@@ -181,16 +165,14 @@ BoundaryFigures MeasureBoundary(const TruthInView& truth, const cv::Mat1b& mask,
     double best = std::numeric_limits<double>::infinity();
     int best_j = -1;
     for (int j = 0; j < 4; ++j) {
-      const double d =
-          (boundary.corners[size_t(j)] - truth.corners[size_t(i)]).norm();
+      const double d = (boundary.corners[size_t(j)] - truth.corners[size_t(i)]).norm();
       if (d < best) {
         best = d;
         best_j = j;
       }
     }
     if (i == 0) nearest_to_tl = best_j;
-    f.corner_hidden =
-        f.corner_hidden || truth.corner_views[size_t(i)] == CornerView::kHidden;
+    f.corner_hidden = f.corner_hidden || truth.corner_views[size_t(i)] == CornerView::kHidden;
     if (truth.corner_views[size_t(i)] == CornerView::kVisible) {
       f.worst_corner_px = std::max(f.worst_corner_px, best);
       ++f.corners_seen;
@@ -215,18 +197,15 @@ BoundaryFigures MeasureBoundary(const TruthInView& truth, const cv::Mat1b& mask,
   }
   double covered = 0, total = 0;
   for (const Polyline& piece : truth.outline)
-    WalkPolyline(
-        piece, kEverySegment, [&](const Eigen::Vector2d& m, double length) {
-          total += length;
-          if (DistanceToPolylines(m, real) <= kCornerTolerance * f.diagonal_px)
-            covered += length;
-        });
+    WalkPolyline(piece, kEverySegment, [&](const Eigen::Vector2d& m, double length) {
+      total += length;
+      if (DistanceToPolylines(m, real) <= kCornerTolerance * f.diagonal_px) covered += length;
+    });
   f.edge_recall = Share(covered, total, 0);
   return f;
 }
 
-LineFigures MeasureLines(const TruthInView& truth,
-                         const std::vector<FeatureSegment>& segments) {
+LineFigures MeasureLines(const TruthInView& truth, const std::vector<FeatureSegment>& segments) {
   SegmentIndex true_text(8), true_edge(8), found_text(8), found_edge(8);
   for (const TrueLine& l : truth.lines)
     (l.kind == "text" ? true_text : true_edge).AddPolyline(l.points);
@@ -237,8 +216,7 @@ LineFigures MeasureLines(const TruthInView& truth,
     (text ? f.text_segments : f.edge_segments)++;
     (text ? found_text : found_edge).AddPolyline(s.points);
     WalkPolyline(s.points, 1.0, [&](const Eigen::Vector2d& p, double length) {
-      const bool good =
-          (text ? true_text : true_edge).Distance(p) <= kLineTolerancePx;
+      const bool good = (text ? true_text : true_edge).Distance(p) <= kLineTolerancePx;
       (text ? all_text : all_edge) += length;
       (text ? good_text : good_edge) += good ? length : 0.0;
     });
@@ -249,27 +227,21 @@ LineFigures MeasureLines(const TruthInView& truth,
   f.precision = Share(good_text + good_edge, f.detected_length, 1);
   // Recall inside the region detect-features searches by default: the page
   // less a margin of 0.6 % of the image diagonal (at least 4 px).
-  const int margin = std::max(
-      4, int(std::lround(0.006 * std::hypot(truth.width, truth.height))));
+  const int margin = std::max(4, int(std::lround(0.006 * std::hypot(truth.width, truth.height))));
   cv::Mat1b region;
   cv::erode(truth.page, region,
-            cv::getStructuringElement(
-                cv::MORPH_ELLIPSE, cv::Size(2 * margin + 1, 2 * margin + 1)));
+            cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * margin + 1, 2 * margin + 1)));
   double covered_text = 0, length_text = 0, covered_rule = 0, length_rule = 0;
   for (const TrueLine& l : truth.lines) {
     if (l.kind == "border") continue;
     const bool text = l.kind == "text";
-    WalkPolyline(
-        l.points, kEverySegment, [&](const Eigen::Vector2d& m, double length) {
-          const int x = int(std::lround(m.x())), y = int(std::lround(m.y()));
-          if (x < 0 || y < 0 || x >= region.cols || y >= region.rows ||
-              !region(y, x))
-            return;
-          const bool covered =
-              (text ? found_text : found_edge).Distance(m) <= kLineTolerancePx;
-          (text ? length_text : length_rule) += length;
-          (text ? covered_text : covered_rule) += covered ? length : 0.0;
-        });
+    WalkPolyline(l.points, kEverySegment, [&](const Eigen::Vector2d& m, double length) {
+      const int x = int(std::lround(m.x())), y = int(std::lround(m.y()));
+      if (x < 0 || y < 0 || x >= region.cols || y >= region.rows || !region(y, x)) return;
+      const bool covered = (text ? found_text : found_edge).Distance(m) <= kLineTolerancePx;
+      (text ? length_text : length_rule) += length;
+      (text ? covered_text : covered_rule) += covered ? length : 0.0;
+    });
   }
   f.true_length = length_text + length_rule;
   f.recall_text = Share(covered_text, length_text, 0);
@@ -318,18 +290,17 @@ FrontEndResult RunFrontEnd(const FrontEndInputs& in) {
   const CameraSet cameras = ReadCameras(cameras_file);
   const PinholeCamera* ours = cameras.Find(cameras.reference);
   if (!ours)
-    throw InputError(cameras_file.string() + ": the reference view " +
-                     cameras.reference + " is not among the views");
+    throw InputError(cameras_file.string() + ": the reference view " + cameras.reference +
+                     " is not among the views");
   const GroundTruth gt = LoadGroundTruth(in.data);
   const PinholeCamera* photo = gt.cameras.Find(cameras.reference);
   if (!photo)
-    throw InputError((in.data / "ground_truth" / "cameras.json").string() +
-                     ": no view " + cameras.reference + " (sfm's reference)");
+    throw InputError((in.data / "ground_truth" / "cameras.json").string() + ": no view " +
+                     cameras.reference + " (sfm's reference)");
   if (photo->width != ours->width || photo->height != ours->height)
-    throw InputError(cameras_file.string() + ": reference " +
-                     cameras.reference + " is " + std::to_string(ours->width) +
-                     "x" + std::to_string(ours->height) + ", its true camera " +
-                     std::to_string(photo->width) + "x" +
+    throw InputError(cameras_file.string() + ": reference " + cameras.reference + " is " +
+                     std::to_string(ours->width) + "x" + std::to_string(ours->height) +
+                     ", its true camera " + std::to_string(photo->width) + "x" +
                      std::to_string(photo->height));
   // reference.png is the photo undistorted by sfm's lens with sfm's K kept;
   // the truth seen by the photo's true camera moves the same way, so the
@@ -362,8 +333,7 @@ FrontEndResult RunFrontEnd(const FrontEndInputs& in) {
   const fs::path mask_file = in.work / "20_boundary" / "mask.png";
   if (fs::exists(boundary_file) || fs::exists(mask_file)) {
     const Boundary boundary = ReadBoundary(boundary_file);
-    const cv::Mat1b mask =
-        ReadDocumentMask(mask_file, truth.width, truth.height);
+    const cv::Mat1b mask = ReadDocumentMask(mask_file, truth.width, truth.height);
     result.has_boundary = true;
     result.boundary = MeasureBoundary(truth, mask, boundary);
     doc["boundary"] = ToJson(result.boundary);
@@ -380,14 +350,11 @@ FrontEndResult RunFrontEnd(const FrontEndInputs& in) {
     doc["features"]["recall_required"] = result.recall_required;
     doc["features"]["holds"] = {
         {"precision", result.lines.precision >= kMinLinePrecision},
-        {"recall",
-         !result.recall_required || result.lines.recall >= kMinLineRecall}};
+        {"recall", !result.recall_required || result.lines.recall >= kMinLineRecall}};
   } else {
     doc["features"] = Json{{"skipped", "no 30_features/features.json"}};
   }
-  doc["seconds"] =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
-          .count();
+  doc["seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   result.document = std::move(doc);
   return result;
 }

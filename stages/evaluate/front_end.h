@@ -24,10 +24,8 @@ namespace docunfold::evaluate {
 
 // Issue 3's figures: what the front end must reach in the reference view.
 inline constexpr double kMinBoundaryIou = 0.97;
-inline constexpr double kCornerTolerance =
-    0.01;  // of the projected page diagonal
-inline constexpr double kLineTolerancePx =
-    2.0;  // a segment point this close is on a line
+inline constexpr double kCornerTolerance = 0.01;  // of the projected page diagonal
+inline constexpr double kLineTolerancePx = 2.0;   // a segment point this close is on a line
 inline constexpr double kMinLinePrecision = 0.95;
 inline constexpr double kMinLineRecall = 0.5;
 
@@ -72,26 +70,20 @@ struct Undistortion {
 TruthInView Undistort(const TruthInView& truth, const Undistortion& lens);
 
 struct BoundaryFigures {
-  double iou = 0;          // detected mask against the true page region
-  double diagonal_px = 0;  // projected page diagonal
-  double worst_corner_px =
-      0;  // over true corners seen: distance to the nearest detected corner
-  int corners_seen = 0;  // true corners inside the image and not hidden
-  bool corner_hidden =
-      false;  // a true corner in the image is hidden by the page
-  bool corners_in_order =
-      false;  // the detected corner nearest the true TL is corners[0]
-  double real_off_edge_px =
-      0;  // 95th percentile distance of real side points from the true edge
+  double iou = 0;                 // detected mask against the true page region
+  double diagonal_px = 0;         // projected page diagonal
+  double worst_corner_px = 0;     // over true corners seen: distance to the nearest detected corner
+  int corners_seen = 0;           // true corners inside the image and not hidden
+  bool corner_hidden = false;     // a true corner in the image is hidden by the page
+  bool corners_in_order = false;  // the detected corner nearest the true TL is corners[0]
+  double real_off_edge_px = 0;    // 95th percentile distance of real side points from the true edge
   double real_off_edge_max_px = 0;
   double edge_recall = 0;  // visible true outline covered by real sides (within
                            // 1 % of the diagonal)
   bool page_cut = false;   // truth: the image border cuts the page
   int sides_not_real = 0;  // detected sides flagged not real
 
-  double WorstCornerFraction() const {
-    return diagonal_px > 0 ? worst_corner_px / diagonal_px : 0;
-  }
+  double WorstCornerFraction() const { return diagonal_px > 0 ? worst_corner_px / diagonal_px : 0; }
   bool IouHolds() const { return iou >= kMinBoundaryIou; }
   // Corners, and real sides that lie on the true edge and cover it. Not
   // judged when a true corner is hidden: the outline's turns are then fold
@@ -99,19 +91,15 @@ struct BoundaryFigures {
   bool CornersHold() const;
   bool SidesHold() const;
   // A cut page has a side flagged not real; a whole page has none.
-  bool CutFlagsHold() const {
-    return page_cut ? sides_not_real >= 1 : sides_not_real == 0;
-  }
-  bool AllHold() const {
-    return IouHolds() && CornersHold() && SidesHold() && CutFlagsHold();
-  }
+  bool CutFlagsHold() const { return page_cut ? sides_not_real >= 1 : sides_not_real == 0; }
+  bool AllHold() const { return IouHolds() && CornersHold() && SidesHold() && CutFlagsHold(); }
 };
 BoundaryFigures MeasureBoundary(const TruthInView& truth, const cv::Mat1b& mask,
                                 const Boundary& boundary);
 
 struct LineFigures {
   double precision = 1, precision_text = 1,
-         precision_edge = 1;  // share of detected length
+         precision_edge = 1;                            // share of detected length
   double recall = 0, recall_text = 0, recall_rule = 0;  // share of true length
   double detected_length = 0, true_length = 0;          // pixels
   int text_segments = 0, edge_segments = 0;
@@ -121,8 +109,7 @@ struct LineFigures {
 // edges). Recall: share of the true text and rule lines' length, inside the
 // page region less detect-features' default margin (0.6 % of the image
 // diagonal), that a segment of the matching kind passes within the tolerance.
-LineFigures MeasureLines(const TruthInView& truth,
-                         const std::vector<FeatureSegment>& segments);
+LineFigures MeasureLines(const TruthInView& truth, const std::vector<FeatureSegment>& segments);
 
 Json ToJson(const BoundaryFigures& f);
 Json ToJson(const LineFigures& f);

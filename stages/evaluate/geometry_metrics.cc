@@ -1,19 +1,17 @@
 #include "stages/evaluate/geometry_metrics.h"
 
-#include <algorithm>
-#include <set>
-#include <utility>
-
 #include <Eigen/Geometry>
 #include <Eigen/SVD>
+#include <algorithm>
 #include <nanoflann.hpp>
+#include <set>
+#include <utility>
 
 #include "common/errors.h"
 
 namespace docunfold::evaluate {
 
-std::optional<CameraAlignment> AlignCameras(const CameraSet& sfm,
-                                            const CameraSet& truth,
+std::optional<CameraAlignment> AlignCameras(const CameraSet& sfm, const CameraSet& truth,
                                             std::string* why_not) {
   std::vector<Eigen::Vector3d> from, to;
   for (const PinholeCamera& camera : sfm.views) {
@@ -25,8 +23,7 @@ std::optional<CameraAlignment> AlignCameras(const CameraSet& sfm,
   const int n = int(from.size());
   if (n < 3) {
     if (why_not)
-      *why_not = std::to_string(n) +
-                 " view(s) in both camera sets; 3 are needed to align";
+      *why_not = std::to_string(n) + " view(s) in both camera sets; 3 are needed to align";
     return std::nullopt;
   }
   Eigen::Matrix3Xd a(3, n), b(3, n);
@@ -36,8 +33,7 @@ std::optional<CameraAlignment> AlignCameras(const CameraSet& sfm,
   }
   // Collinear (or coincident) centres leave the rotation about their line free.
   const Eigen::Matrix3Xd centred = a.colwise() - a.rowwise().mean();
-  const Eigen::Vector3d sv =
-      Eigen::JacobiSVD<Eigen::Matrix3Xd>(centred).singularValues();
+  const Eigen::Vector3d sv = Eigen::JacobiSVD<Eigen::Matrix3Xd>(centred).singularValues();
   if (sv(0) <= 0 || sv(1) < 1e-3 * sv(0)) {
     if (why_not) *why_not = "camera centres are collinear; cannot align";
     return std::nullopt;
@@ -50,8 +46,7 @@ std::optional<CameraAlignment> AlignCameras(const CameraSet& sfm,
   out.truth_from_sfm.R = sr / out.truth_from_sfm.scale;
   out.truth_from_sfm.t = m.topRightCorner<3, 1>();
   double sq = 0;
-  for (int i = 0; i < n; ++i)
-    sq += (out.truth_from_sfm(from[i]) - to[i]).squaredNorm();
+  for (int i = 0; i < n; ++i) sq += (out.truth_from_sfm(from[i]) - to[i]).squaredNorm();
   out.rms_residual = std::sqrt(sq / n);
   return out;
 }
@@ -66,14 +61,12 @@ double PointTriangleDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
   const double d3 = ab.dot(bp), d4 = ac.dot(bp);
   if (d3 >= 0 && d4 <= d3) return bp.norm();
   const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0)
-    return (p - (a + ab * (d1 / (d1 - d3)))).norm();
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return (p - (a + ab * (d1 / (d1 - d3)))).norm();
   const Eigen::Vector3d cp = p - c;
   const double d5 = ab.dot(cp), d6 = ac.dot(cp);
   if (d6 >= 0 && d5 <= d6) return cp.norm();
   const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0)
-    return (p - (a + ac * (d2 / (d2 - d6)))).norm();
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return (p - (a + ac * (d2 / (d2 - d6)))).norm();
   const double va = d3 * d6 - d5 * d4;
   if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
     return (p - (b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6))))).norm();
@@ -90,10 +83,12 @@ struct SurfaceDistance::Index {
     size_t kdtree_get_point_count() const { return points->size(); }
     double kdtree_get_pt(size_t i, size_t dim) const { return (*points)[i][dim]; }
     template <class Box>
-    bool kdtree_get_bbox(Box&) const { return false; }
+    bool kdtree_get_bbox(Box&) const {
+      return false;
+    }
   };
-  using Tree = nanoflann::KDTreeSingleIndexAdaptor<
-      nanoflann::L2_Simple_Adaptor<double, Cloud>, Cloud, 3, size_t>;
+  using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, Cloud>,
+                                                   Cloud, 3, size_t>;
   Cloud cloud;
   Tree tree;
   explicit Index(const std::vector<Eigen::Vector3d>* points)
@@ -118,22 +113,20 @@ double SurfaceDistance::operator()(const Eigen::Vector3d& point) const {
   constexpr size_t kNeighbours = 12;
   std::array<size_t, kNeighbours> ids{};
   std::array<double, kNeighbours> sq{};
-  const size_t found =
-      index_->tree.knnSearch(point.data(), kNeighbours, ids.data(), sq.data());
+  const size_t found = index_->tree.knnSearch(point.data(), kNeighbours, ids.data(), sq.data());
   double best = found > 0 ? std::sqrt(sq[0]) : std::numeric_limits<double>::infinity();
   for (size_t k = 0; k < found; ++k) {
     for (int f : triangles_of_vertex_[ids[k]]) {
       const auto& t = triangles_[f];
-      best = std::min(best, PointTriangleDistance(point, vertices_[t[0]],
-                                                  vertices_[t[1]], vertices_[t[2]]));
+      best = std::min(
+          best, PointTriangleDistance(point, vertices_[t[0]], vertices_[t[1]], vertices_[t[2]]));
     }
   }
   return best;
 }
 
 DistanceStats MeshToSurface(const std::vector<Eigen::Vector3d>& vertices,
-                            const Similarity& transform,
-                            const SurfaceDistance& surface) {
+                            const Similarity& transform, const SurfaceDistance& surface) {
   DistanceStats s;
   double sum = 0;
   for (const Eigen::Vector3d& v : vertices) {
@@ -148,10 +141,8 @@ DistanceStats MeshToSurface(const std::vector<Eigen::Vector3d>& vertices,
 
 IsometryStats IsometryError(const PlyData& mesh3d, const PlyData& mesh2d,
                             const std::string& names_for_errors) {
-  if (mesh3d.vertices.size() != mesh2d.vertices.size() ||
-      mesh3d.faces != mesh2d.faces)
-    throw InputError(names_for_errors +
-                     ": meshes do not share vertices and faces");
+  if (mesh3d.vertices.size() != mesh2d.vertices.size() || mesh3d.faces != mesh2d.faces)
+    throw InputError(names_for_errors + ": meshes do not share vertices and faces");
   std::set<std::pair<int, int>> edges;
   for (const auto& face : mesh3d.faces)
     for (size_t k = 0; k < face.size(); ++k) {
@@ -163,8 +154,7 @@ IsometryStats IsometryError(const PlyData& mesh3d, const PlyData& mesh2d,
   for (const auto& [a, b] : edges) {
     const double flat = (mesh2d.vertices[a] - mesh2d.vertices[b]).norm();
     if (flat <= 0) continue;  // a collapsed flat edge has no relative error
-    const double error =
-        std::abs((mesh3d.vertices[a] - mesh3d.vertices[b]).norm() - flat) / flat;
+    const double error = std::abs((mesh3d.vertices[a] - mesh3d.vertices[b]).norm() - flat) / flat;
     sum += error;
     s.max = std::max(s.max, error);
     ++s.edges;

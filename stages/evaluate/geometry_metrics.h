@@ -3,13 +3,12 @@
 // through the cameras, and the isometry error between M and its flat twin M'.
 #pragma once
 
+#include <Eigen/Core>
 #include <array>
 #include <memory>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "common/camera.h"
 #include "common/ply.h"
@@ -21,22 +20,19 @@ struct Similarity {
   double scale = 1;
   Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
   Eigen::Vector3d t = Eigen::Vector3d::Zero();
-  Eigen::Vector3d operator()(const Eigen::Vector3d& x) const {
-    return scale * (R * x) + t;
-  }
+  Eigen::Vector3d operator()(const Eigen::Vector3d& x) const { return scale * (R * x) + t; }
 };
 
 struct CameraAlignment {
   Similarity truth_from_sfm;
-  int cameras = 0;            // views present in both sets
-  double rms_residual = 0;    // of the camera centres, in truth units
+  int cameras = 0;          // views present in both sets
+  double rms_residual = 0;  // of the camera centres, in truth units
 };
 
 // Similarity (Eigen::umeyama) taking the camera centres of `sfm` onto those of
 // `truth`, matched by image name. Needs three views in both whose centres are
 // not collinear; otherwise returns nullopt and says why in `why_not`.
-std::optional<CameraAlignment> AlignCameras(const CameraSet& sfm,
-                                            const CameraSet& truth,
+std::optional<CameraAlignment> AlignCameras(const CameraSet& sfm, const CameraSet& truth,
                                             std::string* why_not);
 
 // Unsigned distance from points to a triangle mesh. Candidate triangles are
@@ -45,8 +41,7 @@ std::optional<CameraAlignment> AlignCameras(const CameraSet& sfm,
 // dense); for a far-away point it is an upper bound close to the truth.
 class SurfaceDistance {
  public:
-  SurfaceDistance(std::vector<Eigen::Vector3d> vertices,
-                  std::vector<std::array<int, 3>> triangles);
+  SurfaceDistance(std::vector<Eigen::Vector3d> vertices, std::vector<std::array<int, 3>> triangles);
   ~SurfaceDistance();
   double operator()(const Eigen::Vector3d& point) const;
 
@@ -69,8 +64,7 @@ struct DistanceStats {
 };
 // Distances from every vertex of `mesh` (after `transform`) to `surface`.
 DistanceStats MeshToSurface(const std::vector<Eigen::Vector3d>& vertices,
-                            const Similarity& transform,
-                            const SurfaceDistance& surface);
+                            const Similarity& transform, const SurfaceDistance& surface);
 
 struct IsometryStats {
   double mean = 0;  // mean of |len3 - len2| / len2 over the unique edges

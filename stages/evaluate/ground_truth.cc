@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-
 #include <opencv2/imgcodecs.hpp>
 
 #include "common/errors.h"
@@ -52,8 +51,7 @@ GroundTruth LoadGroundTruth(const fs::path& dataset) {
   return gt;
 }
 
-std::optional<Eigen::Vector3d> GroundTruth::SurfacePoint(
-    const Eigen::Vector2d& flat_px) const {
+std::optional<Eigen::Vector3d> GroundTruth::SurfacePoint(const Eigen::Vector2d& flat_px) const {
   if (st_scale_ == 0) {
     // Rasterize the mesh in flat.png pixel space once; depth is irrelevant.
     st_scale_ = 1.0;
@@ -115,8 +113,7 @@ cv::Mat1b TruePageMask(const GroundTruth& gt, const PinholeCamera& camera) {
   return gt.ViewRaster(camera).face >= 0;
 }
 
-std::array<Eigen::Vector2d, 4> TrueCorners(const GroundTruth& gt,
-                                           const PinholeCamera& camera) {
+std::array<Eigen::Vector2d, 4> TrueCorners(const GroundTruth& gt, const PinholeCamera& camera) {
   // The mesh vertex nearest to each corner of the (s, t) square: grids of
   // ground truth include the corners themselves.
   const Eigen::Vector2d st[4] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
@@ -128,15 +125,17 @@ std::array<Eigen::Vector2d, 4> TrueCorners(const GroundTruth& gt,
     double best_d = 1e300;
     for (size_t v = 0; v < s.size(); ++v) {
       const double d = (Eigen::Vector2d(s[v], t[v]) - st[i]).squaredNorm();
-      if (d < best_d) { best_d = d; best = v; }
+      if (d < best_d) {
+        best_d = d;
+        best = v;
+      }
     }
     out[i] = camera.Project(gt.mesh.vertices[best]);
   }
   return out;
 }
 
-std::vector<TrueLine> TrueLinesInView(const GroundTruth& gt,
-                                      const PinholeCamera& camera,
+std::vector<TrueLine> TrueLinesInView(const GroundTruth& gt, const PinholeCamera& camera,
                                       double step_px) {
   const RasterResult& depth = gt.ViewRaster(camera);
   std::vector<TrueLine> out;

@@ -21,9 +21,8 @@ namespace docunfold::evaluate {
 namespace fs = std::filesystem;
 
 struct TrueLine {
-  std::string kind;  // text, rule or border
-  std::vector<Eigen::Vector2d>
-      points;  // flat.png pixels (image pixels once projected)
+  std::string kind;                     // text, rule or border
+  std::vector<Eigen::Vector2d> points;  // flat.png pixels (image pixels once projected)
 };
 
 struct GroundTruth {
@@ -39,8 +38,7 @@ struct GroundTruth {
 
   double Diagonal() const { return std::hypot(width_m, height_m); }
   // Point of the true surface at flat.png pixel (x, y), if inside the page.
-  std::optional<Eigen::Vector3d> SurfacePoint(
-      const Eigen::Vector2d& flat_px) const;
+  std::optional<Eigen::Vector3d> SurfacePoint(const Eigen::Vector2d& flat_px) const;
 
   // The surface rasterized into `camera`'s image (face ids and depth),
   // kept for the last camera asked: the page mask, corners, outline and
@@ -67,15 +65,13 @@ cv::Mat1b TruePageMask(const GroundTruth& gt, const PinholeCamera& camera);
 
 // The four page corners (top-left, top-right, bottom-right, bottom-left of
 // flat.png) projected into `camera`'s image.
-std::array<Eigen::Vector2d, 4> TrueCorners(const GroundTruth& gt,
-                                           const PinholeCamera& camera);
+std::array<Eigen::Vector2d, 4> TrueCorners(const GroundTruth& gt, const PinholeCamera& camera);
 
 // How a view shows each true corner (TrueCorners order): outside the image
 // (or within `margin_px` of its border), visible, or hidden by the page
 // itself (a flap folded over it).
 enum class CornerView { kOutside, kVisible, kHidden };
-std::array<CornerView, 4> TrueCornersInView(const GroundTruth& gt,
-                                            const PinholeCamera& camera,
+std::array<CornerView, 4> TrueCornersInView(const GroundTruth& gt, const PinholeCamera& camera,
                                             double margin_px = 3.0);
 
 // Mean length of the two diagonals of the true corners in the view.
@@ -84,14 +80,14 @@ double ProjectedDiagonal(const GroundTruth& gt, const PinholeCamera& camera);
 // The page's outline (the border of flat.png carried by the true surface)
 // projected into `camera`, about every `step_px` flat pixels; points outside
 // the image or hidden by the page are left out, so it may be in pieces.
-std::vector<std::vector<Eigen::Vector2d>> TrueOutlineInView(
-    const GroundTruth& gt, const PinholeCamera& camera, double step_px = 2.0);
+std::vector<std::vector<Eigen::Vector2d>> TrueOutlineInView(const GroundTruth& gt,
+                                                            const PinholeCamera& camera,
+                                                            double step_px = 2.0);
 
 // True straight lines of the page (gt.lines) projected into `camera`, sampled
 // about every `step_px` flat pixels; points hidden by the page itself or
 // outside the image are dropped (a line may so split into several pieces).
-std::vector<TrueLine> TrueLinesInView(const GroundTruth& gt,
-                                      const PinholeCamera& camera,
+std::vector<TrueLine> TrueLinesInView(const GroundTruth& gt, const PinholeCamera& camera,
                                       double step_px = 2.0);
 
 // True straight lines of a page read off its flat scan (ground_truth/flat.png)

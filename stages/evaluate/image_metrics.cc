@@ -1,22 +1,19 @@
 #include "stages/evaluate/image_metrics.h"
 
 #include <cmath>
-#include <stdexcept>
-
 #include <opencv2/imgproc.hpp>
 #include <opencv2/optflow.hpp>
+#include <stdexcept>
 
 namespace docunfold::evaluate {
 
 cv::Mat1b MatlabGrey(const cv::Mat& image) {
-  if (image.depth() != CV_8U)
-    throw std::invalid_argument("MatlabGrey: 8-bit image expected");
+  if (image.depth() != CV_8U) throw std::invalid_argument("MatlabGrey: 8-bit image expected");
   if (image.channels() == 1) return image.clone();
   if (image.channels() != 3 && image.channels() != 4)
     throw std::invalid_argument("MatlabGrey: 1, 3 or 4 channels expected");
   // rgb2gray's weights (the inverse of the NTSC YIQ transform's first row).
-  constexpr double kR = 0.298936021293775, kG = 0.587043074451121,
-                   kB = 0.114020904255103;
+  constexpr double kR = 0.298936021293775, kG = 0.587043074451121, kB = 0.114020904255103;
   cv::Mat1b grey(image.size());
   const int channels = image.channels();
   for (int y = 0; y < image.rows; ++y) {
@@ -31,23 +28,18 @@ cv::Mat1b MatlabGrey(const cv::Mat& image) {
 }
 
 cv::Size EvaluationSize(cv::Size ground_truth) {
-  if (ground_truth.area() <= 0)
-    throw std::invalid_argument("EvaluationSize: empty image");
+  if (ground_truth.area() <= 0) throw std::invalid_argument("EvaluationSize: empty image");
   const double scale = std::sqrt(kEvaluationArea / ground_truth.area());
   // MATLAB's imresize(img, scale) gives ceil(scale * size); the tiny epsilon
   // keeps an exact product (scale 1, 0.5) from rounding up by float noise.
-  auto side = [&](int n) {
-    return std::max(1, int(std::ceil(scale * n - 1e-9)));
-  };
+  auto side = [&](int n) { return std::max(1, int(std::ceil(scale * n - 1e-9))); };
   return {side(ground_truth.width), side(ground_truth.height)};
 }
 
-EvaluationPair PrepareEvaluationPair(const cv::Mat& ground_truth_bgr,
-                                     const cv::Mat& result_bgr) {
+EvaluationPair PrepareEvaluationPair(const cv::Mat& ground_truth_bgr, const cv::Mat& result_bgr) {
   const cv::Size size = EvaluationSize(ground_truth_bgr.size());
   EvaluationPair pair;
-  cv::resize(MatlabGrey(ground_truth_bgr), pair.ground_truth, size, 0, 0,
-             cv::INTER_AREA);
+  cv::resize(MatlabGrey(ground_truth_bgr), pair.ground_truth, size, 0, 0, cv::INTER_AREA);
   cv::resize(MatlabGrey(result_bgr), pair.result, size, 0, 0, cv::INTER_AREA);
   return pair;
 }
@@ -74,8 +66,7 @@ double Ssim(const cv::Mat1b& a, const cv::Mat1b& b) {
     for (int c = 0; c < x.cols; ++c) {
       const double ux = mx(r, c), uy = my(r, c);
       const double num = (2 * ux * uy + kC1) * (2 * sxy(r, c) + kC2);
-      const double den =
-          (ux * ux + uy * uy + kC1) * (sxx(r, c) + syy(r, c) + kC2);
+      const double den = (ux * ux + uy * uy + kC1) * (sxx(r, c) + syy(r, c) + kC2);
       sum += num / den;
     }
   }
@@ -116,8 +107,7 @@ FlowResult FlowStatistics(const cv::Mat2f& flow) {
   if (flow.empty()) return out;
   double length_sum = 0;
   for (int r = 0; r < flow.rows; ++r)
-    for (int c = 0; c < flow.cols; ++c)
-      length_sum += std::hypot(flow(r, c)[0], flow(r, c)[1]);
+    for (int c = 0; c < flow.cols; ++c) length_sum += std::hypot(flow(r, c)[0], flow(r, c)[1]);
   out.ld = length_sum / double(flow.total());
   // Sample standard deviation (N - 1), as MATLAB's std().
   auto sample_std = [](double sum, double sum_sq, int n) {
@@ -149,13 +139,11 @@ FlowResult FlowStatistics(const cv::Mat2f& flow) {
   return out;
 }
 
-FlowResult DenseFlowMetrics(const cv::Mat1b& ground_truth,
-                            const cv::Mat1b& result) {
+FlowResult DenseFlowMetrics(const cv::Mat1b& ground_truth, const cv::Mat1b& result) {
   const cv::Size half((ground_truth.cols + 1) / 2, (ground_truth.rows + 1) / 2);
   auto prepare = [&](const cv::Mat1b& image) {
     cv::Mat1b blurred, small;
-    cv::GaussianBlur(image, blurred, cv::Size(7, 7), 1.0, 1.0,
-                     cv::BORDER_REPLICATE);
+    cv::GaussianBlur(image, blurred, cv::Size(7, 7), 1.0, 1.0, cv::BORDER_REPLICATE);
     cv::resize(blurred, small, half, 0, 0, cv::INTER_AREA);
     return small;
   };

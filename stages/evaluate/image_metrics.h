@@ -4,7 +4,6 @@
 #pragma once
 
 #include <array>
-
 #include <opencv2/core.hpp>
 
 namespace docunfold::evaluate {
@@ -27,8 +26,7 @@ struct EvaluationPair {
   cv::Mat1b ground_truth;
   cv::Mat1b result;
 };
-EvaluationPair PrepareEvaluationPair(const cv::Mat& ground_truth_bgr,
-                                     const cv::Mat& result_bgr);
+EvaluationPair PrepareEvaluationPair(const cv::Mat& ground_truth_bgr, const cv::Mat& result_bgr);
 
 // Mean SSIM of two equally sized grey images: 11x11 Gaussian window with
 // sigma 1.5, replicated borders, C1 = (0.01*255)^2, C2 = (0.03*255)^2, mean
@@ -36,8 +34,7 @@ EvaluationPair PrepareEvaluationPair(const cv::Mat& ground_truth_bgr,
 double Ssim(const cv::Mat1b& a, const cv::Mat1b& b);
 
 // DocUNet MS-SSIM weights, finest scale first.
-constexpr std::array<double, 5> kMsSsimWeights = {0.0448, 0.2856, 0.3001,
-                                                  0.2363, 0.1333};
+constexpr std::array<double, 5> kMsSsimWeights = {0.0448, 0.2856, 0.3001, 0.2363, 0.1333};
 
 struct MsSsimResult {
   double value = 0;                // weighted sum of the per-scale SSIM
@@ -53,16 +50,15 @@ struct MsSsimResult {
 MsSsimResult MsSsim(const cv::Mat1b& ground_truth, const cv::Mat1b& result);
 
 struct FlowResult {
-  double ld = 0;   // mean flow length, pixels of the flow resolution
-  double li_d = 0; // 0.5 * (mean over rows of std(v_y) + mean over columns of std(v_x))
-  cv::Size size;   // flow resolution (half the evaluation size)
+  double ld = 0;    // mean flow length, pixels of the flow resolution
+  double li_d = 0;  // 0.5 * (mean over rows of std(v_y) + mean over columns of std(v_x))
+  cv::Size size;    // flow resolution (half the evaluation size)
 };
 // Dense flow from ground truth to result with DeepFlow (opencv_contrib
 // optflow), a stand-in for the SIFT flow of the literature. The inputs are
 // the evaluation-size grey images; like DocUNet's code they are blurred
 // (7x7 Gaussian, sigma 1, replicated borders) and halved before the flow.
-FlowResult DenseFlowMetrics(const cv::Mat1b& ground_truth,
-                            const cv::Mat1b& result);
+FlowResult DenseFlowMetrics(const cv::Mat1b& ground_truth, const cv::Mat1b& result);
 
 // LD and Li-D of a given flow field (CV_32FC2, (v_x, v_y) per pixel).
 FlowResult FlowStatistics(const cv::Mat2f& flow);

@@ -47,7 +47,6 @@ void RunFrontEnd(const evaluate::EvaluateInputs& in, const fs::path& out) {
 
 }  // namespace
 
-
 int main(int argc, char** argv) {
   LimitOpenMpThreads(argv);
   CLI::App app{
@@ -67,8 +66,7 @@ int main(int argc, char** argv) {
   evaluate::EvaluateOptions options;
   fs::path out;
   app.add_option("--data", in.data, "data set folder")->required();
-  app.add_option("--work", in.work,
-                 "work directory (meshes, 10_sfm/cameras.json, OCR cache)");
+  app.add_option("--work", in.work, "work directory (meshes, 10_sfm/cameras.json, OCR cache)");
   app.add_option("--result", in.result, "rectified image to evaluate (not with --front-end)");
   bool front_end = false;
   app.add_flag("--front-end", front_end,
@@ -83,8 +81,7 @@ int main(int argc, char** argv) {
   bool no_ocr = false, no_flow = false, no_geometry = false, no_cache = false;
   app.add_flag("--no-ocr", no_ocr, "skip CER, ED and WER (Tesseract)");
   app.add_flag("--no-flow", no_flow, "skip LD and Li-D (DeepFlow)");
-  app.add_flag("--no-geometry", no_geometry,
-               "skip surface distance and isometry error");
+  app.add_flag("--no-geometry", no_geometry, "skip surface distance and isometry error");
   app.add_flag("--no-ocr-cache", no_cache,
                "always OCR flat.png (default: cache its text in "
                "<work>/70_eval/ocr-cache/)");
@@ -92,8 +89,7 @@ int main(int argc, char** argv) {
                "OCR the result resized to flat.png's size (bicubic up, area "
                "down), so that CER does not depend on the output resolution "
                "(default: OCR the result as it is, as the literature does)");
-  app.add_option("--lang", options.ocr_language, "Tesseract language")
-      ->capture_default_str();
+  app.add_option("--lang", options.ocr_language, "Tesseract language")->capture_default_str();
 
   return RunStage("evaluate", app, argc, argv, [&] {
     options.ocr = !no_ocr;
@@ -128,11 +124,10 @@ int main(int argc, char** argv) {
       return std::string(", ") + name + " " + buf;
     };
     Log(options.method + ": MS-SSIM " + fmt("", m.ms_ssim, "%.4f").substr(3) +
-        fmt("LD", m.ld, "%.2f") + fmt("Li-D", m.li_d, "%.2f") +
-        fmt("CER", m.cer, "%.4f") + fmt("WER", m.wer, "%.4f") +
-        fmt("surface mean %", m.surface_mean_pct, "%.3f") +
+        fmt("LD", m.ld, "%.2f") + fmt("Li-D", m.li_d, "%.2f") + fmt("CER", m.cer, "%.4f") +
+        fmt("WER", m.wer, "%.4f") + fmt("surface mean %", m.surface_mean_pct, "%.3f") +
         fmt("isometry", m.isometry_mean, "%.4f") + " (" +
-        fmt("", r.document["seconds"]["total"].get<double>(), "%.1f").substr(3) +
-        " s) -> " + out.string());
+        fmt("", r.document["seconds"]["total"].get<double>(), "%.1f").substr(3) + " s) -> " +
+        out.string());
   });
 }

@@ -1,13 +1,12 @@
 #include "stages/evaluate/ocr.h"
 
-#include <algorithm>
-#include <stdexcept>
-#include <vector>
-
-#include <opencv2/imgcodecs.hpp>
-
 #include <leptonica/allheaders.h>
 #include <tesseract/baseapi.h>
+
+#include <algorithm>
+#include <opencv2/imgcodecs.hpp>
+#include <stdexcept>
+#include <vector>
 
 #include "common/errors.h"
 
@@ -32,15 +31,13 @@ Ocr::~Ocr() {
 
 std::string Ocr::RecognizeFile(const fs::path& image) {
   Pix* pix = pixRead(image.c_str());
-  if (pix == nullptr)
-    throw InputError(image.string() + ": cannot read image for OCR");
+  if (pix == nullptr) throw InputError(image.string() + ": cannot read image for OCR");
   return Recognize(pix, image.string());
 }
 
 std::string Ocr::RecognizeImage(const cv::Mat& image) {
   std::vector<uchar> png;
-  if (!cv::imencode(".png", image, png))
-    throw std::runtime_error("cannot encode an image for OCR");
+  if (!cv::imencode(".png", image, png)) throw std::runtime_error("cannot encode an image for OCR");
   Pix* pix = pixReadMem(png.data(), png.size());
   if (pix == nullptr) throw std::runtime_error("Leptonica cannot read an encoded image");
   return Recognize(pix, "image in memory");
@@ -59,8 +56,8 @@ std::string Ocr::Recognize(Pix* pix, const std::string& what) {
 }
 
 std::string Ocr::Description() const {
-  return std::string("Tesseract ") + tesseract::TessBaseAPI::Version() + ", " +
-         language_ + ", psm 3";
+  return std::string("Tesseract ") + tesseract::TessBaseAPI::Version() + ", " + language_ +
+         ", psm 3";
 }
 
 }  // namespace docunfold::evaluate

@@ -5,9 +5,8 @@
 
 #include <filesystem>
 #include <memory>
-#include <string>
-
 #include <opencv2/core.hpp>
+#include <string>
 
 struct Pix;  // Leptonica's image
 namespace tesseract {

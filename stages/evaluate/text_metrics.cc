@@ -7,10 +7,9 @@ namespace docunfold::evaluate {
 namespace {
 
 bool IsSpace(char32_t c) {
-  return c == U' ' || c == U'\t' || c == U'\n' || c == U'\r' || c == U'\f' ||
-         c == U'\v' || c == 0x85 || c == 0xA0 || c == 0x1680 ||
-         (c >= 0x2000 && c <= 0x200A) || c == 0x2028 || c == 0x2029 ||
-         c == 0x202F || c == 0x205F || c == 0x3000;
+  return c == U' ' || c == U'\t' || c == U'\n' || c == U'\r' || c == U'\f' || c == U'\v' ||
+         c == 0x85 || c == 0xA0 || c == 0x1680 || (c >= 0x2000 && c <= 0x200A) || c == 0x2028 ||
+         c == 0x2029 || c == 0x202F || c == 0x205F || c == 0x3000;
 }
 
 // One row of the dynamic programme at a time: O(min(n, m)) memory.
@@ -25,8 +24,7 @@ size_t Levenshtein(const Sequence& a, const Sequence& b) {
     row[0] = i;
     for (size_t j = 1; j <= shorter.size(); ++j) {
       const size_t up = row[j];
-      const size_t substitute =
-          diagonal + (longer[i - 1] == shorter[j - 1] ? 0 : 1);
+      const size_t substitute = diagonal + (longer[i - 1] == shorter[j - 1] ? 0 : 1);
       row[j] = std::min({up + 1, row[j - 1] + 1, substitute});
       diagonal = up;
     }
@@ -35,8 +33,7 @@ size_t Levenshtein(const Sequence& a, const Sequence& b) {
 }
 
 double Ratio(size_t num, size_t den) {
-  return den == 0 ? std::numeric_limits<double>::quiet_NaN()
-                  : double(num) / double(den);
+  return den == 0 ? std::numeric_limits<double>::quiet_NaN() : double(num) / double(den);
 }
 
 }  // namespace
@@ -47,10 +44,15 @@ std::u32string Utf8ToCodePoints(const std::string& utf8) {
   size_t i = 0;
   while (i < utf8.size()) {
     const auto byte = static_cast<unsigned char>(utf8[i]);
-    int length = byte < 0x80 ? 1 : (byte >> 5) == 0x6 ? 2 : (byte >> 4) == 0xE ? 3
-                                 : (byte >> 3) == 0x1E ? 4 : 0;
-    char32_t code = length == 1 ? byte : length == 2 ? (byte & 0x1F)
-                                     : length == 3 ? (byte & 0x0F) : (byte & 0x07);
+    int length = byte < 0x80           ? 1
+                 : (byte >> 5) == 0x6  ? 2
+                 : (byte >> 4) == 0xE  ? 3
+                 : (byte >> 3) == 0x1E ? 4
+                                       : 0;
+    char32_t code = length == 1   ? byte
+                    : length == 2 ? (byte & 0x1F)
+                    : length == 3 ? (byte & 0x0F)
+                                  : (byte & 0x07);
     bool valid = length > 0 && i + length <= utf8.size();
     for (int k = 1; valid && k < length; ++k) {
       const auto next = static_cast<unsigned char>(utf8[i + k]);
@@ -115,16 +117,12 @@ std::u32string CollapseWhitespace(const std::u32string& text) {
   return out;
 }
 
-size_t EditDistance(const std::u32string& a, const std::u32string& b) {
-  return Levenshtein(a, b);
-}
-size_t EditDistance(const std::vector<std::u32string>& a,
-                    const std::vector<std::u32string>& b) {
+size_t EditDistance(const std::u32string& a, const std::u32string& b) { return Levenshtein(a, b); }
+size_t EditDistance(const std::vector<std::u32string>& a, const std::vector<std::u32string>& b) {
   return Levenshtein(a, b);
 }
 
-TextScores CompareTexts(const std::string& reference_utf8,
-                        const std::string& result_utf8) {
+TextScores CompareTexts(const std::string& reference_utf8, const std::string& result_utf8) {
   const std::u32string reference = Utf8ToCodePoints(reference_utf8);
   const std::u32string result = Utf8ToCodePoints(result_utf8);
   TextScores s;

@@ -23,21 +23,19 @@ std::u32string CollapseWhitespace(const std::u32string& text);
 
 // Levenshtein distance (unit costs for insertion, deletion, substitution).
 size_t EditDistance(const std::u32string& a, const std::u32string& b);
-size_t EditDistance(const std::vector<std::u32string>& a,
-                    const std::vector<std::u32string>& b);
+size_t EditDistance(const std::vector<std::u32string>& a, const std::vector<std::u32string>& b);
 
 struct TextScores {
   size_t ed = 0;               // character edit distance
   size_t reference_chars = 0;  // code points of the reference
   size_t result_chars = 0;
-  double cer = 0;              // ed / reference_chars (NaN for empty reference)
+  double cer = 0;  // ed / reference_chars (NaN for empty reference)
   size_t word_ed = 0;
   size_t reference_words = 0;
-  double wer = 0;              // word_ed / reference_words
+  double wer = 0;  // word_ed / reference_words
 };
 
 // CER over the texts as they are (OCR of result vs OCR of ground truth).
-TextScores CompareTexts(const std::string& reference_utf8,
-                        const std::string& result_utf8);
+TextScores CompareTexts(const std::string& reference_utf8, const std::string& result_utf8);
 
 }  // namespace docunfold::evaluate

@@ -1,19 +1,18 @@
 #include "stages/init-mesh/init_mesh.h"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <limits>
 #include <memory>
-#include <numeric>
-#include <optional>
-#include <sstream>
-
-#include <Eigen/Eigenvalues>
 #include <nanoflann.hpp>
+#include <numeric>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <optional>
+#include <sstream>
 
 #include "common/atomic_file.h"
 #include "common/cli.h"
@@ -29,7 +28,9 @@ namespace docunfold::init_mesh {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double Since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+double Since(Clock::time_point t) {
+  return std::chrono::duration<double>(Clock::now() - t).count();
+}
 
 std::string Fixed(double x, int digits) {
   std::ostringstream s;
@@ -74,7 +75,8 @@ Boundary ParseBoundary(const Json& doc) {
       b.problems.push_back(std::string("the ") + name + " side has fewer than 2 points");
       b.sides[s].points.clear();
     }
-    b.sides[s].real = side.contains("real") && side["real"].is_boolean() && side["real"].get<bool>();
+    b.sides[s].real =
+        side.contains("real") && side["real"].is_boolean() && side["real"].get<bool>();
   }
   return b;
 }
@@ -89,11 +91,14 @@ struct VectorCloud {
   size_t kdtree_get_point_count() const { return pts->size(); }
   double kdtree_get_pt(size_t i, size_t d) const { return (*pts)[i][int(d)]; }
   template <class B>
-  bool kdtree_get_bbox(B&) const { return false; }
+  bool kdtree_get_bbox(B&) const {
+    return false;
+  }
 };
 using PixelCloud = VectorCloud<2>;
-using PixelTree = nanoflann::KDTreeSingleIndexAdaptor<
-    nanoflann::L2_Simple_Adaptor<double, PixelCloud>, PixelCloud, 2, uint32_t>;
+using PixelTree =
+    nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, PixelCloud>,
+                                        PixelCloud, 2, uint32_t>;
 
 // Distance from a 3D position to the nearest of a fixed set of points.
 class NearestPoint {
@@ -234,15 +239,17 @@ bool CoonsGrid(const Boundary& b, const Options& o, const Lift& lift, const cv::
   const int ny = (wide ? o.grid_short : o.grid_long) + 1;
   std::array<std::vector<Eigen::Vector2d>, 4> s;
   for (int k = 0; k < 4; ++k) s[k] = ResampleOnPage(side[k], k % 2 == 0 ? nx : ny, lift, &len[k]);
-  const Eigen::Vector2d tl = (s[0].front() + s[3].front()) / 2, tr = (s[0].back() + s[1].front()) / 2;
+  const Eigen::Vector2d tl = (s[0].front() + s[3].front()) / 2,
+                        tr = (s[0].back() + s[1].front()) / 2;
   const Eigen::Vector2d br = (s[2].back() + s[1].back()) / 2, bl = (s[2].front() + s[3].back()) / 2;
   ImageGrid g;
   g.grid = {nx, ny};
   for (int r = 0; r < ny; ++r)
     for (int c = 0; c < nx; ++c) {
       const double u = double(c) / (nx - 1), v = double(r) / (ny - 1);
-      g.pixels.push_back((1 - v) * s[0][c] + v * s[2][c] + (1 - u) * s[3][r] + u * s[1][r] -
-                         ((1 - u) * (1 - v) * tl + u * (1 - v) * tr + (1 - u) * v * bl + u * v * br));
+      g.pixels.push_back(
+          (1 - v) * s[0][c] + v * s[2][c] + (1 - u) * s[3][r] + u * s[1][r] -
+          ((1 - u) * (1 - v) * tl + u * (1 - v) * tr + (1 - u) * v * bl + u * v * br));
     }
   // The patch must be a proper grid: every quad the same orientation, and on
   // the page.
@@ -347,9 +354,9 @@ MeshPair RegridOnPage(const MeshPair& m) {
   for (int r = 0; r < g.ny; ++r)
     for (int c = 0; c < g.nx; ++c) {
       const double u = double(c) / (g.nx - 1), v = double(r) / (g.ny - 1);
-      Eigen::Vector2d p = (1 - v) * side[0][c] + v * side[2][c] + (1 - u) * side[3][r] +
-                          u * side[1][r] -
-                          ((1 - u) * (1 - v) * tl + u * (1 - v) * tr + (1 - u) * v * bl + u * v * br);
+      Eigen::Vector2d p =
+          (1 - v) * side[0][c] + v * side[2][c] + (1 - u) * side[3][r] + u * side[1][r] -
+          ((1 - u) * (1 - v) * tl + u * (1 - v) * tr + (1 - u) * v * bl + u * v * br);
       // Border points sit on M''s border; nudge them in until located.
       std::optional<SurfacePoint> where = locator.Locate(p);
       for (int k = 1; !where && k <= 30; ++k)
@@ -366,8 +373,8 @@ MeshPair RegridOnPage(const MeshPair& m) {
 // naming each third (left, right, top, bottom) without points, empty when
 // every third has some: the mesh is carried over such a part by fairness
 // and isometry alone (a panel of a fold seen by one other photo has none).
-std::string CheckCoverage(const ImageGrid& g, const std::vector<Eigen::Vector2d>& pixels,
-                          int width, int height, const Options& o, const std::string& image) {
+std::string CheckCoverage(const ImageGrid& g, const std::vector<Eigen::Vector2d>& pixels, int width,
+                          int height, const Options& o, const std::string& image) {
   cv::Mat1i label(height, width, -1);
   for (int q = 0; q < g.grid.NumQuads(); ++q) {
     const auto c = g.grid.Quad(q);
@@ -396,12 +403,11 @@ std::string CheckCoverage(const ImageGrid& g, const std::vector<Eigen::Vector2d>
   for (const auto& [name, n] : parts)
     if (n < o.min_points_per_ninth) empty += std::string(empty.empty() ? "" : ", ") + name;
   if (covered < o.min_covered_ninths)
-    throw InputError(
-        "points cover only " + std::to_string(covered) + " of the page's 9 parts in " + image +
-        " (need " + std::to_string(o.min_covered_ninths) + "; " + std::to_string(pixels.size()) +
-        " points inside the document region" +
-        (empty.empty() ? std::string() : ", none in the " + empty + " third") +
-        "): the page cannot be reconstructed");
+    throw InputError("points cover only " + std::to_string(covered) + " of the page's 9 parts in " +
+                     image + " (need " + std::to_string(o.min_covered_ninths) + "; " +
+                     std::to_string(pixels.size()) + " points inside the document region" +
+                     (empty.empty() ? std::string() : ", none in the " + empty + " third") +
+                     "): the page cannot be reconstructed");
   if (empty.empty()) return "";
   return "no points in the " + empty + " third of the page in " + image +
          ": its shape there is carried over from the rest";
@@ -505,10 +511,10 @@ std::vector<isometry::Marker> OutlineMarkers(const MeshPair& m, const PinholeCam
       // Where M is seen at a grazing angle the outline is likely its
       // silhouette (a curl, a panel seen edge-on), not the page's edge.
       const auto& p3 = m.mesh3d;
-      const Eigen::Vector3d along_row = p3[g.Index(r, std::min(c + 1, g.nx - 1))] -
-                                        p3[g.Index(r, std::max(c - 1, 0))];
-      const Eigen::Vector3d along_col = p3[g.Index(std::min(r + 1, g.ny - 1), c)] -
-                                        p3[g.Index(std::max(r - 1, 0), c)];
+      const Eigen::Vector3d along_row =
+          p3[g.Index(r, std::min(c + 1, g.nx - 1))] - p3[g.Index(r, std::max(c - 1, 0))];
+      const Eigen::Vector3d along_col =
+          p3[g.Index(std::min(r + 1, g.ny - 1), c)] - p3[g.Index(std::max(r - 1, 0), c)];
       const Eigen::Vector3d normal = along_row.cross(along_col).normalized();
       if (!(std::abs(normal.dot((m.mesh3d[v] - centre).normalized())) >= min_cos)) continue;
       // Far from every point M's shape there is a guess (a panel past a
@@ -611,11 +617,10 @@ Result Run(const Inputs& in, const Options& o) {
   res.points_total = int(in.points.size());
   res.points_in_region = int(region_points.size());
   if (res.points_in_region < std::max(o.min_points, 4))
-    throw InputError("only " + std::to_string(res.points_in_region) + " of " +
-                     std::to_string(res.points_total) +
-                     " SfM points fall inside the document region of " + image_name +
-                     " (need at least " + std::to_string(std::max(o.min_points, 4)) +
-                     " to support the mesh)");
+    throw InputError(
+        "only " + std::to_string(res.points_in_region) + " of " + std::to_string(res.points_total) +
+        " SfM points fall inside the document region of " + image_name + " (need at least " +
+        std::to_string(std::max(o.min_points, 4)) + " to support the mesh)");
 
   // Depth outliers: far from the median depth of their image neighbours.
   std::vector<Eigen::Vector2d> kept_px;
@@ -644,8 +649,8 @@ Result Run(const Inputs& in, const Options& o) {
       }
     }
     std::nth_element(spacing.begin(), spacing.begin() + spacing.size() / 2, spacing.end());
-    res.rbf_scale_px = o.rbf_scale_px > 0 ? o.rbf_scale_px
-                                          : std::max(1.0, spacing[spacing.size() / 2]);
+    res.rbf_scale_px =
+        o.rbf_scale_px > 0 ? o.rbf_scale_px : std::max(1.0, spacing[spacing.size() / 2]);
   }
   if (kept_px.size() < 4) {  // everything disagrees: use every point
     kept_px = pixels;
@@ -687,9 +692,9 @@ Result Run(const Inputs& in, const Options& o) {
       sides[s] = in.boundary.sides[s].points;
       real[s] = in.boundary.sides[s].real;
     }
-    res.outline_prior = OutlinePriorDepths(m.grid, g.pixels, grid_depths, sides, real, cam,
-                                           outline_pixels, outline_depths, kept_px, kept_depth,
-                                           o.outline_prior);
+    res.outline_prior =
+        OutlinePriorDepths(m.grid, g.pixels, grid_depths, sides, real, cam, outline_pixels,
+                           outline_depths, kept_px, kept_depth, o.outline_prior);
     if (res.outline_prior.used)
       for (size_t v = 0; v < m.mesh3d.size(); ++v) {
         const Eigen::Vector2d& px = g.pixels[v];
@@ -882,11 +887,11 @@ Json ResultToJson(const Inputs& in, const Result& r, const Options& o, double re
                     {"model_size", r.refine.model_size}};
   doc["upright"] = {{"rotation_deg", r.upright_rotation_deg}, {"from", r.upright_from}};
   doc["warnings"] = r.warnings;
-  doc["timings_s"] = {{"read", read_seconds},       {"depth", r.timings.depth},
-                      {"grid", r.timings.grid},     {"unfold", r.timings.unfold},
-                      {"refine", r.timings.refine}, {"upright", r.timings.upright},
-                      {"write", write_seconds},
-                      {"total", read_seconds + r.timings.total + write_seconds}};
+  doc["timings_s"] = {
+      {"read", read_seconds},       {"depth", r.timings.depth},
+      {"grid", r.timings.grid},     {"unfold", r.timings.unfold},
+      {"refine", r.timings.refine}, {"upright", r.timings.upright},
+      {"write", write_seconds},     {"total", read_seconds + r.timings.total + write_seconds}};
   return doc;
 }
 
@@ -897,12 +902,11 @@ void WriteOutputs(const fs::path& out_dir, const Inputs& in, const Result& r, co
   MeshPairWriteOptions w;
   w.reference_camera = in.reference;
   w.reference_image = in.reference_image;
-  w.comments = {std::string("init-mesh ") + ProgramVersion() + ": " +
-                    std::to_string(r.meshes.grid.nx - 1) + "x" +
-                    std::to_string(r.meshes.grid.ny - 1) + " quads (" + r.grid_source + ")",
-                "refined: " + std::to_string(r.refine.iterations.size()) +
-                    " outer iterations, isometry edge error " +
-                    Fixed(100 * r.isometry_error_mean, 3) + " %"};
+  w.comments = {
+      std::string("init-mesh ") + ProgramVersion() + ": " + std::to_string(r.meshes.grid.nx - 1) +
+          "x" + std::to_string(r.meshes.grid.ny - 1) + " quads (" + r.grid_source + ")",
+      "refined: " + std::to_string(r.refine.iterations.size()) +
+          " outer iterations, isometry edge error " + Fixed(100 * r.isometry_error_mean, 3) + " %"};
   // init.json last: its presence means the meshes beside it are complete.
   WriteMeshPair(out_dir, r.meshes, w);
   WriteJsonAtomic(out_dir / "init.json", ResultToJson(in, r, o, read_seconds, Since(start)));

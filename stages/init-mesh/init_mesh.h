@@ -15,18 +15,17 @@
 //     sides (of the whole mesh when no side is real): top side at small y.
 #pragma once
 
+#include <Eigen/Core>
 #include <array>
 #include <filesystem>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
 
-#include <Eigen/Core>
-#include <opencv2/core.hpp>
-
 #include "common/camera.h"
+#include "common/depth_field.h"
 #include "common/grid_mesh.h"
 #include "common/isometry/isometry.h"
-#include "common/depth_field.h"
 #include "common/json_io.h"
 #include "stages/init-mesh/outline_prior.h"
 
@@ -125,8 +124,8 @@ struct Boundary {
   };
   std::vector<Eigen::Vector2d> contour;
   std::vector<Eigen::Vector2d> corners;  // TL, TR, BR, BL when complete
-  std::array<Side, 4> sides;             // top (TL→TR), right (TR→BR), bottom (BL→BR), left (TL→BL)
-  std::vector<std::string> problems;     // why a part could not be read
+  std::array<Side, 4> sides;  // top (TL→TR), right (TR→BR), bottom (BL→BR), left (TL→BL)
+  std::vector<std::string> problems;  // why a part could not be read
 };
 inline constexpr std::array<const char*, 4> kSideNames = {"top", "right", "bottom", "left"};
 
@@ -137,8 +136,8 @@ struct Inputs {
   // ...); empty when the file has none (sfm's own cloud).
   std::vector<int> point_sources;
   Boundary boundary;
-  cv::Mat1b mask;                       // 255 inside the page
-  fs::path reference_image;             // 10_sfm/reference.png
+  cv::Mat1b mask;            // 255 inside the page
+  fs::path reference_image;  // 10_sfm/reference.png
 };
 
 // Reads and validates 10_sfm/{cameras.json, points.ply, reference.png} and
@@ -165,7 +164,7 @@ struct Result {
   int unfold_iterations = 0;
   isometry::SolveReport refine;
   double upright_rotation_deg = 0;
-  std::string upright_from;  // "real sides: top, left, ..." or "whole mesh"
+  std::string upright_from;        // "real sides: top, left, ..." or "whole mesh"
   double isometry_error_mean = 0;  // mean relative edge-length difference of (M, M')
   double isometry_error_max = 0;
   double mean_inlier_distance = 0;  // of the SfM inliers to M, / model size

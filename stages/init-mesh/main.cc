@@ -23,58 +23,65 @@ int main(int argc, char** argv) {
       ->required();
   app.add_option("--boundary", boundary_dir, "segment-boundary output: boundary.json, mask.png")
       ->required();
-  app.add_option("--points", points_path,
-                 "3D points to fit (default: <sfm>/points.ply; densify writes 25_points/points.ply)");
+  app.add_option(
+      "--points", points_path,
+      "3D points to fit (default: <sfm>/points.ply; densify writes 25_points/points.ply)");
   app.add_option("--out", out_dir, "output directory (mesh3d.ply, mesh2d.ply, init.json)")
       ->required();
-  app.add_option("--grid", grid,
-                 "quads across the page's short side x along its long side")
+  app.add_option("--grid", grid, "quads across the page's short side x along its long side")
       ->capture_default_str();
   app.add_option("--k", o.depth_neighbours, "nearest SfM points per grid vertex for its depth")
-      ->capture_default_str()->check(CLI::Range(1, 64));
+      ->capture_default_str()
+      ->check(CLI::Range(1, 64));
   app.add_option("--rbf-scale-px", o.rbf_scale_px,
                  "pixel distance unit of the depth weights 1/(1+r^2); 0 = median spacing of "
                  "the projected points, 1 = plain pixels as in the paper")
-      ->capture_default_str()->check(CLI::Range(0.0, 1e6));
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1e6));
   app.add_option("--depth-model", o.depth_model,
                  "planar: fit 1/depth as an affine function of the pixel to the nearest "
                  "--planar-k points (continues each panel's plane over blank paper); average: "
                  "the weighted mean depth of the --k nearest (the paper)")
       ->transform(CLI::CheckedTransformer(
-          std::map<std::string, DepthModel>{
-              {"planar", DepthModel::kPlanar},
-              {"average", DepthModel::kAverage}},
+          std::map<std::string, DepthModel>{{"planar", DepthModel::kPlanar},
+                                            {"average", DepthModel::kAverage}},
           CLI::ignore_case))
       ->default_str("planar");
-  app.add_option("--planar-k", o.planar_neighbours,
-                 "nearest SfM points in each planar depth fit")
-      ->capture_default_str()->check(CLI::Range(6, 256));
+  app.add_option("--planar-k", o.planar_neighbours, "nearest SfM points in each planar depth fit")
+      ->capture_default_str()
+      ->check(CLI::Range(6, 256));
   app.add_option("--planar-guard", o.planar_guard,
                  "where the planar fits to the 2 x --planar-k and the --planar-k nearest "
                  "points disagree by more than this fraction of the depth, take the wider "
                  "one; 0 = off")
-      ->capture_default_str()->check(CLI::Range(0.0, 1.0));
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
   app.add_option("--depth-outlier", o.depth_outlier,
                  "points off the median depth of their image neighbours by more than this "
                  "fraction are not used for the depth")
-      ->capture_default_str()->check(CLI::Range(0.0, 10.0));
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 10.0));
   app.add_option("--mask-margin-px", o.mask_margin_px,
                  "points this close outside mask.png still count as on the page")
-      ->capture_default_str()->check(CLI::Range(0.0, 1000.0));
-  app.add_option("--min-points", o.min_points,
-                 "fewer SfM points on the page is bad input (exit 3)")
-      ->capture_default_str()->check(CLI::Range(4, 1000000));
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1000.0));
+  app.add_option("--min-points", o.min_points, "fewer SfM points on the page is bad input (exit 3)")
+      ->capture_default_str()
+      ->check(CLI::Range(4, 1000000));
   app.add_option("--min-points-per-ninth", o.min_points_per_ninth,
                  "a ninth of the page (3x3 parts of the grid) with fewer SfM points has none")
-      ->capture_default_str()->check(CLI::Range(1, 1000000));
+      ->capture_default_str()
+      ->check(CLI::Range(1, 1000000));
   app.add_option("--min-covered-ninths", o.min_covered_ninths,
                  "points in fewer of the page's 9 parts are bad input (exit 3); an empty "
                  "third is a warning")
-      ->capture_default_str()->check(CLI::Range(0, 9));
+      ->capture_default_str()
+      ->check(CLI::Range(0, 9));
   app.add_option("--outlier-distance", o.refine.outlier_distance,
                  "phi: points farther from M than this fraction of the model size are "
                  "ignored (re-decided every iteration)")
-      ->capture_default_str()->check(CLI::Range(0.0, 10.0));
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 10.0));
   AddFairnessBoostOptions(app, &o.refine.unsupported_fairness, &o.refine.support_radius);
   app.add_option("--lambda-iso", o.refine.weights.iso, "lambda1, isometry")->capture_default_str();
   app.add_option("--lambda-dist", o.refine.weights.dist, "lambda2, point fitting")
@@ -86,34 +93,42 @@ int main(int argc, char** argv) {
   app.add_option("--iso-normalization", iso,
                  "strain: E_iso as mean squared strain (resolution independent); raw: the "
                  "paper's sum of squared c_iso")
-      ->capture_default_str()->check(CLI::IsMember({"strain", "raw"}));
+      ->capture_default_str()
+      ->check(CLI::IsMember({"strain", "raw"}));
   AddIsoEdgesOption(app, &o.refine.iso_edges);
   AddFair2dAlongOption(app, &o.refine.fair2d_along);
   app.add_option("--outline-hold", o.outline_hold,
                  "weight of the term holding M's border to the page outline in the reference "
                  "image (sliding along it); 0 = off")
-      ->capture_default_str()->check(CLI::Range(0.0, 1e6));
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1e6));
   app.add_option("--outline-hold-max-angle", o.outline_hold_max_angle_deg,
                  "border vertices where M is seen more than this far off its normal (degrees) are "
                  "not held: the outline there is likely a silhouette")
-      ->capture_default_str()->check(CLI::Range(0.0, 90.0));
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 90.0));
   app.add_option("--outline-hold-support", o.outline_hold_support,
                  "border vertices farther than this from every point (fraction of the model "
                  "size) are not held: M's shape there is a guess")
-      ->capture_default_str()->check(CLI::Range(0.0, 10.0));
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 10.0));
   app.add_option("--method", method, "gn: Gauss-Newton/Levenberg-Marquardt; lbfgs: L-BFGS")
-      ->capture_default_str()->check(CLI::IsMember({"gn", "lbfgs"}));
+      ->capture_default_str()
+      ->check(CLI::IsMember({"gn", "lbfgs"}));
   app.add_option("--max-iterations", o.refine.max_outer_iterations,
                  "outer iterations of the refinement (Q)")
-      ->capture_default_str()->check(CLI::Range(0, 100000));
+      ->capture_default_str()
+      ->check(CLI::Range(0, 100000));
   app.add_option("--converged-max-damping", o.refine.converged_max_damping,
                  "|dF/F| below --tolerance does not stop the refinement while the "
                  "Levenberg-Marquardt damping is above this (its steps are then short, not "
                  "converged); 0 = it always stops")
-      ->capture_default_str()->check(CLI::Range(0.0, 1e6));
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1e6));
   app.add_option("--tolerance", o.refine.relative_tolerance,
                  "stop when |dF/F| between outer iterations is below this (epsilon)")
-      ->capture_default_str()->check(CLI::Range(0.0, 1.0));
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
   app.add_option("--threads", o.refine.num_threads,
                  "solver threads at most; each outer iteration runs fewer "
                  "while other processes keep the cores busy")
@@ -130,7 +145,8 @@ int main(int argc, char** argv) {
   app.add_option("--outline-prior-agreement", o.outline_prior.agreement,
                  "the outline's surface counts where the nearby points' depths differ from it "
                  "by about this fraction or less (weight exp(-(e/a)^2))")
-      ->capture_default_str()->check(CLI::Range(1e-6, 1.0));
+      ->capture_default_str()
+      ->check(CLI::Range(1e-6, 1.0));
   app.add_flag("--verbose", verbose, "log every outer iteration of the refinement");
 
   return RunStage("init-mesh", app, argc, argv, [&] {
@@ -147,8 +163,8 @@ int main(int argc, char** argv) {
     o.regrid_on_page = !no_regrid;
     o.outline_prior.enabled = !no_outline_prior;
     o.refine.method = method == "gn" ? isometry::Method::kGaussNewton : isometry::Method::kLbfgs;
-    o.refine.iso_normalization = iso == "strain" ? isometry::IsoNormalization::kStrain
-                                                 : isometry::IsoNormalization::kRaw;
+    o.refine.iso_normalization =
+        iso == "strain" ? isometry::IsoNormalization::kStrain : isometry::IsoNormalization::kRaw;
 
     const init_mesh::Inputs inputs = init_mesh::ReadInputs(sfm_dir, boundary_dir, points_path);
     const double read_seconds = SecondsSince(start);
@@ -162,20 +178,19 @@ int main(int argc, char** argv) {
       Log("outline prior not used: " + result.outline_prior.note);
     if (verbose)
       for (const auto& it : result.refine.iterations)
-        Log("refine " + std::to_string(it.iteration) + ": F " + std::to_string(it.F) +
-            " (iso " + std::to_string(it.terms.iso) + ", dist " + std::to_string(it.terms.dist) +
-            ", fair3d " + std::to_string(it.terms.fair3d) + ", fair2d " +
-            std::to_string(it.terms.fair2d) + "), inliers " + std::to_string(it.inliers) +
-            ", damping " + std::to_string(it.damping) + (it.step_accepted ? "" : ", no step"));
+        Log("refine " + std::to_string(it.iteration) + ": F " + std::to_string(it.F) + " (iso " +
+            std::to_string(it.terms.iso) + ", dist " + std::to_string(it.terms.dist) + ", fair3d " +
+            std::to_string(it.terms.fair3d) + ", fair2d " + std::to_string(it.terms.fair2d) +
+            "), inliers " + std::to_string(it.inliers) + ", damping " + std::to_string(it.damping) +
+            (it.step_accepted ? "" : ", no step"));
     init_mesh::WriteOutputs(out_dir, inputs, result, o, read_seconds);
     const auto& its = result.refine.iterations;
     Log(std::to_string(result.meshes.grid.nx - 1) + "x" +
         std::to_string(result.meshes.grid.ny - 1) + " quads (" + result.grid_source + "), " +
         std::to_string(result.inliers) + "/" + std::to_string(result.points_in_region) +
-        " points inliers, refined in " + std::to_string(its.size()) +
-        " iterations (F " + std::to_string(its.front().F) + " -> " +
-        std::to_string(its.back().F) + "), isometry error " +
-        std::to_string(100 * result.isometry_error_mean).substr(0, 5) + " %, " +
-        std::to_string(SecondsSince(start)).substr(0, 4) + " s");
+        " points inliers, refined in " + std::to_string(its.size()) + " iterations (F " +
+        std::to_string(its.front().F) + " -> " + std::to_string(its.back().F) +
+        "), isometry error " + std::to_string(100 * result.isometry_error_mean).substr(0, 5) +
+        " %, " + std::to_string(SecondsSince(start)).substr(0, 4) + " s");
   });
 }

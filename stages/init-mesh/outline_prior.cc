@@ -17,14 +17,12 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 std::pair<double, double> OnPolyline(const Eigen::Vector2d& p,
                                      const std::vector<Eigen::Vector2d>& poly) {
   double total = 0;
-  for (size_t k = 1; k < poly.size(); ++k)
-    total += (poly[k] - poly[k - 1]).norm();
+  for (size_t k = 1; k < poly.size(); ++k) total += (poly[k] - poly[k - 1]).norm();
   double best = std::numeric_limits<double>::infinity(), best_t = 0, walked = 0;
   for (size_t k = 1; k < poly.size(); ++k) {
     const Eigen::Vector2d a = poly[k - 1], d = poly[k] - poly[k - 1];
     const double len2 = d.squaredNorm();
-    const double s =
-        len2 > 0 ? std::clamp((p - a).dot(d) / len2, 0.0, 1.0) : 0.0;
+    const double s = len2 > 0 ? std::clamp((p - a).dot(d) / len2, 0.0, 1.0) : 0.0;
     const double dist = (a + s * d - p).norm();
     if (dist < best) {
       best = dist;
@@ -42,8 +40,7 @@ struct Profile {
   double At(double x) const {
     if (x <= t.front()) return inverse_depth.front();
     if (x >= t.back()) return inverse_depth.back();
-    const size_t k =
-        size_t(std::upper_bound(t.begin(), t.end(), x) - t.begin());
+    const size_t k = size_t(std::upper_bound(t.begin(), t.end(), x) - t.begin());
     const double f = (x - t[k - 1]) / std::max(t[k] - t[k - 1], 1e-12);
     return (1 - f) * inverse_depth[k - 1] + f * inverse_depth[k];
   }
@@ -57,8 +54,7 @@ void SmoothProfile(Profile* p) {
   std::vector<double> out(n);
   for (size_t i = 0; i < n; ++i) {
     const size_t lo = i < 2 ? 0 : i - 2, hi = std::min(n, i + 3);
-    std::vector<double> w(p->inverse_depth.begin() + long(lo),
-                          p->inverse_depth.begin() + long(hi));
+    std::vector<double> w(p->inverse_depth.begin() + long(lo), p->inverse_depth.begin() + long(hi));
     std::nth_element(w.begin(), w.begin() + long(w.size() / 2), w.end());
     out[i] = w[w.size() / 2];
   }
@@ -72,8 +68,7 @@ bool FillBorderLine(const std::vector<Eigen::Vector2d>& pixels,
                     std::vector<double>* inverse_depth) {
   const size_t n = pixels.size();
   std::vector<double> s(n, 0);
-  for (size_t i = 1; i < n; ++i)
-    s[i] = s[i - 1] + (pixels[i] - pixels[i - 1]).norm();
+  for (size_t i = 1; i < n; ++i) s[i] = s[i - 1] + (pixels[i] - pixels[i - 1]).norm();
   std::vector<size_t> known;
   for (size_t i = 0; i < n; ++i)
     if (std::isfinite((*inverse_depth)[i])) known.push_back(i);
@@ -88,8 +83,7 @@ bool FillBorderLine(const std::vector<Eigen::Vector2d>& pixels,
     } else {
       const size_t a = *(after - 1), b = *after;
       const double f = (s[i] - s[a]) / std::max(s[b] - s[a], 1e-12);
-      (*inverse_depth)[i] =
-          (1 - f) * (*inverse_depth)[a] + f * (*inverse_depth)[b];
+      (*inverse_depth)[i] = (1 - f) * (*inverse_depth)[a] + f * (*inverse_depth)[b];
     }
   }
   return true;
@@ -100,11 +94,9 @@ bool FillBorderLine(const std::vector<Eigen::Vector2d>& pixels,
 OutlinePriorResult OutlinePriorDepths(
     const QuadGrid& grid, const std::vector<Eigen::Vector2d>& grid_pixels,
     const std::vector<double>& grid_depths,
-    const std::array<std::vector<Eigen::Vector2d>, 4>& sides,
-    const std::array<bool, 4>& real, const PinholeCamera& camera,
-    const std::vector<Eigen::Vector2d>& outline_pixels,
-    const std::vector<double>& outline_depths,
-    const std::vector<Eigen::Vector2d>& point_pixels,
+    const std::array<std::vector<Eigen::Vector2d>, 4>& sides, const std::array<bool, 4>& real,
+    const PinholeCamera& camera, const std::vector<Eigen::Vector2d>& outline_pixels,
+    const std::vector<double>& outline_depths, const std::vector<Eigen::Vector2d>& point_pixels,
     const std::vector<double>& point_depths, const OutlinePriorOptions& o) {
   OutlinePriorResult r;
   const int nx = grid.nx, ny = grid.ny;
@@ -139,8 +131,7 @@ OutlinePriorResult OutlinePriorDepths(
     Profile& p = profiles[s];
     std::vector<size_t> order(p.t.size());
     for (size_t k = 0; k < order.size(); ++k) order[k] = k;
-    std::sort(order.begin(), order.end(),
-              [&](size_t a, size_t b) { return p.t[a] < p.t[b]; });
+    std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return p.t[a] < p.t[b]; });
     Profile sorted;
     for (size_t k : order) {
       sorted.t.push_back(p.t[k]);
@@ -224,19 +215,16 @@ OutlinePriorResult OutlinePriorDepths(
     return (K_inv * Eigen::Vector3d(p.x(), p.y(), 1)) / border[size_t(v)];
   };
   std::vector<double> prior(size_t(nx) * ny, kNaN);  // inverse depth
-  const Eigen::Vector3d c00 = on_ray(grid.Index(0, 0)),
-                        c01 = on_ray(grid.Index(0, nx - 1)),
+  const Eigen::Vector3d c00 = on_ray(grid.Index(0, 0)), c01 = on_ray(grid.Index(0, nx - 1)),
                         c10 = on_ray(grid.Index(ny - 1, 0)),
                         c11 = on_ray(grid.Index(ny - 1, nx - 1));
   for (int row = 0; row < ny; ++row)
     for (int col = 0; col < nx; ++col) {
       const double u = double(col) / (nx - 1), v = double(row) / (ny - 1);
-      const Eigen::Vector3d x = (1 - v) * on_ray(grid.Index(0, col)) +
-                                v * on_ray(grid.Index(ny - 1, col)) +
-                                (1 - u) * on_ray(grid.Index(row, 0)) +
-                                u * on_ray(grid.Index(row, nx - 1)) -
-                                ((1 - u) * (1 - v) * c00 + u * (1 - v) * c01 +
-                                 (1 - u) * v * c10 + u * v * c11);
+      const Eigen::Vector3d x =
+          (1 - v) * on_ray(grid.Index(0, col)) + v * on_ray(grid.Index(ny - 1, col)) +
+          (1 - u) * on_ray(grid.Index(row, 0)) + u * on_ray(grid.Index(row, nx - 1)) -
+          ((1 - u) * (1 - v) * c00 + u * (1 - v) * c01 + (1 - u) * v * c10 + u * v * c11);
       if (x.z() > 0) prior[size_t(grid.Index(row, col))] = 1 / x.z();
     }
   for (double w : prior)
@@ -248,28 +236,23 @@ OutlinePriorResult OutlinePriorDepths(
   // 4. The points' residuals against the patch: its inverse depth at their
   // pixels from a raster of the image grid.
   const double diagonal = std::hypot(camera.width, camera.height);
-  const double scale =
-      std::min(1.0, 1600.0 / std::max(camera.width, camera.height));
+  const double scale = std::min(1.0, 1600.0 / std::max(camera.width, camera.height));
   std::vector<Eigen::Vector3d> screen;
   for (size_t v = 0; v < grid_pixels.size(); ++v)
     screen.emplace_back(grid_pixels[v].x() * scale, grid_pixels[v].y() * scale,
                         std::max(grid_depths[v], 1e-6));
   const std::vector<Triangle> triangles = grid.Triangles();
-  const RasterResult raster =
-      Rasterize(screen, triangles, int(std::ceil(camera.width * scale)),
-                int(std::ceil(camera.height * scale)));
+  const RasterResult raster = Rasterize(screen, triangles, int(std::ceil(camera.width * scale)),
+                                        int(std::ceil(camera.height * scale)));
   Eigen::MatrixXf attribute(prior.size(), 1);
-  for (size_t v = 0; v < prior.size(); ++v)
-    attribute(long(v), 0) = float(prior[v]);
-  const cv::Mat prior_image =
-      InterpolateAttributes(raster, triangles, attribute);
+  for (size_t v = 0; v < prior.size(); ++v) attribute(long(v), 0) = float(prior[v]);
+  const cv::Mat prior_image = InterpolateAttributes(raster, triangles, attribute);
   std::vector<Eigen::Vector2d> judged_px;
   std::vector<double> residual, relative;
   for (size_t i = 0; i < point_pixels.size(); ++i) {
     const int x = int(std::lround(point_pixels[i].x() * scale)),
               y = int(std::lround(point_pixels[i].y() * scale));
-    if (x < 0 || y < 0 || x >= prior_image.cols || y >= prior_image.rows)
-      continue;
+    if (x < 0 || y < 0 || x >= prior_image.cols || y >= prior_image.rows) continue;
     const float w = prior_image.at<float>(y, x);
     if (!std::isfinite(w) || !(point_depths[i] > 0)) continue;
     judged_px.push_back(point_pixels[i]);
@@ -298,8 +281,8 @@ OutlinePriorResult OutlinePriorDepths(
     const double correction = swr / (o.prior_weight + sw);
     const double rms = sw > 0 ? std::sqrt(swe / sw) : 0;
     const double alpha = std::exp(-(rms * rms) / (o.agreement * o.agreement));
-    const double inverse = alpha * (prior[v] + correction) +
-                           (1 - alpha) / std::max(grid_depths[v], 1e-9);
+    const double inverse =
+        alpha * (prior[v] + correction) + (1 - alpha) / std::max(grid_depths[v], 1e-9);
     r.depth[v] = inverse > 0 ? 1 / inverse : grid_depths[v];
     weight_sum += alpha;
   }

@@ -47,9 +47,8 @@ struct OutlinePriorOptions {
 
 struct OutlinePriorResult {
   bool used = false;
-  std::string note;  // why not, when not used
-  std::array<int, 4>
-      side_points{};  // outline points per side (top right bottom left)
+  std::string note;                  // why not, when not used
+  std::array<int, 4> side_points{};  // outline points per side (top right bottom left)
   int measured_sides = 0;
   std::vector<double> depth;  // per grid vertex: camera depth, when used
   double mean_weight = 0;     // of the patch, over the grid vertices
@@ -62,12 +61,9 @@ struct OutlinePriorResult {
 OutlinePriorResult OutlinePriorDepths(
     const QuadGrid& grid, const std::vector<Eigen::Vector2d>& grid_pixels,
     const std::vector<double>& grid_depths,
-    const std::array<std::vector<Eigen::Vector2d>, 4>& sides,
-    const std::array<bool, 4>& real, const PinholeCamera& camera,
-    const std::vector<Eigen::Vector2d>& outline_pixels,
-    const std::vector<double>& outline_depths,
-    const std::vector<Eigen::Vector2d>& point_pixels,
-    const std::vector<double>& point_depths,
-    const OutlinePriorOptions& options);
+    const std::array<std::vector<Eigen::Vector2d>, 4>& sides, const std::array<bool, 4>& real,
+    const PinholeCamera& camera, const std::vector<Eigen::Vector2d>& outline_pixels,
+    const std::vector<double>& outline_depths, const std::vector<Eigen::Vector2d>& point_pixels,
+    const std::vector<double>& point_depths, const OutlinePriorOptions& options);
 
 }  // namespace docunfold::init_mesh

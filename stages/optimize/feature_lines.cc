@@ -1,13 +1,12 @@
 #include "stages/optimize/feature_lines.h"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <nanoflann.hpp>
 #include <numeric>
 #include <optional>
-
-#include <Eigen/Eigenvalues>
-#include <nanoflann.hpp>
 
 #include "common/statistics.h"
 
@@ -19,7 +18,10 @@ constexpr double kPi = 3.14159265358979323846;
 // Diagonal of M''s bounding box: the unit of the grouping tolerances.
 double FlatDiagonal(const MeshPair& meshes) {
   Eigen::Vector2d lo = meshes.mesh2d[0], hi = lo;
-  for (const auto& v : meshes.mesh2d) { lo = lo.cwiseMin(v); hi = hi.cwiseMax(v); }
+  for (const auto& v : meshes.mesh2d) {
+    lo = lo.cwiseMin(v);
+    hi = hi.cwiseMax(v);
+  }
   return (hi - lo).norm();
 }
 
@@ -63,10 +65,13 @@ struct EndpointCloud {
   size_t kdtree_get_point_count() const { return points.size(); }
   double kdtree_get_pt(size_t i, size_t dim) const { return points[i][int(dim)]; }
   template <class BBox>
-  bool kdtree_get_bbox(BBox&) const { return false; }
+  bool kdtree_get_bbox(BBox&) const {
+    return false;
+  }
 };
-using EndpointTree = nanoflann::KDTreeSingleIndexAdaptor<
-    nanoflann::L2_Simple_Adaptor<double, EndpointCloud>, EndpointCloud, 2, uint32_t>;
+using EndpointTree =
+    nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, EndpointCloud>,
+                                        EndpointCloud, 2, uint32_t>;
 
 // Straightness h/w of the union of two clusters, and whether they overlap
 // along the line more than a little (then they are two parallel lines, or
@@ -343,8 +348,8 @@ std::vector<isometry::FeatureLine> AssignLines(const MeshPair& meshes, const Gro
     lines[l].offset = normal.dot(mean);
   }
   for (int l = 0; l < n; ++l) {
-    lines[l].axis_aligned = axis_lines == AxisLines::kAll ||
-                            (axis_lines == AxisLines::kFeatures && grouping.line_kind[l] != "boundary");
+    lines[l].axis_aligned = axis_lines == AxisLines::kAll || (axis_lines == AxisLines::kFeatures &&
+                                                              grouping.line_kind[l] != "boundary");
     lines[l].text_row = grouping.line_kind[l] == "text";
   }
   return lines;
@@ -421,8 +426,8 @@ std::array<bool, 4> HeldCorners(const MeshPair& meshes, const Boundary& boundary
   for (int k = 0; k < 4; ++k) {
     if (!boundary.sides[kCornerSides[k][0]].real || !boundary.sides[kCornerSides[k][1]].real)
       continue;
-    const Eigen::Vector3d x_cam = reference.CamFromWorld(
-        meshes.mesh3d[grid.Index(CornerRow(grid, k), CornerCol(grid, k))]);
+    const Eigen::Vector3d x_cam =
+        reference.CamFromWorld(meshes.mesh3d[grid.Index(CornerRow(grid, k), CornerCol(grid, k))]);
     held[k] = x_cam.z() > 0 && (reference.ProjectCam(x_cam) - boundary.corners[k]).norm() <= max_px;
   }
   return held;

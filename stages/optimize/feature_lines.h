@@ -4,25 +4,24 @@
 // close to one straight line in M' are merged into feature lines.
 #pragma once
 
+#include <Eigen/Core>
 #include <array>
 #include <string>
 #include <vector>
 
-#include <Eigen/Core>
-
 #include "common/axis_direction.h"
 #include "common/camera.h"
 #include "common/grid_mesh.h"
-#include "common/page_files.h"
 #include "common/isometry/isometry.h"
+#include "common/page_files.h"
 
 namespace docunfold::optimize {
 
 // A straight piece of the page in the reference image: a detected segment
 // (text or edge) or a real side of the page boundary.
 struct Segment {
-  std::string kind;   // "text", "edge" or "boundary"
-  int side = -1;      // boundary: 0 top, 1 right, 2 bottom, 3 left
+  std::string kind;                     // "text", "edge" or "boundary"
+  int side = -1;                        // boundary: 0 top, 1 right, 2 bottom, 3 left
   std::vector<Eigen::Vector2d> pixels;  // samples along the polyline
 };
 
@@ -33,9 +32,9 @@ std::vector<Eigen::Vector2d> SamplePolyline(const std::vector<Eigen::Vector2d>& 
 // Every sample of every segment as a marker on M (`line` left at -1).
 struct MarkerSet {
   std::vector<isometry::Marker> markers;
-  std::vector<int> segment;               // per marker: index into the segments
-  std::vector<Eigen::Vector2d> pixel;     // per marker: its reference pixel
-  std::vector<int> markers_of_segment;    // per segment: markers found on M
+  std::vector<int> segment;             // per marker: index into the segments
+  std::vector<Eigen::Vector2d> pixel;   // per marker: its reference pixel
+  std::vector<int> markers_of_segment;  // per segment: markers found on M
 };
 
 struct CastOptions {

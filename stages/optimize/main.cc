@@ -20,11 +20,11 @@ int main(int argc, char** argv) {
   app.add_option("--sfm", paths.sfm, "10_sfm/ (cameras.json, points.ply, reference.png)")
       ->required();
   app.add_option("--boundary", paths.boundary, "20_boundary/ or its boundary.json")->required();
-  app.add_option("--features", paths.features, "feature segments (docunfold.features)")
-      ->required();
+  app.add_option("--features", paths.features, "feature segments (docunfold.features)")->required();
   app.add_option("--init", paths.init, "40_init/ (mesh3d.ply, mesh2d.ply)")->required();
-  app.add_option("--points", paths.points,
-                 "3D points to fit (default: <sfm>/points.ply; densify writes 25_points/points.ply)");
+  app.add_option(
+      "--points", paths.points,
+      "3D points to fit (default: <sfm>/points.ply; densify writes 25_points/points.ply)");
   app.add_option("--out", out, "output folder, e.g. 50_optimize")->required();
   app.add_option("--rounds", o.rounds, "rounds of optimisation (subdivisions between them)")
       ->capture_default_str();
@@ -32,8 +32,7 @@ int main(int argc, char** argv) {
   app.add_option("--lambda-dist", o.weights.dist, "λ2, distance to the points")
       ->capture_default_str();
   app.add_option("--lambda-fair3d", o.weights.fair3d, "λ3, fairness of M")->capture_default_str();
-  app.add_option("--lambda-fair2d", o.weights.fair2d, "λ4, fairness of M'")
-      ->capture_default_str();
+  app.add_option("--lambda-fair2d", o.weights.fair2d, "λ4, fairness of M'")->capture_default_str();
   app.add_option("--lambda-line", o.weights.line, "λ5, straightness of feature lines in M'")
       ->capture_default_str();
   app.add_option("--lambda-ray", o.weights.ray, "λ6, feature points on their viewing rays")
@@ -46,14 +45,17 @@ int main(int argc, char** argv) {
   app.add_option("--converged-iterations", o.converged_iterations,
                  "... for this many times (in a row or not), in the rounds before "
                  "--rises-from-round (1 = the paper: the first short step ends a round)")
-      ->capture_default_str()->check(CLI::Range(1, 100));
+      ->capture_default_str()
+      ->check(CLI::Range(1, 100));
   app.add_option("--max-rises", o.max_rises,
                  "inner loop also stops once F has risen from one outer iteration to the next this "
                  "many times (footpoints and markers re-decided make it oscillate); 0 = off")
-      ->capture_default_str()->check(CLI::Range(0, 100000));
+      ->capture_default_str()
+      ->check(CLI::Range(0, 100000));
   app.add_option("--rises-from-round", o.rises_from_round,
                  "--max-rises applies from this round on (the first rounds are cheap)")
-      ->capture_default_str()->check(CLI::Range(0, 100000));
+      ->capture_default_str()
+      ->check(CLI::Range(0, 100000));
   app.add_option("--max-iterations", o.max_outer_iterations, "outer iterations per round at most")
       ->capture_default_str();
   app.add_option("--outlier-distance", o.outlier_distance,
@@ -136,13 +138,15 @@ int main(int argc, char** argv) {
   app.add_option("--axis-lines", axis_lines,
                  "lines held along the axes of M': none (only straight, as in the paper), "
                  "features (text and rules), all (and the real page sides)")
-      ->capture_default_str()->check(CLI::IsMember({"none", "features", "all"}));
+      ->capture_default_str()
+      ->check(CLI::IsMember({"none", "features", "all"}));
   bool no_upright = false;
   app.add_flag("--no-upright-by-lines", no_upright,
                "keep init-mesh's upright M' even where the segments run off its axes");
   app.add_option("--upright-min-deg", o.upright_min_deg,
                  "turn M' when the segments run at least this many degrees off its axes")
-      ->capture_default_str()->check(CLI::Range(0.0, 45.0));
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 45.0));
   app.add_option("--threads", o.threads,
                  "solver threads at most; each outer iteration runs fewer "
                  "while other processes keep the cores busy")
@@ -168,14 +172,15 @@ int main(int argc, char** argv) {
     o.features = !no_features;
     o.project = !no_projection;
     o.upright_by_lines = !no_upright;
-    o.axis_lines = axis_lines == "none"     ? optimize::AxisLines::kNone
+    o.axis_lines = axis_lines == "none"       ? optimize::AxisLines::kNone
                    : axis_lines == "features" ? optimize::AxisLines::kFeatures
                                               : optimize::AxisLines::kAll;
     const Json options_json = {{"rounds", o.rounds},
                                {"solver", solver},
                                {"linear_solver", linear},
-                               {"lambda", {o.weights.iso, o.weights.dist, o.weights.fair3d,
-                                           o.weights.fair2d, o.weights.line, o.weights.ray}},
+                               {"lambda",
+                                {o.weights.iso, o.weights.dist, o.weights.fair3d, o.weights.fair2d,
+                                 o.weights.line, o.weights.ray}},
                                {"feature_growth", o.feature_weight_growth},
                                {"tolerance", o.relative_tolerance},
                                {"converged_iterations", o.converged_iterations},
@@ -211,9 +216,8 @@ int main(int argc, char** argv) {
     output.scene = !no_scene;
     optimize::WriteOutputs(out, paths, in, r, options_json, output);
     char buf[200];
-    std::snprintf(buf, sizeof buf,
-                  "wrote %s: %dx%d grid after %zu rounds, %zu lines, %.1f s", out.c_str(),
-                  r.meshes.grid.nx, r.meshes.grid.ny, r.rounds.size(),
+    std::snprintf(buf, sizeof buf, "wrote %s: %dx%d grid after %zu rounds, %zu lines, %.1f s",
+                  out.c_str(), r.meshes.grid.nx, r.meshes.grid.ny, r.rounds.size(),
                   r.rounds.back().lines.size(), r.seconds);
     Log(buf);
   });

@@ -1,10 +1,9 @@
 #include "stages/optimize/optimize.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
-
-#include <Eigen/Geometry>
 
 #include "common/axis_direction.h"
 #include "common/cli.h"
@@ -21,7 +20,8 @@ std::vector<Segment> MakeSegments(const OptimizeInputs& in, const OptimizeOption
   if (!o.features) return segments;
   for (int i = 0; i < 4; ++i) {
     if (!in.boundary.sides[i].real) continue;
-    segments.push_back({"boundary", i, SamplePolyline(in.boundary.sides[i].points, o.marker_step_px)});
+    segments.push_back(
+        {"boundary", i, SamplePolyline(in.boundary.sides[i].points, o.marker_step_px)});
     ++*boundary_lines;
   }
   if (o.boundary_only) return segments;
@@ -45,8 +45,7 @@ OptimizeResult Run(const OptimizeInputs& in, const OptimizeOptions& o) {
     const MarkerSet first = CastMarkers(in.init, in.reference, segments, o.cast);
     std::vector<Segment> kept;
     for (size_t s = 0; s < segments.size(); ++s) {
-      const bool on_page =
-          first.markers_of_segment[s] >= 0.5 * double(segments[s].pixels.size());
+      const bool on_page = first.markers_of_segment[s] >= 0.5 * double(segments[s].pixels.size());
       if (on_page || segments[s].kind == "boundary") {
         kept.push_back(segments[s]);
       } else {
@@ -57,8 +56,8 @@ OptimizeResult Run(const OptimizeInputs& in, const OptimizeOptions& o) {
     if (result.segments_off_page > 0)
       Log("warning: " + std::to_string(result.segments_off_page) + " of " +
           std::to_string(result.segments) +
-          " feature segments fall outside the page and are dropped (" +
-          in.features.file.string() + ")");
+          " feature segments fall outside the page and are dropped (" + in.features.file.string() +
+          ")");
   }
 
   result.region_points =
@@ -76,8 +75,8 @@ OptimizeResult Run(const OptimizeInputs& in, const OptimizeOptions& o) {
   // a side), they turn it, as the lines are kept only near the axes. A turn
   // of M' changes no term of F.
   if (o.upright_by_lines && !segments.empty()) {
-    const AxisDirection dir =
-        DominantLineDirection(meshes, CastMarkers(meshes, in.reference, segments, o.cast), segments);
+    const AxisDirection dir = DominantLineDirection(
+        meshes, CastMarkers(meshes, in.reference, segments, o.cast), segments);
     result.line_direction = dir;
     char buf[200];
     std::snprintf(buf, sizeof buf,
@@ -153,8 +152,7 @@ OptimizeResult Run(const OptimizeInputs& in, const OptimizeOptions& o) {
         *c.lines = AssignLines(*c.meshes, grouping, &current, o.axis_lines);
         if (o.side_outliers > 0)
           round.side_markers_dropped =
-              DropSideOutliers(*c.meshes, grouping, o.side_outliers, &current,
-                               o.side_end_outliers);
+              DropSideOutliers(*c.meshes, grouping, o.side_outliers, &current, o.side_end_outliers);
         c.markers->clear();
         kept.clear();
         for (size_t i = 0; i < current.markers.size(); ++i)

@@ -18,16 +18,16 @@
 namespace docunfold::optimize {
 
 struct OptimizeOptions {
-  int rounds = 4;  // rounds of optimisation; rounds - 1 subdivisions between them
-  isometry::Weights weights;          // λ1..λ6 of the first round (paper values)
-  double feature_weight_growth = 4;   // λ5 and λ6 are multiplied by this per subdivision
-  double relative_tolerance = 0.01;   // inner loop stops when |ΔF/F| < this (ε)
+  int rounds = 4;                    // rounds of optimisation; rounds - 1 subdivisions between them
+  isometry::Weights weights;         // λ1..λ6 of the first round (paper values)
+  double feature_weight_growth = 4;  // λ5 and λ6 are multiplied by this per subdivision
+  double relative_tolerance = 0.01;  // inner loop stops when |ΔF/F| < this (ε)
   // ... for the converged_iterations-th time (1 = the paper; see
   // isometry::SolveOptions::converged_iterations), in the rounds before
   // rises_from_round (below): they are cheap, and a round that stops on one
   // short step hands the next a page it has not finished fitting.
   int converged_iterations = 2;
-  int max_outer_iterations = 100;     // ... or after this many outer iterations (Q)
+  int max_outer_iterations = 100;  // ... or after this many outer iterations (Q)
   // ... or once F rose from one outer iteration to the next this often (0 =
   // off), in round rises_from_round and later. With markers re-decided every
   // iteration F can oscillate without settling in the fine rounds, where an
@@ -36,7 +36,7 @@ struct OptimizeOptions {
   // and may need many iterations (set02's first: 35, after a rise at the 4th).
   int max_rises = 3;
   int rises_from_round = 2;
-  double outlier_distance = 0.06;     // φ, fraction of the model size
+  double outlier_distance = 0.06;  // φ, fraction of the model size
   // Only points projecting into the document region of the reference view
   // (boundary contour grown by this many pixels) are fitted, as in
   // init-mesh; points of the table beside the page are within φ of M's edge
@@ -47,9 +47,9 @@ struct OptimizeOptions {
   // views but rounded an unsupported fold on set01 (README, "Choices we
   // measured").
   double unsupported_fairness = 1;
-  double support_radius = 0.03;       // fraction of the model size
-  double iso_edges = 0;               // isometry::SolveOptions::iso_edges
-  double fair2d_along = 1;            // isometry::SolveOptions::fair2d_along
+  double support_radius = 0.03;  // fraction of the model size
+  double iso_edges = 0;          // isometry::SolveOptions::iso_edges
+  double fair2d_along = 1;       // isometry::SolveOptions::fair2d_along
   // isometry::SolveOptions::fair2d_relative in this many rounds from the
   // first (0 = none, the paper).
   int fair2d_relative_rounds = 0;
@@ -72,8 +72,8 @@ struct OptimizeOptions {
   // two real sides (CornerMarkers) where init-mesh's corner projects within
   // this many reference pixels of them; 0 = off.
   double corner_max_px = 0;
-  double line_spacing = 0;            // isometry::SolveOptions::line_spacing
-  double max_spacing_ratio = 1.35;    // isometry::SolveOptions::max_spacing_ratio
+  double line_spacing = 0;          // isometry::SolveOptions::line_spacing
+  double max_spacing_ratio = 1.35;  // isometry::SolveOptions::max_spacing_ratio
   isometry::Method method = isometry::Method::kGaussNewton;
   isometry::LinearSolver linear_solver = isometry::LinearSolver::kAuto;
   bool features = true;        // false: no feature lines at all (--no-features)
@@ -87,7 +87,7 @@ struct OptimizeOptions {
   // +0.017, +0.015, +0.030 (set04 +0.16 each time, r02 +0.10, r01 +0.05;
   // worst single change set02 -0.022 and set07 -0.011).
   AxisLines axis_lines = AxisLines::kAll;
-  double marker_step_px = 4;   // sample spacing along segments, reference pixels
+  double marker_step_px = 4;  // sample spacing along segments, reference pixels
   // Turn M' before the first round when the detected segments (text rows,
   // rules) run at least upright_min_deg off its axes: at least
   // upright_min_segments of them, upright_min_share of their length within
@@ -106,9 +106,9 @@ struct OptimizeOptions {
 };
 
 struct OptimizeInputs {
-  MeshPair init;                         // 40_init/
-  PinholeCamera reference;               // reference camera (world = its frame)
-  std::vector<Eigen::Vector3d> points;   // points to fit (sfm's or densify's)
+  MeshPair init;                                     // 40_init/
+  PinholeCamera reference;                           // reference camera (world = its frame)
+  std::vector<Eigen::Vector3d> points;               // points to fit (sfm's or densify's)
   std::vector<std::array<uint8_t, 3>> point_colors;  // empty, or one per point
   Boundary boundary;
   FeatureFile features;
@@ -119,9 +119,9 @@ struct LineRecord {
   std::string kind;  // text, edge, boundary
   int side = -1;     // boundary side (0 top, 1 right, 2 bottom, 3 left)
   int segments = 0;
-  isometry::FeatureLine line;             // n·p' = offset in M'
-  std::vector<Eigen::Vector2d> pixels;    // its markers in the reference image
-  std::vector<Eigen::Vector2d> flat;      // and in M'
+  isometry::FeatureLine line;           // n·p' = offset in M'
+  std::vector<Eigen::Vector2d> pixels;  // its markers in the reference image
+  std::vector<Eigen::Vector2d> flat;    // and in M'
 };
 
 struct RoundResult {
@@ -137,19 +137,19 @@ struct RoundResult {
 };
 
 struct OptimizeResult {
-  MeshPair meshes;                 // final M and M'
+  MeshPair meshes;  // final M and M'
   std::vector<RoundResult> rounds;
   std::vector<int> region_points;  // indices of the SfM points in the document region
   AxisDirection line_direction;    // of the segments in M' before the first round
   // The reader's down in the final M' (unit), from the feature file's
   // text_down through an affine fit of the final lines' pixels to M'.
   std::optional<Eigen::Vector2d> text_down_flat;
-  double upright_turn_deg = 0;     // M' turned by this before the first round
-  std::vector<bool> inliers;       // per region point, after the last round
-  int segments = 0;                // feature segments given (text + edge)
-  int segments_off_page = 0;       // of those, dropped: their samples miss M
-  int boundary_lines = 0;          // real boundary sides used
-  int held_corners = 0;            // page corners M's grid corners were held to
+  double upright_turn_deg = 0;  // M' turned by this before the first round
+  std::vector<bool> inliers;    // per region point, after the last round
+  int segments = 0;             // feature segments given (text + edge)
+  int segments_off_page = 0;    // of those, dropped: their samples miss M
+  int boundary_lines = 0;       // real boundary sides used
+  int held_corners = 0;         // page corners M's grid corners were held to
   double seconds = 0;
 };
 

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-
 #include <opencv2/imgproc.hpp>
 
 #include "common/atomic_file.h"
@@ -35,25 +34,24 @@ OptimizeInputs ReadInputs(const InputPaths& paths) {
                      ": no reference view (not written by sfm?)");
   in.reference = *ref;
   const PlyData points = ReadPly(paths.PointsFile());
-  if (points.vertices.empty())
-    throw InputError(paths.PointsFile().string() + ": no points");
+  if (points.vertices.empty()) throw InputError(paths.PointsFile().string() + ": no points");
   in.points = points.vertices;
   in.point_colors = points.colors;
   const fs::path boundary_file =
       fs::is_directory(paths.boundary) ? paths.boundary / "boundary.json" : paths.boundary;
   in.boundary = ReadBoundary(boundary_file);
   if (in.boundary.width != ref->width || in.boundary.height != ref->height)
-    throw InputError(boundary_file.string() + ": found in a " +
-                     std::to_string(in.boundary.width) + "x" + std::to_string(in.boundary.height) +
+    throw InputError(boundary_file.string() + ": found in a " + std::to_string(in.boundary.width) +
+                     "x" + std::to_string(in.boundary.height) +
                      " image, but the reference view is " + std::to_string(ref->width) + "x" +
                      std::to_string(ref->height));
   in.features = ReadFeatures(paths.features);
   if (in.features.width > 0 &&
       (in.features.width != ref->width || in.features.height != ref->height))
     throw InputError(paths.features.string() + ": segments of a " +
-                     std::to_string(in.features.width) + "x" +
-                     std::to_string(in.features.height) + " image, but the reference view is " +
-                     std::to_string(ref->width) + "x" + std::to_string(ref->height));
+                     std::to_string(in.features.width) + "x" + std::to_string(in.features.height) +
+                     " image, but the reference view is " + std::to_string(ref->width) + "x" +
+                     std::to_string(ref->height));
   in.init = ReadMeshPair(paths.init);
   return in;
 }
@@ -76,8 +74,7 @@ Json LinesJson(const std::vector<LineRecord>& lines, const Json& options_json,
     if (l.side >= 0) j["side"] = kSideNames[l.side];
     doc["lines"].push_back(j);
   }
-  if (text_down_flat)
-    doc["text_down_flat"] = {text_down_flat->x(), text_down_flat->y()};
+  if (text_down_flat) doc["text_down_flat"] = {text_down_flat->x(), text_down_flat->y()};
   return doc;
 }
 
@@ -145,15 +142,17 @@ void WriteOutputs(const fs::path& out, const InputPaths& paths, const OptimizeIn
   // same texture (the rectified page), and the SfM points M was fitted to.
   cv::Mat texture = ReadImage(reference_image);
   const double shrink = std::min(1.0, double(output_options.texture_width) / texture.cols);
-  if (shrink < 1)
-    cv::resize(texture, texture, cv::Size(), shrink, shrink, cv::INTER_AREA);
+  if (shrink < 1) cv::resize(texture, texture, cv::Size(), shrink, shrink, cv::INTER_AREA);
   GltfMesh m3, m2;
   m3.name = "M (page in 3D)";
   m2.name = "M' (flat page)";
   m3.texture = m2.texture = texture;
   m3.triangles = m2.triangles = result.meshes.grid.Triangles();
   Eigen::Vector3d lo3 = result.meshes.mesh3d[0], hi3 = lo3;
-  for (const auto& v : result.meshes.mesh3d) { lo3 = lo3.cwiseMin(v); hi3 = hi3.cwiseMax(v); }
+  for (const auto& v : result.meshes.mesh3d) {
+    lo3 = lo3.cwiseMin(v);
+    hi3 = hi3.cwiseMax(v);
+  }
   Eigen::Vector2d lo2 = result.meshes.mesh2d[0];
   for (const auto& v : result.meshes.mesh2d) lo2 = lo2.cwiseMin(v);
   const double gap = 0.1 * (hi3 - lo3).norm();

@@ -4,9 +4,8 @@
 #pragma once
 
 #include <filesystem>
-#include <optional>
-
 #include <opencv2/core.hpp>
+#include <optional>
 
 #include "common/json_io.h"
 #include "stages/optimize/optimize.h"
@@ -28,7 +27,7 @@ struct InputPaths {
 OptimizeInputs ReadInputs(const InputPaths& paths);
 
 struct OutputOptions {
-  bool scene = true;       // write scene.glb
+  bool scene = true;         // write scene.glb
   int texture_width = 2048;  // scene.glb's texture, pixels at most
 };
 

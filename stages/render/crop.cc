@@ -13,32 +13,29 @@ namespace {
 
 Triangle CornersOf(const QuadGrid& grid, int triangle) {
   const auto c = grid.Quad(triangle / 2);
-  return triangle % 2 == 0 ? Triangle{c[0], c[1], c[2]}
-                           : Triangle{c[0], c[2], c[3]};
+  return triangle % 2 == 0 ? Triangle{c[0], c[1], c[2]} : Triangle{c[0], c[2], c[3]};
 }
 
 // Where the viewing ray of `pixel` meets the plane of `triangle`, as a point
 // of M' (barycentrics may lie slightly outside the triangle).
-std::optional<Eigen::Vector2d> RayThroughTrianglePlane(
-    const MeshPair& mesh, const PinholeCamera& camera, int triangle,
-    const Eigen::Vector2d& pixel) {
+std::optional<Eigen::Vector2d> RayThroughTrianglePlane(const MeshPair& mesh,
+                                                       const PinholeCamera& camera, int triangle,
+                                                       const Eigen::Vector2d& pixel) {
   const Triangle t = CornersOf(mesh.grid, triangle);
   const Eigen::Vector3d a = camera.CamFromWorld(mesh.mesh3d[t[0]]);
   const Eigen::Vector3d b = camera.CamFromWorld(mesh.mesh3d[t[1]]);
   const Eigen::Vector3d c = camera.CamFromWorld(mesh.mesh3d[t[2]]);
-  const Eigen::Vector3d d =
-      camera.K.inverse() * Eigen::Vector3d(pixel.x(), pixel.y(), 1);
+  const Eigen::Vector3d d = camera.K.inverse() * Eigen::Vector3d(pixel.x(), pixel.y(), 1);
   Eigen::Matrix3d A;
   A << b - a, c - a, -d;
   const Eigen::Vector3d sol = A.colPivHouseholderQr().solve(-a);
   if (!sol.allFinite() || sol[2] <= 0) return std::nullopt;
-  return (1 - sol[0] - sol[1]) * mesh.mesh2d[t[0]] +
-         sol[0] * mesh.mesh2d[t[1]] + sol[1] * mesh.mesh2d[t[2]];
+  return (1 - sol[0] - sol[1]) * mesh.mesh2d[t[0]] + sol[0] * mesh.mesh2d[t[1]] +
+         sol[1] * mesh.mesh2d[t[2]];
 }
 
 // Nearest pixel centre of the raster within `radius` that shows M.
-int NearestFace(const RasterResult& raster, const Eigen::Vector2d& p,
-                double radius) {
+int NearestFace(const RasterResult& raster, const Eigen::Vector2d& p, double radius) {
   const int r = int(std::ceil(radius));
   const int cx = int(std::lround(p.x())), cy = int(std::lround(p.y()));
   int best = -1;
@@ -73,10 +70,8 @@ Line FitTotalLeastSquares(const std::vector<Eigen::Vector2d>& pts) {
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(cov);
   Line line;
   line.point = mean;
-  line.direction =
-      eig.eigenvectors().col(1).normalized();  // largest eigenvalue
-  line.rms =
-      std::sqrt(std::max(0.0, eig.eigenvalues()[0]) / double(pts.size()));
+  line.direction = eig.eigenvectors().col(1).normalized();  // largest eigenvalue
+  line.rms = std::sqrt(std::max(0.0, eig.eigenvalues()[0]) / double(pts.size()));
   return line;
 }
 
@@ -91,16 +86,15 @@ double XAt(const SideFit& s, double y) {
   return s.point.x() + (y - s.point.y()) * s.direction.x() / s.direction.y();
 }
 
-std::vector<Eigen::Vector2d> MapPolylineOntoFlat(
-    const MeshPair& mesh, const PinholeCamera& camera,
-    const PixelToSurface& lookup, const std::vector<Eigen::Vector2d>& polyline,
-    double snap_px, int* samples, int max_samples) {
+std::vector<Eigen::Vector2d> MapPolylineOntoFlat(const MeshPair& mesh, const PinholeCamera& camera,
+                                                 const PixelToSurface& lookup,
+                                                 const std::vector<Eigen::Vector2d>& polyline,
+                                                 double snap_px, int* samples, int max_samples) {
   std::vector<Eigen::Vector2d> out;
   *samples = 0;
   if (polyline.size() < 2) return out;
   double length = 0;
-  for (size_t i = 1; i < polyline.size(); ++i)
-    length += (polyline[i] - polyline[i - 1]).norm();
+  for (size_t i = 1; i < polyline.size(); ++i) length += (polyline[i] - polyline[i - 1]).norm();
   const double step = std::max(1.0, length / std::max(1, max_samples));
   auto map_one = [&](const Eigen::Vector2d& p) {
     ++*samples;
@@ -125,20 +119,18 @@ std::vector<Eigen::Vector2d> MapPolylineOntoFlat(
   return out;
 }
 
-SideFit FitSideLine(int side, bool real,
-                    const std::vector<Eigen::Vector2d>& flat_points,
+SideFit FitSideLine(int side, bool real, const std::vector<Eigen::Vector2d>& flat_points,
                     int samples) {
   SideFit fit;
   fit.real = real;
   fit.samples = samples;
-  fit.direction = (side == 0 || side == 2) ? Eigen::Vector2d::UnitX()
-                                           : Eigen::Vector2d::UnitY();
+  fit.direction = (side == 0 || side == 2) ? Eigen::Vector2d::UnitX() : Eigen::Vector2d::UnitY();
   if (!real) return fit;
   std::vector<Eigen::Vector2d> pts = flat_points;
   if (pts.size() < 10) {
     fit.mapped = int(pts.size());
-    fit.note = "only " + std::to_string(pts.size()) + " of " +
-               std::to_string(samples) + " samples map onto the mesh";
+    fit.note = "only " + std::to_string(pts.size()) + " of " + std::to_string(samples) +
+               " samples map onto the mesh";
     return fit;
   }
   Line line = FitTotalLeastSquares(pts);
@@ -147,8 +139,7 @@ SideFit FitSideLine(int side, bool real,
   for (int round = 0; round < 2; ++round) {
     const Eigen::Vector2d normal(-line.direction.y(), line.direction.x());
     std::vector<double> res;
-    for (const auto& p : pts)
-      res.push_back(std::abs(normal.dot(p - line.point)));
+    for (const auto& p : pts) res.push_back(std::abs(normal.dot(p - line.point)));
     const double mad = Median(res);
     const double limit = std::max(4.0 * 1.4826 * mad, 1e-12);
     std::vector<Eigen::Vector2d> kept;
@@ -167,15 +158,14 @@ SideFit FitSideLine(int side, bool real,
   if ((horizontal ? d.x() : d.y()) < 0) d = -d;
   fit.direction = d;
   if (fit.mapped < std::max(10.0, 0.3 * samples)) {
-    fit.note = "only " + std::to_string(fit.mapped) + " of " +
-               std::to_string(samples) + " samples map onto the mesh";
+    fit.note = "only " + std::to_string(fit.mapped) + " of " + std::to_string(samples) +
+               " samples map onto the mesh";
     return fit;
   }
   // A side that runs closer to the other axis means M' is not upright or the
   // boundary's sides are mislabelled; its line would cut the page diagonally.
   if (std::abs(horizontal ? d.x() : d.y()) < std::cos(M_PI / 4)) {
-    fit.note =
-        "fitted line is more than 45 degrees off its axis (is M' upright?)";
+    fit.note = "fitted line is more than 45 degrees off its axis (is M' upright?)";
     return fit;
   }
   fit.used = true;
@@ -205,8 +195,8 @@ void RotateSide(SideFit* side, double angle) {
   side->direction = rot * side->direction;
 }
 
-CropRect ChooseCrop(std::array<SideFit, 4>* sides_in,
-                    const Eigen::Vector4d& visible_box, double middle_max_slant) {
+CropRect ChooseCrop(std::array<SideFit, 4>* sides_in, const Eigen::Vector4d& visible_box,
+                    double middle_max_slant) {
   std::array<SideFit, 4>& sides = *sides_in;
   const double cx = 0.5 * (visible_box[0] + visible_box[2]);
   const double cy = 0.5 * (visible_box[1] + visible_box[3]);
@@ -215,18 +205,15 @@ CropRect ChooseCrop(std::array<SideFit, 4>* sides_in,
     sides[i].used = false;
     sides[i].note = why;
   };
-  if (sides[0].used && sides[2].used &&
-      YAt(sides[0], cx) >= YAt(sides[2], cx)) {
+  if (sides[0].used && sides[2].used && YAt(sides[0], cx) >= YAt(sides[2], cx)) {
     drop(0, "top line lies below the bottom line in M'");
     drop(2, "bottom line lies above the top line in M'");
   }
-  if (sides[3].used && sides[1].used &&
-      XAt(sides[3], cy) >= XAt(sides[1], cy)) {
+  if (sides[3].used && sides[1].used && XAt(sides[3], cy) >= XAt(sides[1], cy)) {
     drop(3, "left line lies right of the right line in M'");
     drop(1, "right line lies left of the left line in M'");
   }
-  CropRect crop{visible_box[0], visible_box[1], visible_box[2], visible_box[3],
-                ""};
+  CropRect crop{visible_box[0], visible_box[1], visible_box[2], visible_box[3], ""};
   std::array<bool, 4> middle{};
   for (int i = 0; i < 4; ++i)
     middle[i] = sides[i].used && std::abs(SlantOf(sides[i], i)) <= middle_max_slant;
@@ -238,39 +225,33 @@ CropRect ChooseCrop(std::array<SideFit, 4>* sides_in,
     CropRect next = crop;
     const double mx = 0.5 * (crop.x0 + crop.x1), my = 0.5 * (crop.y0 + crop.y1);
     if (sides[0].used)
-      next.y0 = middle[0] ? YAt(sides[0], mx)
-                          : std::max(YAt(sides[0], crop.x0), YAt(sides[0], crop.x1));
+      next.y0 =
+          middle[0] ? YAt(sides[0], mx) : std::max(YAt(sides[0], crop.x0), YAt(sides[0], crop.x1));
     if (sides[2].used)
-      next.y1 = middle[2] ? YAt(sides[2], mx)
-                          : std::min(YAt(sides[2], crop.x0), YAt(sides[2], crop.x1));
+      next.y1 =
+          middle[2] ? YAt(sides[2], mx) : std::min(YAt(sides[2], crop.x0), YAt(sides[2], crop.x1));
     if (sides[3].used)
-      next.x0 = middle[3] ? XAt(sides[3], my)
-                          : std::max(XAt(sides[3], crop.y0), XAt(sides[3], crop.y1));
+      next.x0 =
+          middle[3] ? XAt(sides[3], my) : std::max(XAt(sides[3], crop.y0), XAt(sides[3], crop.y1));
     if (sides[1].used)
-      next.x1 = middle[1] ? XAt(sides[1], my)
-                          : std::min(XAt(sides[1], crop.y0), XAt(sides[1], crop.y1));
+      next.x1 =
+          middle[1] ? XAt(sides[1], my) : std::min(XAt(sides[1], crop.y0), XAt(sides[1], crop.y1));
     crop = next;
   }
-  const int used =
-      int(sides[0].used) + sides[1].used + sides[2].used + sides[3].used;
-  const double box_w = visible_box[2] - visible_box[0],
-               box_h = visible_box[3] - visible_box[1];
-  const bool degenerate =
-      !(crop.Width() > 0.02 * box_w && crop.Height() > 0.02 * box_h) ||
-      !std::isfinite(crop.x0 + crop.x1 + crop.y0 + crop.y1);
+  const int used = int(sides[0].used) + sides[1].used + sides[2].used + sides[3].used;
+  const double box_w = visible_box[2] - visible_box[0], box_h = visible_box[3] - visible_box[1];
+  const bool degenerate = !(crop.Width() > 0.02 * box_w && crop.Height() > 0.02 * box_h) ||
+                          !std::isfinite(crop.x0 + crop.x1 + crop.y0 + crop.y1);
   if (used == 0 || degenerate) {
     if (degenerate)
-      for (int i = 0; i < 4; ++i)
-        drop(i, "the lines bound no usable rectangle");
-    return {visible_box[0], visible_box[1], visible_box[2], visible_box[3],
-            "visible-mesh"};
+      for (int i = 0; i < 4; ++i) drop(i, "the lines bound no usable rectangle");
+    return {visible_box[0], visible_box[1], visible_box[2], visible_box[3], "visible-mesh"};
   }
   crop.rule = used == 4 ? "boundary-lines" : "real-sides-and-visible-mesh";
   return crop;
 }
 
-PageFormatFit ExtendToPageFormat(CropRect* crop, const std::array<bool, 4>& unseen,
-                                 double aspect) {
+PageFormatFit ExtendToPageFormat(CropRect* crop, const std::array<bool, 4>& unseen, double aspect) {
   PageFormatFit fit;
   const bool x_unseen = unseen[1] || unseen[3], y_unseen = unseen[0] || unseen[2];
   if (!x_unseen && !y_unseen) return fit;

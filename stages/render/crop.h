@@ -21,17 +21,17 @@ namespace docunfold::render {
 // within `snap_px` and intersected with that triangle's plane (the mesh
 // border may run a pixel or two inside the segmented boundary); farther
 // samples are dropped. `samples` receives the number of samples taken.
-std::vector<Eigen::Vector2d> MapPolylineOntoFlat(
-    const MeshPair& mesh, const PinholeCamera& camera,
-    const PixelToSurface& lookup, const std::vector<Eigen::Vector2d>& polyline,
-    double snap_px, int* samples, int max_samples = 4000);
+std::vector<Eigen::Vector2d> MapPolylineOntoFlat(const MeshPair& mesh, const PinholeCamera& camera,
+                                                 const PixelToSurface& lookup,
+                                                 const std::vector<Eigen::Vector2d>& polyline,
+                                                 double snap_px, int* samples,
+                                                 int max_samples = 4000);
 
 // Fits a straight line to the points of side `side` (0 top, 1 right,
 // 2 bottom, 3 left) by total least squares with MAD-based outlier removal.
 // Directions point +x for top/bottom and +y for left/right. The side is
 // `used` when at least 10 points and 30% of the samples survive.
-SideFit FitSideLine(int side, bool real,
-                    const std::vector<Eigen::Vector2d>& flat_points,
+SideFit FitSideLine(int side, bool real, const std::vector<Eigen::Vector2d>& flat_points,
                     int samples);
 
 // Where a fitted side's line crosses x (top, bottom) or y (left, right).
@@ -48,8 +48,7 @@ void RotateSide(SideFit* side, double angle);
 
 struct CropRect {
   double x0 = 0, y0 = 0, x1 = 0, y1 = 0;
-  std::string
-      rule;  // boundary-lines | real-sides-and-visible-mesh | visible-mesh
+  std::string rule;  // boundary-lines | real-sides-and-visible-mesh | visible-mesh
   double Width() const { return x1 - x0; }
   double Height() const { return y1 - y0; }
 };
@@ -64,8 +63,8 @@ struct CropRect {
 // bounds the rectangle where it crosses the middle of the other axis' extent
 // instead: a slightly slanted line then cuts off as much page at one end as
 // it leaves table at the other. (Negative: every side inscribed.)
-CropRect ChooseCrop(std::array<SideFit, 4>* sides,
-                    const Eigen::Vector4d& visible_box, double middle_max_slant = -1);
+CropRect ChooseCrop(std::array<SideFit, 4>* sides, const Eigen::Vector4d& visible_box,
+                    double middle_max_slant = -1);
 
 // A page cut off where no photo sees its edge ends somewhere past the crop;
 // a paper format of long-to-short ratio `aspect` says where. Lengthens `crop`
@@ -75,8 +74,7 @@ CropRect ChooseCrop(std::array<SideFit, 4>* sides,
 // the lengthening. Not applied when both axes have an unseen side (W is then
 // not the page's) or the part seen is longer than W * aspect (+1 %: not that
 // format).
-PageFormatFit ExtendToPageFormat(CropRect* crop, const std::array<bool, 4>& unseen,
-                                 double aspect);
+PageFormatFit ExtendToPageFormat(CropRect* crop, const std::array<bool, 4>& unseen, double aspect);
 
 // Angle (radians) of a side's line from its axis: from +x for top and
 // bottom, from +y for left and right, positive clockwise in image axes.

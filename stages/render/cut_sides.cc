@@ -4,8 +4,8 @@
 #include <cmath>
 #include <memory>
 #include <opencv2/calib3d.hpp>
-#include <opencv2/features2d.hpp>
 #include <opencv2/core/utility.hpp>
+#include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "common/raster.h"
@@ -59,10 +59,12 @@ Border GridBorder(const QuadGrid& g, int b, int depth) {
 
 }  // namespace
 
-std::array<CutSideEdge, 4> FindCutSideEdges(
-    const MeshPair& meshes, const std::vector<Eigen::Vector2d>& flat,
-    const Eigen::Vector4d& visible_box, const std::array<bool, 4>& cut,
-    const std::vector<ViewMask>& views, const CutSideOptions& options) {
+std::array<CutSideEdge, 4> FindCutSideEdges(const MeshPair& meshes,
+                                            const std::vector<Eigen::Vector2d>& flat,
+                                            const Eigen::Vector4d& visible_box,
+                                            const std::array<bool, 4>& cut,
+                                            const std::vector<ViewMask>& views,
+                                            const CutSideOptions& options) {
   std::array<CutSideEdge, 4> edges;
   const QuadGrid& g = meshes.grid;
   if (g.nx < 3 || g.ny < 3) return edges;
@@ -75,8 +77,8 @@ std::array<CutSideEdge, 4> FindCutSideEdges(
     }
     const Eigen::Vector2d n = Outward(side);
     const bool vertical_axis = side == 0 || side == 2;  // the bound is a y
-    const double extent = vertical_axis ? visible_box[3] - visible_box[1]
-                                        : visible_box[2] - visible_box[0];
+    const double extent =
+        vertical_axis ? visible_box[3] - visible_box[1] : visible_box[2] - visible_box[0];
     // The grid border lying farthest out on this side of M'.
     int best = 0;
     double best_out = -1e300;
@@ -90,22 +92,19 @@ std::array<CutSideEdge, 4> FindCutSideEdges(
       }
     }
     const int rows_inward = (best == 0 || best == 2) ? g.ny - 1 : g.nx - 1;
-    const int depth = std::clamp(
-        int(std::lround(options.base_fraction * rows_inward)), 1, rows_inward);
+    const int depth =
+        std::clamp(int(std::lround(options.base_fraction * rows_inward)), 1, rows_inward);
     const Border border = GridBorder(g, best, depth);
     constexpr int kStepsPerExtent = 400;
     std::vector<double> crossings;
     std::vector<double> seen_page;  // per column: the farthest page seen
     // Per border column: the continuation's direction (per step of t).
-    std::vector<Eigen::Vector3d> dir3(border.vertex.size(),
-                                      Eigen::Vector3d::Zero());
-    std::vector<Eigen::Vector2d> dir2(border.vertex.size(),
-                                      Eigen::Vector2d::Zero());
+    std::vector<Eigen::Vector3d> dir3(border.vertex.size(), Eigen::Vector3d::Zero());
+    std::vector<Eigen::Vector2d> dir2(border.vertex.size(), Eigen::Vector2d::Zero());
     std::vector<char> view_crossed(views.size(), 0);
     for (size_t k = 0; k < border.vertex.size(); ++k) {
       const int vb = border.vertex[k], vi = border.inner[k];
-      const Eigen::Vector3d d3 =
-          (meshes.mesh3d[vb] - meshes.mesh3d[vi]) / depth;
+      const Eigen::Vector3d d3 = (meshes.mesh3d[vb] - meshes.mesh3d[vi]) / depth;
       const Eigen::Vector2d d2 = (flat[vb] - flat[vi]) / depth;
       const double speed = n.dot(d2);  // outward M' distance per step of t
       if (!(speed > 0)) continue;
@@ -116,21 +115,17 @@ std::array<CutSideEdge, 4> FindCutSideEdges(
       double column_seen = std::nan("");  // farthest page any view sees here
       for (size_t v = 0; v < views.size(); ++v) {
         const ViewMask& view = views[v];
-        const double m = options.frame_margin *
-                         std::hypot(view.camera.width, view.camera.height);
+        const double m = options.frame_margin * std::hypot(view.camera.width, view.camera.height);
         // -1 unseen (behind the camera or off the photo), 0 table, 1 page.
         auto state_at = [&](int j, Eigen::Vector2d* px) {
-          const auto projected = ProjectDistorted(
-              view.camera, view.distortion, meshes.mesh3d[vb] + j * dt * d3);
+          const auto projected =
+              ProjectDistorted(view.camera, view.distortion, meshes.mesh3d[vb] + j * dt * d3);
           if (!projected) return -1;
           *px = *projected;
-          if (!(px->x() >= m && px->y() >= m &&
-                px->x() <= view.camera.width - 1 - m &&
+          if (!(px->x() >= m && px->y() >= m && px->x() <= view.camera.width - 1 - m &&
                 px->y() <= view.camera.height - 1 - m))
             return -1;
-          return view.mask(int(std::lround(px->y())), int(std::lround(px->x())))
-                     ? 1
-                     : 0;
+          return view.mask(int(std::lround(px->y())), int(std::lround(px->x()))) ? 1 : 0;
         };
         // Out from the border for as long as the view sees page there.
         Eigen::Vector2d px;
@@ -179,16 +174,14 @@ std::array<CutSideEdge, 4> FindCutSideEdges(
       // No photo sees the edge itself; the page reaches at least as far as
       // the photos see it (a high quantile over the columns: the page is a
       // rectangle, so page seen past any column is page past the side).
-      edge.bound =
-          Quantile(seen_page, side == 0 || side == 3 ? 1 - options.seen_quantile
-                                                     : options.seen_quantile);
+      edge.bound = Quantile(
+          seen_page, side == 0 || side == 3 ? 1 - options.seen_quantile : options.seen_quantile);
     } else {
       edge.note =
           "the other views see neither the page edge nor page past this side "
           "(" +
-          std::to_string(edge.crossings) + " crossings, " +
-          std::to_string(edge.columns_seen) + " columns seen; " +
-          std::to_string(options.min_crossings) + " needed)";
+          std::to_string(edge.crossings) + " crossings, " + std::to_string(edge.columns_seen) +
+          " columns seen; " + std::to_string(options.min_crossings) + " needed)";
       continue;
     }
     const double visible_bound = visible_box[BoxIndexOfSide(side)];
@@ -211,15 +204,12 @@ std::array<CutSideEdge, 4> FindCutSideEdges(
       for (int k = 0; k < strip.cols; ++k) {
         const int vb = border.vertex[k];
         const double speed = n.dot(dir2[k]);
-        const double t_end =
-            speed > 0 ? std::max(0.0, (target - n.dot(flat[vb])) / speed) : 0;
+        const double t_end = speed > 0 ? std::max(0.0, (target - n.dot(flat[vb])) / speed) : 0;
         for (int j = 0; j < strip.rows; ++j) {
           // Band rows run back over the mesh, towards the inner vertex.
-          const double t = j < band
-                               ? -double(depth) * (band - j) / band
-                               : t_end * (j - band) / (strip.rows - band - 1);
-          strip.mesh3d[size_t(j) * strip.cols + k] =
-              meshes.mesh3d[vb] + t * dir3[k];
+          const double t = j < band ? -double(depth) * (band - j) / band
+                                    : t_end * (j - band) / (strip.rows - band - 1);
+          strip.mesh3d[size_t(j) * strip.cols + k] = meshes.mesh3d[vb] + t * dir3[k];
           strip.flat[size_t(j) * strip.cols + k] = flat[vb] + t * dir2[k];
         }
       }
@@ -238,8 +228,8 @@ struct StripMesh {
   std::vector<Triangle> triangles;
 };
 
-StripMesh JoinStrips(const std::vector<const ExtensionStrip*>& strips,
-                     double x0, double y0, double scale) {
+StripMesh JoinStrips(const std::vector<const ExtensionStrip*>& strips, double x0, double y0,
+                     double scale) {
   StripMesh m;
   for (const ExtensionStrip* strip : strips) {
     const int base = int(m.screen.size());
@@ -250,8 +240,8 @@ StripMesh JoinStrips(const std::vector<const ExtensionStrip*>& strips,
     }
     for (int j = 0; j + 1 < strip->rows; ++j)
       for (int k = 0; k + 1 < strip->cols; ++k) {
-        const int a = base + j * strip->cols + k, b = a + 1,
-                  c = a + strip->cols + 1, d = a + strip->cols;
+        const int a = base + j * strip->cols + k, b = a + 1, c = a + strip->cols + 1,
+                  d = a + strip->cols;
         m.triangles.push_back({a, b, c});
         m.triangles.push_back({a, c, d});
       }
@@ -267,8 +257,8 @@ struct ViewRendering {
 };
 
 ViewRendering RenderStripsFromView(const StripMesh& m, const ViewMask& view,
-                                   const TextureSampler& sampler, int width,
-                                   int height, bool antialias) {
+                                   const TextureSampler& sampler, int width, int height,
+                                   bool antialias) {
   const std::vector<Eigen::Vector3d>& screen = m.screen;
   const RasterResult raster = Rasterize(screen, m.triangles, width, height);
   // Per triangle: all corners on the view's page mask, and the affine map
@@ -278,17 +268,14 @@ ViewRendering RenderStripsFromView(const StripMesh& m, const ViewMask& view,
   for (size_t f = 0; f < m.triangles.size(); ++f) {
     const Triangle& t = m.triangles[f];
     Eigen::Matrix2d S;
-    S << (screen[t[1]] - screen[t[0]]).head<2>(),
-        (screen[t[2]] - screen[t[0]]).head<2>();
+    S << (screen[t[1]] - screen[t[0]]).head<2>(), (screen[t[2]] - screen[t[0]]).head<2>();
     if (!(std::abs(S.determinant()) > 1e-9)) continue;
     Eigen::Vector2d px[3];
     bool ok = true;
     for (int c = 0; c < 3 && ok; ++c) {
-      const auto projected =
-          ProjectDistorted(view.camera, view.distortion, m.world[t[c]]);
+      const auto projected = ProjectDistorted(view.camera, view.distortion, m.world[t[c]]);
       if (projected) px[c] = *projected;
-      ok = projected && px[c].x() >= 0 && px[c].y() >= 0 &&
-           px[c].x() <= view.camera.width - 1 &&
+      ok = projected && px[c].x() >= 0 && px[c].y() >= 0 && px[c].x() <= view.camera.width - 1 &&
            px[c].y() <= view.camera.height - 1 &&
            view.mask(int(std::lround(px[c].y())), int(std::lround(px[c].x())));
     }
@@ -298,27 +285,25 @@ ViewRendering RenderStripsFromView(const StripMesh& m, const ViewMask& view,
     usable[f] = 1;
     jacobian[f] = P * S.inverse();
   }
-  ViewRendering out{cv::Mat3b(height, width, cv::Vec3b(0, 0, 0)),
-                    cv::Mat1f(height, width, 0.0f)};
+  ViewRendering out{cv::Mat3b(height, width, cv::Vec3b(0, 0, 0)), cv::Mat1f(height, width, 0.0f)};
   for (int y = 0; y < height; ++y) {
     for (int x = 0; x < width; ++x) {
       const int f = raster.face(y, x);
       if (f < 0 || !usable[f]) continue;
       const Triangle& t = m.triangles[f];
       const cv::Vec2f b = raster.bary(y, x);
-      const Eigen::Vector3d p = (1 - b[0] - b[1]) * m.world[t[0]] +
-                                b[0] * m.world[t[1]] + b[1] * m.world[t[2]];
+      const Eigen::Vector3d p =
+          (1 - b[0] - b[1]) * m.world[t[0]] + b[0] * m.world[t[1]] + b[1] * m.world[t[2]];
       const auto projected = ProjectDistorted(view.camera, view.distortion, p);
       if (!projected) continue;
       const Eigen::Vector2d px = *projected;
       const Eigen::Matrix2d& J = jacobian[f];
-      const float Jf[4] = {float(J(0, 0)), float(J(0, 1)), float(J(1, 0)),
-                           float(J(1, 1))};
+      const float Jf[4] = {float(J(0, 0)), float(J(0, 1)), float(J(1, 0)), float(J(1, 1))};
       float colour[3];
       sampler.Sample(float(px.x()), float(px.y()), Jf, antialias, colour);
-      out.colour(y, x) = cv::Vec3b(cv::saturate_cast<uchar>(colour[0]),
-                                   cv::saturate_cast<uchar>(colour[1]),
-                                   cv::saturate_cast<uchar>(colour[2]));
+      out.colour(y, x) =
+          cv::Vec3b(cv::saturate_cast<uchar>(colour[0]), cv::saturate_cast<uchar>(colour[1]),
+                    cv::saturate_cast<uchar>(colour[2]));
       out.density(y, x) = float(std::sqrt(std::abs(J.determinant())));
     }
   }
@@ -344,8 +329,7 @@ struct ReferenceRendering {
   cv::Mat1b keypoints;  // `valid` away from its border (SIFT's mask)
 };
 
-ReferenceRendering PrepareReference(const cv::Mat3b& image,
-                                    const cv::Mat1b& valid) {
+ReferenceRendering PrepareReference(const cv::Mat3b& image, const cv::Mat1b& valid) {
   ReferenceRendering r;
   cv::cvtColor(image, r.grey, cv::COLOR_BGR2GRAY);
   r.detail = FineDetail(image);
@@ -357,8 +341,8 @@ ReferenceRendering PrepareReference(const cv::Mat3b& image,
 // The affine map (output pixels) that moves `view` onto the reference where
 // both show the page: SIFT matches between the two renderings, RANSAC.
 // Identity when fewer than `min_inliers` matches agree.
-cv::Matx23d Register(const ReferenceRendering& reference,
-                     const ViewRendering& view, int min_inliers, int* inliers) {
+cv::Matx23d Register(const ReferenceRendering& reference, const ViewRendering& view,
+                     int min_inliers, int* inliers) {
   *inliers = 0;
   const cv::Matx23d identity(1, 0, 0, 0, 1, 0);
   cv::Mat grey_view;
@@ -371,8 +355,7 @@ cv::Matx23d Register(const ReferenceRendering& reference,
   cv::Mat1b near_view;
   cv::dilate(view_valid, near_view, cv::Mat(), cv::Point(-1, -1), 40);
   const cv::Mat1b ref_mask = reference.keypoints & near_view;
-  if (cv::countNonZero(ref_mask) < 100 || cv::countNonZero(view_mask) < 100)
-    return identity;
+  if (cv::countNonZero(ref_mask) < 100 || cv::countNonZero(view_mask) < 100) return identity;
   // SIFT on the box of the view's rendering and its surroundings only (its
   // pyramid over the whole output would cost most of render's time).
   const cv::Rect box = cv::boundingRect(near_view);
@@ -381,8 +364,7 @@ cv::Matx23d Register(const ReferenceRendering& reference,
   cv::Mat dr, dv;
   sift->detectAndCompute(reference.grey(box), ref_mask(box), kr, dr);
   sift->detectAndCompute(grey_view(box), view_mask(box), kv, dv);
-  if (kr.size() < size_t(min_inliers) || kv.size() < size_t(min_inliers))
-    return identity;
+  if (kr.size() < size_t(min_inliers) || kv.size() < size_t(min_inliers)) return identity;
   cv::BFMatcher matcher(cv::NORM_L2);
   std::vector<std::vector<cv::DMatch>> knn;
   matcher.knnMatch(dv, dr, knn, 2);
@@ -403,10 +385,8 @@ cv::Matx23d Register(const ReferenceRendering& reference,
 // `view` moved by the affine map A (output pixels).
 ViewRendering Warp(const ViewRendering& view, const cv::Matx23d& A) {
   ViewRendering out;
-  cv::warpAffine(view.colour, out.colour, A, view.colour.size(),
-                 cv::INTER_LINEAR);
-  cv::warpAffine(view.density, out.density, A, view.density.size(),
-                 cv::INTER_NEAREST);
+  cv::warpAffine(view.colour, out.colour, A, view.colour.size(), cv::INTER_LINEAR);
+  cv::warpAffine(view.density, out.density, A, view.density.size(), cv::INTER_NEAREST);
   // Bilinear colour at the rendering's edge mixes in the empty black.
   cv::Mat1b inside = out.density > 0;
   cv::erode(inside, inside, cv::Mat());
@@ -417,8 +397,7 @@ ViewRendering Warp(const ViewRendering& view, const cv::Matx23d& A) {
 // How well `view` matches the reference where both show the page: the
 // correlation of their fine detail, -1..1; 0 when they overlap in fewer than
 // 500 pixels.
-double Agreement(const ReferenceRendering& reference,
-                 const ViewRendering& view) {
+double Agreement(const ReferenceRendering& reference, const ViewRendering& view) {
   cv::Mat1b both = reference.valid & (view.density > 0);
   cv::erode(both, both, cv::Mat(), cv::Point(-1, -1), 3);
   if (cv::countNonZero(both) < 500) return 0;
@@ -458,26 +437,21 @@ ViewRegistration RegisterWithReference(const ReferenceRendering& reference, int 
 }  // namespace
 
 cv::Mat1b TextureStrips(const std::vector<const ExtensionStrip*>& strips,
-                        const std::vector<ViewMask>& views,
-                        const std::vector<cv::Mat>& photos, double x0,
-                        double y0, double scale, bool antialias,
-                        const cv::Mat3b& reference_render,
-                        const cv::Mat1b& reference_valid,
+                        const std::vector<ViewMask>& views, const std::vector<cv::Mat>& photos,
+                        double x0, double y0, double scale, bool antialias,
+                        const cv::Mat3b& reference_render, const cv::Mat1b& reference_valid,
                         const cv::Mat1b& fillable, cv::Mat3b* image,
-                        std::vector<ViewRegistration>* registrations,
-                        bool own_photo) {
+                        std::vector<ViewRegistration>* registrations, bool own_photo) {
   const int W = image->cols, H = image->rows;
   cv::Mat1b done(H, W, uchar(0));
   const StripMesh m = JoinStrips(strips, x0, y0, scale);
   if (m.triangles.empty()) return done;
-  const ReferenceRendering reference =
-      PrepareReference(reference_render, reference_valid);
+  const ReferenceRendering reference = PrepareReference(reference_render, reference_valid);
   cv::Mat1f best(H, W, 0.0f);
   for (size_t v = 0; v < views.size(); ++v) {
     if (photos[v].empty()) continue;
     const TextureSampler sampler(photos[v]);
-    ViewRendering r =
-        RenderStripsFromView(m, views[v], sampler, W, H, antialias);
+    ViewRendering r = RenderStripsFromView(m, views[v], sampler, W, H, antialias);
     if (cv::countNonZero(r.density > 0) == 0) continue;
     // The other view sees M where it is least sure (the page's cut edge in
     // the reference view); move its texture onto the reference's where the
@@ -547,15 +521,13 @@ cv::Vec3f MedianGain(const cv::Mat3b& reference, const cv::Mat3b& view, const cv
 
 }  // namespace
 
-cv::Mat1b TextureFromBetterViews(const MeshPair& meshes,
-                                 const std::vector<Eigen::Vector2d>& flat,
+cv::Mat1b TextureFromBetterViews(const MeshPair& meshes, const std::vector<Eigen::Vector2d>& flat,
                                  const RasterResult& out_raster,
-                                 const PinholeCamera& reference_camera,
-                                 double scale, const std::vector<ViewMask>& views,
+                                 const PinholeCamera& reference_camera, double scale,
+                                 const std::vector<ViewMask>& views,
                                  const std::vector<cv::Mat>& photos, bool antialias,
-                                 const cv::Mat1b& replaceable,
-                                 const BetterViewOptions& options, cv::Mat3b* image,
-                                 std::vector<ViewRegistration>* registrations) {
+                                 const cv::Mat1b& replaceable, const BetterViewOptions& options,
+                                 cv::Mat3b* image, std::vector<ViewRegistration>* registrations) {
   const int W = image->cols, H = image->rows;
   cv::Mat1b done(H, W, uchar(0));
   if (!(options.min_gain > 0)) return done;
@@ -589,7 +561,8 @@ cv::Mat1b TextureFromBetterViews(const MeshPair& meshes,
   cv::Mat1f best = reference_resolution * options.min_gain;
   // The printed side: the winding most triangles have in the reference view.
   std::vector<Eigen::Vector2d> reference_pixels(world.size());
-  for (size_t i = 0; i < world.size(); ++i) reference_pixels[i] = reference_camera.Project(world[i]);
+  for (size_t i = 0; i < world.size(); ++i)
+    reference_pixels[i] = reference_camera.Project(world[i]);
   long majority = 0;
   for (signed char w : Winding(reference_pixels, flat, tris)) majority += w;
   const signed char printed = majority >= 0 ? 1 : -1;
@@ -630,8 +603,7 @@ cv::Mat1b TextureFromBetterViews(const MeshPair& meshes,
           const Eigen::Vector3d X = point(y, x, &f);
           if (winding[f] != printed) continue;
           const auto p = ProjectDistorted(cam, view.distortion, X);
-          if (!p || p->x() < 0 || p->y() < 0 || p->x() > cam.width - 1 ||
-              p->y() > cam.height - 1)
+          if (!p || p->x() < 0 || p->y() < 0 || p->x() > cam.width - 1 || p->y() > cam.height - 1)
             continue;
           const int u = int(std::lround(p->x())), w = int(std::lround(p->y()));
           if (!view.mask(w, u)) continue;
@@ -642,9 +614,9 @@ cv::Mat1b TextureFromBetterViews(const MeshPair& meshes,
           const float Jf[4] = {float(J(0, 0)), float(J(0, 1)), float(J(1, 0)), float(J(1, 1))};
           float colour[3];
           sampler.Sample(float(p->x()), float(p->y()), Jf, antialias, colour);
-          r.colour(y, x) = cv::Vec3b(cv::saturate_cast<uchar>(colour[0]),
-                                     cv::saturate_cast<uchar>(colour[1]),
-                                     cv::saturate_cast<uchar>(colour[2]));
+          r.colour(y, x) =
+              cv::Vec3b(cv::saturate_cast<uchar>(colour[0]), cv::saturate_cast<uchar>(colour[1]),
+                        cv::saturate_cast<uchar>(colour[2]));
           r.density(y, x) = float(std::max(1e-6, Resolution(J)));
         }
     });
@@ -655,8 +627,8 @@ cv::Mat1b TextureFromBetterViews(const MeshPair& meshes,
     if (!reg.used) continue;
     // Another exposure: the view's colours scaled to the reference's where
     // both resolve the page well.
-    const cv::Vec3f gain = MedianGain(
-        reference_image, r.colour, (reference_resolution >= 0.7f) & (r.density >= 0.7f));
+    const cv::Vec3f gain =
+        MedianGain(reference_image, r.colour, (reference_resolution >= 0.7f) & (r.density >= 0.7f));
     for (int y = 0; y < H; ++y)
       for (int x = 0; x < W; ++x) {
         const float d = r.density(y, x);

@@ -70,7 +70,7 @@ struct CutSideOptions {
 struct ViewRegistration {
   int view = -1;
   cv::Matx23d affine = cv::Matx23d(1, 0, 0, 0, 1, 0);  // output pixels
-  int inliers = 0;       // SIFT matches that agree on it
+  int inliers = 0;                                     // SIFT matches that agree on it
   bool moved = false;    // the map was applied (it improved the agreement)
   double agreement = 0;  // correlation of fine detail with the reference
   bool used = false;     // agreement high enough for the view to be used
@@ -90,9 +90,7 @@ struct ExtensionStrip {
 
 // Index into a box (x0 y0 x1 y1) of the coordinate that bounds side `side`
 // (0 top: y0, 1 right: x1, 2 bottom: y1, 3 left: x0).
-inline int BoxIndexOfSide(int side) {
-  return side == 0 ? 1 : side == 1 ? 2 : side == 2 ? 3 : 0;
-}
+inline int BoxIndexOfSide(int side) { return side == 0 ? 1 : side == 1 ? 2 : side == 2 ? 3 : 0; }
 
 struct CutSideEdge {
   bool measured = false;
@@ -115,10 +113,12 @@ struct CutSideEdge {
 // `flat`) with cut[i] set: the page edge past that side of the mesh, seen in
 // `views`. `flat` is M' after render's deskew turn, `visible_box` (x0 y0 x1
 // y1) the box of the part of it the reference view sees.
-std::array<CutSideEdge, 4> FindCutSideEdges(
-    const MeshPair& meshes, const std::vector<Eigen::Vector2d>& flat,
-    const Eigen::Vector4d& visible_box, const std::array<bool, 4>& cut,
-    const std::vector<ViewMask>& views, const CutSideOptions& options = {});
+std::array<CutSideEdge, 4> FindCutSideEdges(const MeshPair& meshes,
+                                            const std::vector<Eigen::Vector2d>& flat,
+                                            const Eigen::Vector4d& visible_box,
+                                            const std::array<bool, 4>& cut,
+                                            const std::vector<ViewMask>& views,
+                                            const CutSideOptions& options = {});
 
 // Textures the extension strips from the other views' photos. For every
 // pixel of `image` (output pixel (x, y) is the point (x0 + (x + 0.5) /
@@ -132,14 +132,11 @@ std::array<CutSideEdge, 4> FindCutSideEdges(
 // views are the reference's own photo, which needs neither. `photos[v]`
 // belongs to `views[v]` (empty: not used). Returns the pixels textured (255).
 cv::Mat1b TextureStrips(const std::vector<const ExtensionStrip*>& strips,
-                        const std::vector<ViewMask>& views,
-                        const std::vector<cv::Mat>& photos, double x0,
-                        double y0, double scale, bool antialias,
-                        const cv::Mat3b& reference_render,
-                        const cv::Mat1b& reference_valid,
+                        const std::vector<ViewMask>& views, const std::vector<cv::Mat>& photos,
+                        double x0, double y0, double scale, bool antialias,
+                        const cv::Mat3b& reference_render, const cv::Mat1b& reference_valid,
                         const cv::Mat1b& fillable, cv::Mat3b* image,
-                        std::vector<ViewRegistration>* registrations,
-                        bool own_photo = false);
+                        std::vector<ViewRegistration>* registrations, bool own_photo = false);
 
 // Where the reference view sees the page at a grazing angle (a fold's steep
 // panel, a curl's far side), another photo may see it squarely.
@@ -162,14 +159,12 @@ struct BetterViewOptions {
 // `flat`). Each view's rendering is registered with `image` first (as in
 // TextureStrips) and its colours scaled to the reference's where both
 // resolve the page well. Returns the pixels retextured (255).
-cv::Mat1b TextureFromBetterViews(const MeshPair& meshes,
-                                 const std::vector<Eigen::Vector2d>& flat,
+cv::Mat1b TextureFromBetterViews(const MeshPair& meshes, const std::vector<Eigen::Vector2d>& flat,
                                  const RasterResult& out_raster,
-                                 const PinholeCamera& reference_camera,
-                                 double scale, const std::vector<ViewMask>& views,
+                                 const PinholeCamera& reference_camera, double scale,
+                                 const std::vector<ViewMask>& views,
                                  const std::vector<cv::Mat>& photos, bool antialias,
-                                 const cv::Mat1b& replaceable,
-                                 const BetterViewOptions& options, cv::Mat3b* image,
-                                 std::vector<ViewRegistration>* registrations);
+                                 const cv::Mat1b& replaceable, const BetterViewOptions& options,
+                                 cv::Mat3b* image, std::vector<ViewRegistration>* registrations);
 
 }  // namespace docunfold::render

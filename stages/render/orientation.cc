@@ -1,12 +1,12 @@
 #include "stages/render/orientation.h"
 
+#include <leptonica/allheaders.h>
+#include <tesseract/baseapi.h>
+
 #include <algorithm>
 #include <cctype>
 #include <memory>
-
-#include <leptonica/allheaders.h>
 #include <opencv2/imgproc.hpp>
-#include <tesseract/baseapi.h>
 
 namespace docunfold::render {
 namespace {
@@ -24,7 +24,8 @@ int ReadableWords(tesseract::TessBaseAPI* api, const cv::Mat1b& grey) {
     std::unique_ptr<char[]> text(it->GetUTF8Text(tesseract::RIL_WORD));
     if (!text) continue;
     int letters = 0;
-    for (const char* c = text.get(); *c; ++c) letters += std::isalpha(static_cast<unsigned char>(*c)) != 0;
+    for (const char* c = text.get(); *c; ++c)
+      letters += std::isalpha(static_cast<unsigned char>(*c)) != 0;
     if (letters >= 3 && it->Confidence(tesseract::RIL_WORD) >= 70) ++words;
   } while (it->Next(tesseract::RIL_WORD));
   return words;
@@ -51,10 +52,17 @@ double RowOverColumnContrast(const cv::Mat1b& grey) {
 cv::Mat Turn(const cv::Mat& image, int quarter_turns) {
   cv::Mat out;
   switch (((quarter_turns % 4) + 4) % 4) {
-    case 1: cv::rotate(image, out, cv::ROTATE_90_CLOCKWISE); break;
-    case 2: cv::rotate(image, out, cv::ROTATE_180); break;
-    case 3: cv::rotate(image, out, cv::ROTATE_90_COUNTERCLOCKWISE); break;
-    default: out = image.clone();
+    case 1:
+      cv::rotate(image, out, cv::ROTATE_90_CLOCKWISE);
+      break;
+    case 2:
+      cv::rotate(image, out, cv::ROTATE_180);
+      break;
+    case 3:
+      cv::rotate(image, out, cv::ROTATE_90_COUNTERCLOCKWISE);
+      break;
+    default:
+      out = image.clone();
   }
   return out;
 }
@@ -62,8 +70,10 @@ cv::Mat Turn(const cv::Mat& image, int quarter_turns) {
 Orientation FindOrientation(const cv::Mat& image, const OrientationOptions& o) {
   Orientation r;
   cv::Mat grey;
-  if (image.channels() == 3) cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
-  else grey = image;
+  if (image.channels() == 3)
+    cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
+  else
+    grey = image;
   const double scale = double(o.read_size) / std::max(grey.cols, grey.rows);
   cv::resize(grey, grey, cv::Size(), scale, scale, scale < 1 ? cv::INTER_AREA : cv::INTER_CUBIC);
   // The window with the most ink among nine placements (a receipt's middle
@@ -77,7 +87,10 @@ Orientation FindOrientation(const cv::Mat& image, const OrientationOptions& o) {
     for (int j = 0; j < 3; ++j) {
       const cv::Rect r(i * (grey.cols - w) / 2, j * (grey.rows - h) / 2, w, h);
       const double sum = cv::sum(ink(r))[0];
-      if (sum > most) { most = sum; window = r; }
+      if (sum > most) {
+        most = sum;
+        window = r;
+      }
     }
   const cv::Mat1b centre = grey(window).clone();
 

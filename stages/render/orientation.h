@@ -5,9 +5,8 @@
 #pragma once
 
 #include <array>
-#include <string>
-
 #include <opencv2/core.hpp>
+#include <string>
 
 namespace docunfold::render {
 
@@ -34,9 +33,9 @@ struct OrientationOptions {
 };
 
 struct Orientation {
-  int quarter_turns = 0;           // clockwise turns applied to the image: 0..3
-  std::array<int, 4> words{};      // readable words per candidate turn
-  bool decided = false;            // false: too little text, left as it was
+  int quarter_turns = 0;       // clockwise turns applied to the image: 0..3
+  std::array<int, 4> words{};  // readable words per candidate turn
+  bool decided = false;        // false: too little text, left as it was
   std::string note;
 };
 

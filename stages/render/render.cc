@@ -1,5 +1,4 @@
 #include "stages/render/render.h"
-#include "stages/render/orientation.h"
 
 #include <Eigen/Dense>
 #include <algorithm>
@@ -17,6 +16,7 @@
 #include "common/raster.h"
 #include "common/statistics.h"
 #include "stages/render/crop.h"
+#include "stages/render/orientation.h"
 #include "stages/render/texture_sampler.h"
 
 namespace docunfold::render {
@@ -25,12 +25,11 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 // Output pixel states.
-constexpr uchar kOutside = 0;  // not on M'
-constexpr uchar kPage = 1;     // sampled from the reference image
-constexpr uchar kHidden = 2;   // on M', but the reference view does not see it
-constexpr uchar kOtherView = 4;  // past a cut side, from another view's photo
-constexpr uchar kHiddenSampled =
-    3;  // the same, sampled anyway (--sample-hidden)
+constexpr uchar kOutside = 0;        // not on M'
+constexpr uchar kPage = 1;           // sampled from the reference image
+constexpr uchar kHidden = 2;         // on M', but the reference view does not see it
+constexpr uchar kOtherView = 4;      // past a cut side, from another view's photo
+constexpr uchar kHiddenSampled = 3;  // the same, sampled anyway (--sample-hidden)
 
 // Largest rms distance of a side's samples from its fitted line, as a
 // fraction of the diagonal of M', for the side to bound the crop.
@@ -38,12 +37,10 @@ constexpr double kMaxSideRms = 0.005;
 
 class StepTimer {
  public:
-  explicit StepTimer(std::vector<std::pair<std::string, double>>* out)
-      : out_(out) {}
+  explicit StepTimer(std::vector<std::pair<std::string, double>>* out) : out_(out) {}
   void Mark(const std::string& step) {
     const auto now = Clock::now();
-    out_->emplace_back(step,
-                       std::chrono::duration<double>(now - last_).count());
+    out_->emplace_back(step, std::chrono::duration<double>(now - last_).count());
     last_ = now;
   }
 
@@ -59,28 +56,23 @@ cv::Vec3b ParseFill(const std::string& fill, bool* paper) {
   if (fill == "white") return {255, 255, 255};
   unsigned r, g, b;
   char tail;
-  if (fill.size() == 7 &&
-      std::sscanf(fill.c_str(), "#%2x%2x%2x%c", &r, &g, &b, &tail) == 3)
+  if (fill.size() == 7 && std::sscanf(fill.c_str(), "#%2x%2x%2x%c", &r, &g, &b, &tail) == 3)
     return {uchar(b), uchar(g), uchar(r)};
-  throw UsageError("--fill: expected paper, white or #RRGGBB, got \"" + fill +
-                   "\"");
+  throw UsageError("--fill: expected paper, white or #RRGGBB, got \"" + fill + "\"");
 }
 
 void CheckSizeOptions(const RenderOptions& o) {
-  const int chosen =
-      (o.width > 0) + (o.height > 0) + (o.dpi > 0) + (o.scale > 0);
-  if (chosen > 1)
-    throw UsageError("give at most one of --width, --height, --dpi, --scale");
-  if (o.width < 0 || o.height < 0 || o.dpi < 0 || o.scale < 0 ||
-      o.page_width_mm < 0 || o.page_height_mm < 0)
+  const int chosen = (o.width > 0) + (o.height > 0) + (o.dpi > 0) + (o.scale > 0);
+  if (chosen > 1) throw UsageError("give at most one of --width, --height, --dpi, --scale");
+  if (o.width < 0 || o.height < 0 || o.dpi < 0 || o.scale < 0 || o.page_width_mm < 0 ||
+      o.page_height_mm < 0)
     throw UsageError("sizes must be positive");
   if (o.dpi > 0 && (o.page_width_mm > 0) == (o.page_height_mm > 0))
     throw UsageError(
         "--dpi needs exactly one of --page-width-mm, --page-height-mm "
         "(photos carry no absolute scale)");
   if (o.dpi == 0 && (o.page_width_mm > 0 || o.page_height_mm > 0))
-    throw UsageError(
-        "--page-width-mm/--page-height-mm only make sense with --dpi");
+    throw UsageError("--page-width-mm/--page-height-mm only make sense with --dpi");
   if (!(o.max_pixels >= 1)) throw UsageError("--max-pixels must be at least 1");
 }
 
@@ -88,32 +80,22 @@ void CheckSizeOptions(const RenderOptions& o) {
 void CheckInputs(const RenderInputs& in) {
   const PinholeCamera& cam = in.camera;
   if (in.reference.empty() || in.reference.type() != CV_8UC3)
-    throw InputError(in.reference_file.string() +
-                     ": expected an 8-bit colour image");
+    throw InputError(in.reference_file.string() + ": expected an 8-bit colour image");
   if (in.reference.cols != cam.width || in.reference.rows != cam.height)
-    throw InputError(in.cameras_file.string() + ": reference camera " +
-                     cam.image + " is " + std::to_string(cam.width) + "x" +
-                     std::to_string(cam.height) + " but " +
+    throw InputError(in.cameras_file.string() + ": reference camera " + cam.image + " is " +
+                     std::to_string(cam.width) + "x" + std::to_string(cam.height) + " but " +
                      in.reference_file.filename().string() + " is " +
-                     std::to_string(in.reference.cols) + "x" +
-                     std::to_string(in.reference.rows));
-  if (in.boundary.width != in.reference.cols ||
-      in.boundary.height != in.reference.rows)
+                     std::to_string(in.reference.cols) + "x" + std::to_string(in.reference.rows));
+  if (in.boundary.width != in.reference.cols || in.boundary.height != in.reference.rows)
     throw InputError(in.boundary.file.string() + ": made for a " +
-                     std::to_string(in.boundary.width) + "x" +
-                     std::to_string(in.boundary.height) + " image but " +
-                     in.reference_file.filename().string() + " is " +
-                     std::to_string(in.reference.cols) + "x" +
-                     std::to_string(in.reference.rows));
+                     std::to_string(in.boundary.width) + "x" + std::to_string(in.boundary.height) +
+                     " image but " + in.reference_file.filename().string() + " is " +
+                     std::to_string(in.reference.cols) + "x" + std::to_string(in.reference.rows));
   const MeshPair& m = in.meshes;
-  const fs::path m3 = in.meshes_dir / "mesh3d.ply",
-                 m2 = in.meshes_dir / "mesh2d.ply";
-  if (m.grid.nx < 2 || m.grid.ny < 2 ||
-      int(m.mesh3d.size()) != m.grid.NumVertices() ||
+  const fs::path m3 = in.meshes_dir / "mesh3d.ply", m2 = in.meshes_dir / "mesh2d.ply";
+  if (m.grid.nx < 2 || m.grid.ny < 2 || int(m.mesh3d.size()) != m.grid.NumVertices() ||
       int(m.mesh2d.size()) != m.grid.NumVertices())
-    throw InputError(
-        m3.string() +
-        ": not a grid of at least 2x2 vertices matching mesh2d.ply");
+    throw InputError(m3.string() + ": not a grid of at least 2x2 vertices matching mesh2d.ply");
   int behind = 0;
   for (const Eigen::Vector3d& v : m.mesh3d)
     if (!(cam.CamFromWorld(v).z() > 0)) ++behind;
@@ -127,8 +109,7 @@ void CheckInputs(const RenderInputs& in) {
     lo = lo.cwiseMin(q);
     hi = hi.cwiseMax(q);
   }
-  if (!((hi - lo).minCoeff() > 0))
-    throw InputError(m2.string() + ": the flat mesh has no area");
+  if (!((hi - lo).minCoeff() > 0)) throw InputError(m2.string() + ": the flat mesh has no area");
 }
 
 double Cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
@@ -171,10 +152,8 @@ ProjectedMesh ProjectMesh(const RenderInputs& in) {
   double positive = 0, negative = 0;
   for (size_t f = 0; f < p.triangles.size(); ++f) {
     const Triangle& t = p.triangles[f];
-    const double a = 0.5 * Cross(p.pixel[t[1]] - p.pixel[t[0]],
-                                 p.pixel[t[2]] - p.pixel[t[0]]);
-    const double a2 = 0.5 * Cross(m.mesh2d[t[1]] - m.mesh2d[t[0]],
-                                  m.mesh2d[t[2]] - m.mesh2d[t[0]]);
+    const double a = 0.5 * Cross(p.pixel[t[1]] - p.pixel[t[0]], p.pixel[t[2]] - p.pixel[t[0]]);
+    const double a2 = 0.5 * Cross(m.mesh2d[t[1]] - m.mesh2d[t[0]], m.mesh2d[t[2]] - m.mesh2d[t[0]]);
     // Orientation relative to M' (whose winding may be either way round).
     signed_area[f] = a2 >= 0 ? a : -a;
     (signed_area[f] > 0 ? positive : negative) += std::abs(a);
@@ -183,17 +162,14 @@ ProjectedMesh ProjectMesh(const RenderInputs& in) {
   std::vector<double> ratios;
   p.front.resize(p.triangles.size());
   auto inside = [&](const Eigen::Vector2d& x) {
-    return x.x() >= -0.5 && x.y() >= -0.5 && x.x() <= cam.width - 0.5 &&
-           x.y() <= cam.height - 0.5;
+    return x.x() >= -0.5 && x.y() >= -0.5 && x.x() <= cam.width - 0.5 && x.y() <= cam.height - 0.5;
   };
   for (size_t f = 0; f < p.triangles.size(); ++f) {
     const Triangle& t = p.triangles[f];
     p.front[f] = signed_area[f] * sign > 0;
-    if (!inside(p.pixel[t[0]]) || !inside(p.pixel[t[1]]) ||
-        !inside(p.pixel[t[2]]))
-      continue;
-    const double a2 = std::abs(0.5 * Cross(m.mesh2d[t[1]] - m.mesh2d[t[0]],
-                                           m.mesh2d[t[2]] - m.mesh2d[t[0]]));
+    if (!inside(p.pixel[t[0]]) || !inside(p.pixel[t[1]]) || !inside(p.pixel[t[2]])) continue;
+    const double a2 =
+        std::abs(0.5 * Cross(m.mesh2d[t[1]] - m.mesh2d[t[0]], m.mesh2d[t[2]] - m.mesh2d[t[0]]));
     if (!(a2 > 0) || !p.front[f]) continue;
     ratios.push_back(std::sqrt(std::abs(signed_area[f]) / a2));
   }
@@ -203,8 +179,7 @@ ProjectedMesh ProjectMesh(const RenderInputs& in) {
 }
 
 // Box of the part of M' the reference view sees (M's raster mapped to M').
-Eigen::Vector4d VisibleBox(const RasterResult& raster,
-                           const std::vector<Triangle>& tris,
+Eigen::Vector4d VisibleBox(const RasterResult& raster, const std::vector<Triangle>& tris,
                            const std::vector<Eigen::Vector2d>& flat) {
   double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
   for (int y = 0; y < raster.face.rows; ++y) {
@@ -214,8 +189,7 @@ Eigen::Vector4d VisibleBox(const RasterResult& raster,
       if (face[x] < 0) continue;
       const Triangle& t = tris[face[x]];
       const double b1 = bary[x][0], b2 = bary[x][1];
-      const Eigen::Vector2d q =
-          (1 - b1 - b2) * flat[t[0]] + b1 * flat[t[1]] + b2 * flat[t[2]];
+      const Eigen::Vector2d q = (1 - b1 - b2) * flat[t[0]] + b1 * flat[t[1]] + b2 * flat[t[2]];
       x0 = std::min(x0, q.x());
       y0 = std::min(y0, q.y());
       x1 = std::max(x1, q.x());
@@ -232,8 +206,7 @@ struct SizeChoice {
   bool capped = false;
 };
 
-SizeChoice ChooseSize(const RenderOptions& o, double crop_w, double crop_h,
-                      double density) {
+SizeChoice ChooseSize(const RenderOptions& o, double crop_w, double crop_h, double density) {
   SizeChoice s;
   if (o.width > 0) {
     s.rule = "width";
@@ -253,10 +226,8 @@ SizeChoice ChooseSize(const RenderOptions& o, double crop_w, double crop_h,
     s.scale = density;
   }
   auto dims = [&] {
-    s.width =
-        o.width > 0 ? o.width : std::max(1, int(std::lround(crop_w * s.scale)));
-    s.height = o.height > 0 ? o.height
-                            : std::max(1, int(std::lround(crop_h * s.scale)));
+    s.width = o.width > 0 ? o.width : std::max(1, int(std::lround(crop_w * s.scale)));
+    s.height = o.height > 0 ? o.height : std::max(1, int(std::lround(crop_h * s.scale)));
   };
   dims();
   const double pixels = double(s.width) * s.height;
@@ -279,11 +250,9 @@ struct SampleStats {
 };
 
 SampleStats SamplePixels(const RenderOptions& options, const RenderInputs& in,
-                         const ProjectedMesh& pm,
-                         const std::vector<Eigen::Vector2d>& flat,
-                         const RasterResult& out_raster,
-                         const RasterResult& ref_raster, double scale,
-                         cv::Mat3b* image, cv::Mat1b* state) {
+                         const ProjectedMesh& pm, const std::vector<Eigen::Vector2d>& flat,
+                         const RasterResult& out_raster, const RasterResult& ref_raster,
+                         double scale, cv::Mat3b* image, cv::Mat1b* state) {
   const PinholeCamera& cam = in.camera;
   const int W = out_raster.face.cols, H = out_raster.face.rows;
   *image = cv::Mat3b(H, W, cv::Vec3b(0, 0, 0));
@@ -319,12 +288,12 @@ SampleStats SamplePixels(const RenderOptions& options, const RenderInputs& in,
         if (f < 0) continue;
         const Triangle& t = pm.triangles[f];
         const double b1 = bary[x][0], b2 = bary[x][1];
-        const Eigen::Vector3d X = (1 - b1 - b2) * pm.cam[t[0]] +
-                                  b1 * pm.cam[t[1]] + b2 * pm.cam[t[2]];
+        const Eigen::Vector3d X =
+            (1 - b1 - b2) * pm.cam[t[0]] + b1 * pm.cam[t[1]] + b2 * pm.cam[t[2]];
         const Eigen::Vector3d h = K * X;
         const double u = h.x() / h.z(), v = h.y() / h.z();
-        const bool in_image = h.z() > 0 && u >= -0.5 && v >= -0.5 &&
-                              u <= cam.width - 0.5 && v <= cam.height - 0.5;
+        const bool in_image =
+            h.z() > 0 && u >= -0.5 && v >= -0.5 && u <= cam.width - 0.5 && v <= cam.height - 0.5;
         bool seen = in_image && pm.front[f];
         if (seen) {
           // Depth test against the nearest surface at the 2x2 pixels around.
@@ -353,13 +322,10 @@ SampleStats SamplePixels(const RenderOptions& options, const RenderInputs& in,
         }
         // Footprint: d(u,v)/d(X) of the projection times d(X)/d(pixel).
         const Eigen::Matrix2d J = cam.ProjectCamJacobian(X) * dx_dpix[f];
-        const float Jf[4] = {float(J(0, 0)), float(J(0, 1)), float(J(1, 0)),
-                             float(J(1, 1))};
+        const float Jf[4] = {float(J(0, 0)), float(J(0, 1)), float(J(1, 0)), float(J(1, 1))};
         float c[3];
-        if (sampler.Sample(float(u), float(v), Jf, options.antialias, c))
-          ++stats.minified;
-        out[x] = cv::Vec3b(cv::saturate_cast<uchar>(c[0]),
-                           cv::saturate_cast<uchar>(c[1]),
+        if (sampler.Sample(float(u), float(v), Jf, options.antialias, c)) ++stats.minified;
+        out[x] = cv::Vec3b(cv::saturate_cast<uchar>(c[0]), cv::saturate_cast<uchar>(c[1]),
                            cv::saturate_cast<uchar>(c[2]));
       }
     }
@@ -398,29 +364,25 @@ cv::Vec3b MedianColour(const cv::Mat3b& image, const cv::Mat1b& state) {
 // The edges of M' over the image: every k-th grid line (k keeps drawn lines
 // at least `min_spacing` pixels apart) and always the border rows/columns;
 // points of M' that the reference view does not see are tinted.
-cv::Mat3b DrawGrid(const cv::Mat3b& image, const cv::Mat1b& state,
-                   const MeshPair& m, const std::vector<Eigen::Vector2d>& flat,
-                   double x0, double y0, double scale, const cv::Scalar& colour,
-                   double min_spacing, int* step) {
+cv::Mat3b DrawGrid(const cv::Mat3b& image, const cv::Mat1b& state, const MeshPair& m,
+                   const std::vector<Eigen::Vector2d>& flat, double x0, double y0, double scale,
+                   const cv::Scalar& colour, double min_spacing, int* step) {
   cv::Mat3b out = image.clone();
   for (int y = 0; y < out.rows; ++y)
     for (int x = 0; x < out.cols; ++x)
       if (state(y, x) == kHidden || state(y, x) == kHiddenSampled) {
         cv::Vec3b& p = out(y, x);
-        p = cv::Vec3b(uchar(0.6 * p[0] + 0.4 * 200),
-                      uchar(0.6 * p[1] + 0.4 * 80),
+        p = cv::Vec3b(uchar(0.6 * p[0] + 0.4 * 200), uchar(0.6 * p[1] + 0.4 * 80),
                       uchar(0.6 * p[2] + 0.4 * 200));
       }
   const QuadGrid& g = m.grid;
   std::vector<double> lengths;
   for (int r = 0; r < g.ny; ++r)
     for (int c = 0; c + 1 < g.nx; ++c)
-      lengths.push_back((flat[g.Index(r, c + 1)] - flat[g.Index(r, c)]).norm() *
-                        scale);
+      lengths.push_back((flat[g.Index(r, c + 1)] - flat[g.Index(r, c)]).norm() * scale);
   for (int r = 0; r + 1 < g.ny; ++r)
     for (int c = 0; c < g.nx; ++c)
-      lengths.push_back((flat[g.Index(r + 1, c)] - flat[g.Index(r, c)]).norm() *
-                        scale);
+      lengths.push_back((flat[g.Index(r + 1, c)] - flat[g.Index(r, c)]).norm() * scale);
   const double spacing = Median(lengths);
   *step = spacing > 0 ? std::max(1, int(std::ceil(min_spacing / spacing))) : 1;
   constexpr int kShift = 4;  // sub-pixel vertex positions
@@ -474,10 +436,8 @@ Json OptionsToJson(const RenderOptions& o) {
 
 Json Vec2(const Eigen::Vector2d& v) { return Json::array({v.x(), v.y()}); }
 
-Json MakeReport(const RenderOptions& options, const RenderInputs& in,
-                const RenderResult& r) {
-  Json doc =
-      MakeHeader("docunfold.render", 1, "render", OptionsToJson(options));
+Json MakeReport(const RenderOptions& options, const RenderInputs& in, const RenderResult& r) {
+  Json doc = MakeHeader("docunfold.render", 1, "render", OptionsToJson(options));
   doc["inputs"] = {{"meshes", in.meshes_dir.string()},
                    {"reference", in.reference_file.string()},
                    {"boundary", in.boundary.file.string()},
@@ -501,10 +461,7 @@ Json MakeReport(const RenderOptions& options, const RenderInputs& in,
   Json sides = Json::object();
   for (int i = 0; i < 4; ++i) {
     const SideFit& s = r.sides[i];
-    Json j = {{"real", s.real},
-              {"used", s.used},
-              {"samples", s.samples},
-              {"mapped", s.mapped}};
+    Json j = {{"real", s.real}, {"used", s.used}, {"samples", s.samples}, {"mapped", s.mapped}};
     if (s.used) {
       j["point"] = Vec2(s.point);
       j["direction"] = Vec2(s.direction);
@@ -513,8 +470,8 @@ Json MakeReport(const RenderOptions& options, const RenderInputs& in,
     if (!s.note.empty()) j["note"] = s.note;
     if (s.scattered) j["median_bound"] = s.median_bound;
     if (const CutSideEdge& e = r.reached_sides[i]; e.measured)
-      j["reached_past_mesh"] = {{"bound", e.bound}, {"extension", e.extension},
-                                {"crossings", e.crossings}};
+      j["reached_past_mesh"] = {
+          {"bound", e.bound}, {"extension", e.extension}, {"crossings", e.crossings}};
     if (!s.real && options.extend_cut_sides) {
       const CutSideEdge& e = r.cut_edges[i];
       Json c = {{"measured", e.measured},
@@ -535,8 +492,11 @@ Json MakeReport(const RenderOptions& options, const RenderInputs& in,
   if (const PageFormatFit& f = r.page_format;
       options.page_aspect > 0 && (f.axis >= 0 || !f.note.empty())) {
     // axis -1 with a note: sides of both axes are cut off unseen.
-    Json j = {{"aspect", options.page_aspect}, {"applied", f.applied},
-              {"axis", f.axis < 0 ? "both" : f.axis == 0 ? "x" : "y"}};
+    Json j = {{"aspect", options.page_aspect},
+              {"applied", f.applied},
+              {"axis", f.axis < 0    ? "both"
+                       : f.axis == 0 ? "x"
+                                     : "y"}};
     if (f.axis >= 0) {
       j["seen"] = f.seen;
       j["across"] = f.across;
@@ -556,8 +516,9 @@ Json MakeReport(const RenderOptions& options, const RenderInputs& in,
   Json regs = Json::array();
   for (const ViewRegistration& g : r.registrations)
     regs.push_back({{"view", in.views[g.view].camera.image},
-                    {"affine", {{g.affine(0, 0), g.affine(0, 1), g.affine(0, 2)},
-                                {g.affine(1, 0), g.affine(1, 1), g.affine(1, 2)}}},
+                    {"affine",
+                     {{g.affine(0, 0), g.affine(0, 1), g.affine(0, 2)},
+                      {g.affine(1, 0), g.affine(1, 1), g.affine(1, 2)}}},
                     {"inliers", g.inliers},
                     {"moved", g.moved},
                     {"agreement", g.agreement},
@@ -617,9 +578,8 @@ RenderResult Run(const RenderOptions& options, const RenderInputs& in) {
 
   const ProjectedMesh pm = ProjectMesh(in);
   if (pm.faces_in_view == 0)
-    throw InputError(m3.string() +
-                     ": no face of M lies inside the reference image " +
-                     cam.image + " facing the camera");
+    throw InputError(m3.string() + ": no face of M lies inside the reference image " + cam.image +
+                     " facing the camera");
   r.reference_pixels_per_unit = pm.density;
   const PixelToSurface lookup(in.meshes, cam);
   timer.Mark("project");
@@ -637,8 +597,7 @@ RenderResult Run(const RenderOptions& options, const RenderInputs& in) {
     const BoundarySide& side = in.boundary.sides[i];
     int samples = 0;
     if (side.real)
-      side_points[i] = MapPolylineOntoFlat(in.meshes, cam, lookup, side.points,
-                                           snap_px, &samples);
+      side_points[i] = MapPolylineOntoFlat(in.meshes, cam, lookup, side.points, snap_px, &samples);
     r.sides[i] = FitSideLine(i, side.real, side_points[i], samples);
     // A side whose samples scatter about their line is not a straight page
     // edge seen on M (the boundary runs over a fold, or M is far off there).
@@ -646,8 +605,7 @@ RenderResult Run(const RenderOptions& options, const RenderInputs& in) {
       r.sides[i].used = false;
       r.sides[i].scattered = true;
       r.sides[i].note = "samples scatter about their line (rms " +
-                        std::to_string(r.sides[i].rms / flat_diagonal) +
-                        " of M' diagonal)";
+                        std::to_string(r.sides[i].rms / flat_diagonal) + " of M' diagonal)";
     }
   }
   double angle = 0;
@@ -676,16 +634,13 @@ RenderResult Run(const RenderOptions& options, const RenderInputs& in) {
   for (auto& q : flat) q = rotation * q;
   for (auto& s : r.sides)
     if (s.used) RotateSide(&s, angle);
-  Eigen::Vector4d visible =
-      VisibleBox(lookup.raster(), pm.triangles, flat);
+  Eigen::Vector4d visible = VisibleBox(lookup.raster(), pm.triangles, flat);
   if (!(visible[2] > visible[0] && visible[3] > visible[1]))
-    throw InputError(m3.string() +
-                     ": the mesh covers no pixel of the reference image");
+    throw InputError(m3.string() + ": the mesh covers no pixel of the reference image");
   if (options.extend_cut_sides) {
     std::array<bool, 4> cut;
     for (int i = 0; i < 4; ++i) cut[i] = !in.boundary.sides[i].real;
-    r.cut_edges =
-        FindCutSideEdges(in.meshes, flat, visible, cut, in.views, options.cut_sides);
+    r.cut_edges = FindCutSideEdges(in.meshes, flat, visible, cut, in.views, options.cut_sides);
     for (int i = 0; i < 4; ++i) {
       if (!cut[i]) continue;
       const CutSideEdge& e = r.cut_edges[i];
@@ -699,12 +654,12 @@ RenderResult Run(const RenderOptions& options, const RenderInputs& in) {
       const std::string share =
           std::to_string(int(std::lround(100 * e.extension / axis_extent))) + " % of the page";
       Log(std::string(kSideNames[i]) + " side cut off by the reference image: " +
-          (e.edge_seen ? "the other views see the page edge " + share + " past it (" +
-                             std::to_string(e.crossings) + " crossings in " +
-                             std::to_string(e.views) + " views)"
-                       : "the other views see page up to " + share +
-                             " past it, but not its edge (" + std::to_string(e.columns_seen) +
-                             " columns)"));
+          (e.edge_seen
+               ? "the other views see the page edge " + share + " past it (" +
+                     std::to_string(e.crossings) + " crossings in " + std::to_string(e.views) +
+                     " views)"
+               : "the other views see page up to " + share + " past it, but not its edge (" +
+                     std::to_string(e.columns_seen) + " columns)"));
     }
   }
   // A real side that M stops short of (its border runs inside the outline
@@ -719,8 +674,11 @@ RenderResult Run(const RenderOptions& options, const RenderInputs& in) {
                       (!r.sides[i].used ||
                        r.sides[i].mapped < options.reach_partial_below * r.sides[i].samples);
     if (std::any_of(short_side.begin(), short_side.end(), [](bool s) { return s; })) {
-      self_view.push_back({cam, OutlineMask(in.boundary, cam.width, cam.height),
-                           in.boundary.file, in.reference_file, {}});
+      self_view.push_back({cam,
+                           OutlineMask(in.boundary, cam.width, cam.height),
+                           in.boundary.file,
+                           in.reference_file,
+                           {}});
       const std::array<CutSideEdge, 4> reached =
           FindCutSideEdges(in.meshes, flat, visible, short_side, self_view, options.cut_sides);
       for (int i = 0; i < 4; ++i) {
@@ -732,8 +690,8 @@ RenderResult Run(const RenderOptions& options, const RenderInputs& in) {
           // The line where it crosses the middle of the visible box; the
           // reached edge replaces it only if it lies farther out.
           const bool horizontal = i == 0 || i == 2;
-          const double mid = horizontal ? 0.5 * (visible[0] + visible[2])
-                                        : 0.5 * (visible[1] + visible[3]);
+          const double mid =
+              horizontal ? 0.5 * (visible[0] + visible[2]) : 0.5 * (visible[1] + visible[3]);
           const double line = horizontal ? YAt(side, mid) : XAt(side, mid);
           const bool farther = (i == 0 || i == 3) ? e.bound < line : e.bound > line;
           if (!farther) continue;
@@ -760,21 +718,19 @@ RenderResult Run(const RenderOptions& options, const RenderInputs& in) {
       across.push_back(i % 2 == 0 ? q.y() : q.x());
     }
     r.sides[i].median_bound = Median(across);
-    if (options.scattered_sides == "median")
-      visible[BoxIndexOfSide(i)] = r.sides[i].median_bound;
+    if (options.scattered_sides == "median") visible[BoxIndexOfSide(i)] = r.sides[i].median_bound;
   }
-  CropRect crop = ChooseCrop(&r.sides, visible,
-                             options.crop_rule == "middle" ? options.crop_middle_max_deg * M_PI / 180
-                                                           : -1.0);
+  CropRect crop =
+      ChooseCrop(&r.sides, visible,
+                 options.crop_rule == "middle" ? options.crop_middle_max_deg * M_PI / 180 : -1.0);
   for (int i = 0; i < 4; ++i)
     if (r.sides[i].real && !r.sides[i].used && !r.reached_sides[i].measured)
-      Log(std::string(kSideNames[i]) +
-          " side not used for the crop: " + r.sides[i].note);
+      Log(std::string(kSideNames[i]) + " side not used for the crop: " + r.sides[i].note);
   if (options.page_aspect > 0) {
     std::array<bool, 4> unseen;
     for (int i = 0; i < 4; ++i)
-      unseen[i] = !in.boundary.sides[i].real &&
-                  !(r.cut_edges[i].measured && r.cut_edges[i].edge_seen);
+      unseen[i] =
+          !in.boundary.sides[i].real && !(r.cut_edges[i].measured && r.cut_edges[i].edge_seen);
     r.page_format = ExtendToPageFormat(&crop, unseen, options.page_aspect);
     const PageFormatFit& f = r.page_format;
     if (f.applied) {
@@ -793,11 +749,10 @@ RenderResult Run(const RenderOptions& options, const RenderInputs& in) {
   timer.Mark("crop");
 
   // Output size; the crop is re-centred to a whole number of pixels.
-  const SizeChoice size =
-      ChooseSize(options, crop.Width(), crop.Height(), pm.density);
+  const SizeChoice size = ChooseSize(options, crop.Width(), crop.Height(), pm.density);
   if (size.capped)
-    Log("output reduced to " + std::to_string(size.width) + "x" +
-        std::to_string(size.height) + " by --max-pixels");
+    Log("output reduced to " + std::to_string(size.width) + "x" + std::to_string(size.height) +
+        " by --max-pixels");
   const double cx = 0.5 * (crop.x0 + crop.x1), cy = 0.5 * (crop.y0 + crop.y1);
   r.crop_x0 = cx - 0.5 * size.width / size.scale;
   r.crop_x1 = cx + 0.5 * size.width / size.scale;
@@ -813,15 +768,13 @@ RenderResult Run(const RenderOptions& options, const RenderInputs& in) {
   for (size_t i = 0; i < flat.size(); ++i)
     screen[i] = {(flat[i].x() - r.crop_x0) * size.scale - 0.5,
                  (flat[i].y() - r.crop_y0) * size.scale - 0.5, 1.0};
-  const RasterResult out_raster =
-      Rasterize(screen, pm.triangles, size.width, size.height);
+  const RasterResult out_raster = Rasterize(screen, pm.triangles, size.width, size.height);
   timer.Mark("rasterize");
 
   cv::Mat3b image;
   cv::Mat1b state;
   const SampleStats stats =
-      SamplePixels(options, in, pm, flat, out_raster, lookup.raster(),
-                   size.scale, &image, &state);
+      SamplePixels(options, in, pm, flat, out_raster, lookup.raster(), size.scale, &image, &state);
   timer.Mark("sample");
 
   // The page past the sides the reference image cuts off, from the photos
@@ -839,8 +792,8 @@ RenderResult Run(const RenderOptions& options, const RenderInputs& in) {
     }
   if (better_views) {
     const cv::Mat1b textured = TextureFromBetterViews(
-        in.meshes, flat, out_raster, in.camera, size.scale, in.views, photos,
-        options.antialias, state == kPage, options.better_views, &image, &r.registrations);
+        in.meshes, flat, out_raster, in.camera, size.scale, in.views, photos, options.antialias,
+        state == kPage, options.better_views, &image, &r.registrations);
     state.setTo(kOtherView, textured);
     r.better_view_fraction = cv::countNonZero(textured) / (double(size.width) * size.height);
     timer.Mark("better_views");
@@ -868,8 +821,7 @@ RenderResult Run(const RenderOptions& options, const RenderInputs& in) {
   }
 
   r.fill = paper_fill ? MedianColour(image, state) : fixed_fill;
-  const cv::Mat1b unfilled =
-      (state != kPage) & (state != kHiddenSampled) & (state != kOtherView);
+  const cv::Mat1b unfilled = (state != kPage) & (state != kHiddenSampled) & (state != kOtherView);
   image.setTo(cv::Scalar(r.fill[0], r.fill[1], r.fill[2]), unfilled);
   if (options.shading == "remove") {
     ShadingRemoval removal = RemoveShading(image, options.shading_removal);
@@ -884,9 +836,8 @@ RenderResult Run(const RenderOptions& options, const RenderInputs& in) {
   r.minified_fraction = stats.minified / n;
   r.rectified = image;
   r.page_mask = ~unfilled;
-  r.rectified_grid = DrawGrid(image, state, in.meshes, flat, r.crop_x0,
-                              r.crop_y0, size.scale, options.grid_color,
-                              options.grid_min_spacing_px, &r.grid_line_step);
+  r.rectified_grid = DrawGrid(image, state, in.meshes, flat, r.crop_x0, r.crop_y0, size.scale,
+                              options.grid_color, options.grid_min_spacing_px, &r.grid_line_step);
   timer.Mark("fill_and_grid");
   Json orientation = {{"checked", options.orient}};
   if (options.orient) {
@@ -907,8 +858,8 @@ RenderResult Run(const RenderOptions& options, const RenderInputs& in) {
       const Eigen::Vector2d d = Eigen::Rotation2Dd(angle) * down;
       // Clockwise quarter turns map the image's down (0, 1) to: 0 -> (0, 1),
       // 1 -> (-1, 0), 2 -> (0, -1), 3 -> (1, 0); pick the one taking d there.
-      const int turns = std::abs(d.y()) >= std::abs(d.x()) ? (d.y() > 0 ? 0 : 2)
-                                                           : (d.x() > 0 ? 1 : 3);
+      const int turns =
+          std::abs(d.y()) >= std::abs(d.x()) ? (d.y() > 0 ? 0 : 2) : (d.x() > 0 ? 1 : 3);
       o.quarter_turns = turns;
       o.note += "; turned by the side the text's baselines lie on (" + down_from + ")";
       orientation["by"] = "baselines";

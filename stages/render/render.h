@@ -10,17 +10,17 @@
 #include <Eigen/Core>
 #include <array>
 #include <filesystem>
-#include <optional>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "common/axis_direction.h"
 #include "common/camera.h"
 #include "common/grid_mesh.h"
-#include "common/shading.h"
 #include "common/json_io.h"
 #include "common/page_files.h"
+#include "common/shading.h"
 #include "stages/render/cut_sides.h"
 
 namespace docunfold::render {
@@ -182,13 +182,13 @@ struct PageFormatFit {
 // Per boundary side: what its mapping onto M' gave.
 struct SideFit {
   bool real = false;
-  bool used = false;  // real, and enough of it maps onto M
-  int samples = 0;    // pixels sampled along the side
-  int mapped = 0;     // of those, mapped onto M and kept as inliers
-  Eigen::Vector2d point = Eigen::Vector2d::Zero();       // on the line (M')
+  bool used = false;                                // real, and enough of it maps onto M
+  int samples = 0;                                  // pixels sampled along the side
+  int mapped = 0;                                   // of those, mapped onto M and kept as inliers
+  Eigen::Vector2d point = Eigen::Vector2d::Zero();  // on the line (M')
   Eigen::Vector2d direction = Eigen::Vector2d::UnitX();  // unit
-  double rms = 0;    // residual of the fit, M' units
-  std::string note;  // why a real side was not used
+  double rms = 0;                                        // residual of the fit, M' units
+  std::string note;                                      // why a real side was not used
   // A real side whose samples scatter about their line: the median of their
   // coordinate across it (y for top and bottom, x for left and right, M'
   // after the deskew turn), which then bounds the crop (scattered_sides).
@@ -206,21 +206,20 @@ struct RenderResult {
   double reference_pixels_per_unit = 0;  // the reference image's density
   double rotation_deg = 0;               // deskew applied to M'
   std::string deskew_source = "none";    // what it was taken from: lines, sides, none
-  std::string crop_rule;  // "boundary-lines", "real-sides-and-visible-mesh",
-                          // "visible-mesh"
-  std::string
-      size_rule;  // "reference-density", "width", "height", "dpi", "scale"
-  bool capped = false;  // the default size was reduced to max_pixels
+  std::string crop_rule;                 // "boundary-lines", "real-sides-and-visible-mesh",
+                                         // "visible-mesh"
+  std::string size_rule;                 // "reference-density", "width", "height", "dpi", "scale"
+  bool capped = false;                   // the default size was reduced to max_pixels
   std::array<SideFit, 4> sides;
-  std::array<CutSideEdge, 4> cut_edges;  // the page edge past cut sides
-  std::array<CutSideEdge, 4> reached_sides;  // real sides past M's border
-  PageFormatFit page_format;  // the crop lengthened past unseen cut sides
+  std::array<CutSideEdge, 4> cut_edges;         // the page edge past cut sides
+  std::array<CutSideEdge, 4> reached_sides;     // real sides past M's border
+  PageFormatFit page_format;                    // the crop lengthened past unseen cut sides
   std::vector<ViewRegistration> registrations;  // of the views textured from
   cv::Vec3b fill;
-  double page_fraction = 0;      // output pixels showing the page
-  double hidden_fraction = 0;    // output pixels on M' but not seen
-  double minified_fraction = 0;  // output pixels that needed pre-filtering
-  double other_view_fraction = 0;  // output pixels from another view's photo
+  double page_fraction = 0;         // output pixels showing the page
+  double hidden_fraction = 0;       // output pixels on M' but not seen
+  double minified_fraction = 0;     // output pixels that needed pre-filtering
+  double other_view_fraction = 0;   // output pixels from another view's photo
   double better_view_fraction = 0;  // of the reference's, retextured (better_views)
   bool shading_removed = false;
   double shading_paper_fraction = 0;  // of the image taken as paper (shading = remove)
@@ -229,7 +228,7 @@ struct RenderResult {
   // and pixels_per_unit above refer to the unturned image).
   int quarter_turns = 0;
   std::vector<std::pair<std::string, double>> timings;  // seconds per step
-  Json report;  // render.json (docunfold.render)
+  Json report;                                          // render.json (docunfold.render)
 };
 
 // Reads and validates everything render needs; InputError naming the file
@@ -237,10 +236,8 @@ struct RenderResult {
 // `images_dir` (optional): the photos, for the page past cut sides.
 // `features_file` (optional): features.json, for which way up the page is
 // when Tesseract cannot tell and there is no lines.json beside the meshes.
-RenderInputs ReadRenderInputs(const fs::path& sfm_dir,
-                              const fs::path& boundary_dir,
-                              const fs::path& meshes_dir,
-                              const fs::path& images_dir = {},
+RenderInputs ReadRenderInputs(const fs::path& sfm_dir, const fs::path& boundary_dir,
+                              const fs::path& meshes_dir, const fs::path& images_dir = {},
                               const fs::path& features_file = {});
 
 // Renders the rectified page. Throws InputError for inconsistent inputs

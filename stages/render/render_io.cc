@@ -10,10 +10,8 @@
 
 namespace docunfold::render {
 
-RenderInputs ReadRenderInputs(const fs::path& sfm_dir,
-                              const fs::path& boundary_dir,
-                              const fs::path& meshes_dir,
-                              const fs::path& images_dir,
+RenderInputs ReadRenderInputs(const fs::path& sfm_dir, const fs::path& boundary_dir,
+                              const fs::path& meshes_dir, const fs::path& images_dir,
                               const fs::path& features_file) {
   RenderInputs in;
   in.cameras_file = sfm_dir / "cameras.json";
@@ -35,25 +33,22 @@ RenderInputs ReadRenderInputs(const fs::path& sfm_dir,
   for (size_t i = 0; i < cameras.views.size(); ++i) {
     const PinholeCamera& view = cameras.views[i];
     if (view.image == cameras.reference) continue;
-    const fs::path mask_file =
-        boundary_dir / "views" / fs::path(view.image).stem() / "mask.png";
+    const fs::path mask_file = boundary_dir / "views" / fs::path(view.image).stem() / "mask.png";
     std::error_code exists_ec;
     if (!fs::is_regular_file(mask_file, exists_ec)) continue;
     fs::path photo;
     if (!images_dir.empty()) {
       photo = images_dir / view.image;
       if (!fs::is_regular_file(photo, exists_ec))
-        throw InputError(photo.string() + ": no such file (a view in " +
-                         in.cameras_file.string() + ")");
+        throw InputError(photo.string() + ": no such file (a view in " + in.cameras_file.string() +
+                         ")");
     }
     in.views.push_back({view, ReadDocumentMask(mask_file, view.width, view.height), mask_file,
-                        photo,
-                        ReadDistortion(cameras_reader, "/views/" + std::to_string(i))});
+                        photo, ReadDistortion(cameras_reader, "/views/" + std::to_string(i))});
   }
   std::error_code ec;
   if (!fs::is_directory(meshes_dir, ec))
-    throw InputError(meshes_dir.string() +
-                     ": no such directory (expected mesh3d.ply, mesh2d.ply)");
+    throw InputError(meshes_dir.string() + ": no such directory (expected mesh3d.ply, mesh2d.ply)");
   in.meshes = ReadMeshPair(meshes_dir);
   // optimize's lines, for the deskew: each line's direction (its normal
   // turned, the same modulo 90 degrees) and its extent in M'.
@@ -88,8 +83,7 @@ RenderInputs ReadRenderInputs(const fs::path& sfm_dir,
       in.text_down_image = features.text_down;
       for (const FeatureSegment& segment : features.segments)
         if (segment.kind == "text")
-          in.text_points.insert(in.text_points.end(), segment.points.begin(),
-                                segment.points.end());
+          in.text_points.insert(in.text_points.end(), segment.points.begin(), segment.points.end());
     }
   }
   return in;
@@ -101,12 +95,10 @@ void WriteRenderOutputs(const fs::path& out_dir, const RenderResult& result) {
   EnsureDirectory(out_dir);
   // A target that exists as something other than a file (a directory in the
   // way) would fail its rename after the others were renamed: refuse first.
-  for (const char* name :
-       {"rectified.png", "rectified_grid.png", "render.json"}) {
+  for (const char* name : {"rectified.png", "rectified_grid.png", "render.json"}) {
     std::error_code ec;
     const fs::path target = out_dir / name;
-    if (fs::exists(fs::symlink_status(target, ec)) &&
-        !fs::is_regular_file(target, ec))
+    if (fs::exists(fs::symlink_status(target, ec)) && !fs::is_regular_file(target, ec))
       throw OutputError(target.string() + ": exists and is not a regular file");
   }
   // Everything goes to temporary files first; only when all three are
@@ -130,12 +122,10 @@ void WriteRenderOutputs(const fs::path& out_dir, const RenderResult& result) {
   {
     // WriteJsonAtomic would commit on its own; write the text by hand.
     FILE* f = std::fopen(report.temp_path().c_str(), "wb");
-    if (!f)
-      throw OutputError(report.target().string() + ": cannot open for writing");
+    if (!f) throw OutputError(report.target().string() + ": cannot open for writing");
     const std::string text = result.report.dump(1) + "\n";
     const bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();
-    if (std::fclose(f) != 0 || !ok)
-      throw OutputError(report.target().string() + ": write failed");
+    if (std::fclose(f) != 0 || !ok) throw OutputError(report.target().string() + ": write failed");
   }
   rectified.Commit();
   grid.Commit();

@@ -1,8 +1,8 @@
 #include "stages/render/texture_sampler.h"
 
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
-#include <Eigen/LU>
 #include <opencv2/imgproc.hpp>
 
 namespace docunfold::render {
@@ -23,16 +23,14 @@ inline void CubicWeights(float t, float w[4]) {
 TextureSampler::TextureSampler(const cv::Mat& image) {
   CV_Assert(image.type() == CV_8UC3);
   levels_.push_back(image);
-  while (levels_.size() < 14 &&
-         std::min(levels_.back().cols, levels_.back().rows) > 16) {
+  while (levels_.size() < 14 && std::min(levels_.back().cols, levels_.back().rows) > 16) {
     cv::Mat next;
     cv::pyrDown(levels_.back(), next);
     levels_.push_back(next);
   }
 }
 
-void TextureSampler::Bicubic(int level, float u, float v, float weight,
-                             float acc[3]) const {
+void TextureSampler::Bicubic(int level, float u, float v, float weight, float acc[3]) const {
   const cv::Mat& img = levels_[level];
   const float scale = 1.0f / float(1 << level);
   const float x = u * scale, y = v * scale;
@@ -42,8 +40,7 @@ void TextureSampler::Bicubic(int level, float u, float v, float weight,
   CubicWeights(x - fx0, wx);
   CubicWeights(y - fy0, wy);
   int cols[4];
-  for (int k = 0; k < 4; ++k)
-    cols[k] = 3 * std::clamp(ix - 1 + k, 0, img.cols - 1);
+  for (int k = 0; k < 4; ++k) cols[k] = 3 * std::clamp(ix - 1 + k, 0, img.cols - 1);
   float sum[3] = {0, 0, 0};
   for (int j = 0; j < 4; ++j) {
     const uchar* row = img.ptr<uchar>(std::clamp(iy - 1 + j, 0, img.rows - 1));
@@ -111,9 +108,7 @@ bool TextureSampler::Sample(float u, float v, const float J[4], bool antialias,
   level = std::min(level, num_levels() - 1);
   const float pixel = float(1 << level);
   auto taps_for = [&](float width) {
-    return width > 1.25f * pixel
-               ? std::min(kMaxTaps, int(std::ceil(width / pixel)))
-               : 1;
+    return width > 1.25f * pixel ? std::min(kMaxTaps, int(std::ceil(width / pixel))) : 1;
   };
   const int n1 = taps_for(sigma1), n2 = taps_for(sigma2);
   if (n1 == 1 && n2 == 1 && level == 0) {
@@ -141,9 +136,8 @@ std::vector<Eigen::Matrix<double, 3, 2>> SurfacePerOutputPixel(
     Q << flat[t[1]] - flat[t[0]], flat[t[2]] - flat[t[0]];
     Eigen::Matrix<double, 3, 2> P;
     P << surface[t[1]] - surface[t[0]], surface[t[2]] - surface[t[0]];
-    out[f] = std::abs(Q.determinant()) > 0
-                 ? Eigen::Matrix<double, 3, 2>(P * Q.inverse() / scale)
-                 : Eigen::Matrix<double, 3, 2>::Zero();
+    out[f] = std::abs(Q.determinant()) > 0 ? Eigen::Matrix<double, 3, 2>(P * Q.inverse() / scale)
+                                           : Eigen::Matrix<double, 3, 2>::Zero();
   }
   return out;
 }

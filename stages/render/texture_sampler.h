@@ -29,8 +29,7 @@ class TextureSampler {
   // Colour at reference pixel (u, v) (centres at integers; clamped to the
   // image) for footprint J = [du/dx du/dy; dv/dx dv/dy]. `antialias` false
   // gives plain bicubic whatever J. Returns whether pre-filtering was used.
-  bool Sample(float u, float v, const float J[4], bool antialias,
-              float out[3]) const;
+  bool Sample(float u, float v, const float J[4], bool antialias, float out[3]) const;
 
   int num_levels() const { return int(levels_.size()); }
 

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -13,19 +12,27 @@ std::string Escape(const std::string& text) {
   std::string out;
   for (char c : text) {
     switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        out += c;
     }
   }
   return out;
 }
 
 std::string Base64(const std::vector<unsigned char>& bytes) {
-  static const char* kAlphabet =
-      "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  static const char* kAlphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
   std::string out;
   out.reserve((bytes.size() + 2) / 3 * 4);
   for (size_t i = 0; i < bytes.size(); i += 3) {
@@ -43,14 +50,13 @@ std::string Base64(const std::vector<unsigned char>& bytes) {
 std::string InlineImage(const cv::Mat& image, int max_width, const std::string& alt, bool png) {
   cv::Mat scaled = image;
   if (image.cols > max_width)
-    cv::resize(image, scaled,
-               cv::Size(max_width, std::max(1, image.rows * max_width / image.cols)), 0, 0,
-               cv::INTER_AREA);
+    cv::resize(image, scaled, cv::Size(max_width, std::max(1, image.rows * max_width / image.cols)),
+               0, 0, cv::INTER_AREA);
   std::vector<unsigned char> bytes;
   cv::imencode(png ? ".png" : ".jpg", scaled, bytes,
                png ? std::vector<int>{} : std::vector<int>{cv::IMWRITE_JPEG_QUALITY, 88});
-  return "<img src=\"data:image/" + std::string(png ? "png" : "jpeg") + ";base64," +
-         Base64(bytes) + "\" width=\"" + std::to_string(scaled.cols) + "\" height=\"" +
+  return "<img src=\"data:image/" + std::string(png ? "png" : "jpeg") + ";base64," + Base64(bytes) +
+         "\" width=\"" + std::to_string(scaled.cols) + "\" height=\"" +
          std::to_string(scaled.rows) + "\" alt=\"" + Escape(alt) + "\">";
 }
 
@@ -75,7 +81,10 @@ std::vector<double> Ticks(double lo, double hi, int wanted) {
   const double mag = std::pow(10, std::floor(std::log10(raw)));
   double step = mag;
   for (double m : {1.0, 2.0, 5.0, 10.0})
-    if (raw <= m * mag) { step = m * mag; break; }
+    if (raw <= m * mag) {
+      step = m * mag;
+      break;
+    }
   std::vector<double> ticks;
   for (double t = std::ceil(lo / step) * step; t <= hi + 1e-9 * span; t += step)
     ticks.push_back(std::abs(t) < 1e-12 * span ? 0 : t);
@@ -92,19 +101,28 @@ std::string SvgScatter(const std::vector<PlotPoint>& points, const PlotOptions& 
   for (const PlotPoint& p : points) {
     const double y = o.log_y ? std::log10(std::max(p.y, 1e-300)) : p.y;
     if (!std::isfinite(y) || !std::isfinite(p.x)) continue;
-    if (first) { x0 = x1 = p.x; y0 = y1 = y; first = false; }
-    x0 = std::min(x0, p.x); x1 = std::max(x1, p.x);
-    y0 = std::min(y0, y); y1 = std::max(y1, y);
+    if (first) {
+      x0 = x1 = p.x;
+      y0 = y1 = y;
+      first = false;
+    }
+    x0 = std::min(x0, p.x);
+    x1 = std::max(x1, p.x);
+    y0 = std::min(y0, y);
+    y1 = std::max(y1, y);
   }
   if (x1 - x0 < 1e-9) x1 = x0 + 1;
-  if (y1 - y0 < 1e-9) { y0 -= 0.5; y1 += 0.5; }
+  if (y1 - y0 < 1e-9) {
+    y0 -= 0.5;
+    y1 += 0.5;
+  }
   const double pad = 0.05 * (y1 - y0);
   y0 -= pad;
   y1 += pad;
   auto X = [&](double x) { return left + (x - x0) / (x1 - x0) * w; };
   auto Y = [&](double y) { return top + (1 - (y - y0) / (y1 - y0)) * h; };
-  std::string s = "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" +
-                  std::to_string(o.width) + "\" height=\"" + std::to_string(o.height) +
+  std::string s = "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" + std::to_string(o.width) +
+                  "\" height=\"" + std::to_string(o.height) +
                   "\" font-family=\"sans-serif\" font-size=\"11\">";
   s += "<rect x=\"" + std::to_string(left) + "\" y=\"" + std::to_string(top) + "\" width=\"" +
        std::to_string(w) + "\" height=\"" + std::to_string(h) +

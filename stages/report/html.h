@@ -2,10 +2,9 @@
 // data: URIs, and an inline SVG scatter plot.
 #pragma once
 
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 namespace docunfold::report {
 

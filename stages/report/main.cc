@@ -10,8 +10,7 @@ int main(int argc, char** argv) {
       "report: one HTML page with every stage's output for a data set (photos, reference "
       "view, boundary, feature segments, point cloud and meshes, convergence, the rectified "
       "page, metrics, stage times and flags). Self-contained: opens from disk, offline."};
-  app.add_option("--data", o.data, "data-set folder (images/, optional ground_truth/)")
-      ->required();
+  app.add_option("--data", o.data, "data-set folder (images/, optional ground_truth/)")->required();
   app.add_option("--work", o.work, "its work directory")->required();
   app.add_option("--out", o.out, "HTML file to write (default <work>/report.html)");
   app.add_option("--thumbnail-width", o.thumbnail_width, "photo thumbnails, pixels")

@@ -1,18 +1,16 @@
 #include "stages/report/mesh_views.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
-
-#include <Eigen/Geometry>
 #include <opencv2/imgproc.hpp>
 
 #include "common/raster.h"
 
 namespace docunfold::report {
 
-cv::Mat RenderMeshView(const MeshPair& mesh, const PinholeCamera& reference,
-                       const cv::Mat& texture, const std::vector<Eigen::Vector3d>& points,
-                       const MeshViewOptions& o) {
+cv::Mat RenderMeshView(const MeshPair& mesh, const PinholeCamera& reference, const cv::Mat& texture,
+                       const std::vector<Eigen::Vector3d>& points, const MeshViewOptions& o) {
   const auto& V = mesh.mesh3d;
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
   for (const auto& v : V) centre += v;
@@ -22,10 +20,9 @@ cv::Mat RenderMeshView(const MeshPair& mesh, const PinholeCamera& reference,
 
   // The virtual camera: the reference camera's orientation, turned.
   const double kDeg = 3.14159265358979 / 180;
-  const Eigen::Matrix3d turn =
-      (Eigen::AngleAxisd(o.pitch_deg * kDeg, Eigen::Vector3d::UnitX()) *
-       Eigen::AngleAxisd(o.yaw_deg * kDeg, Eigen::Vector3d::UnitY()))
-          .toRotationMatrix();
+  const Eigen::Matrix3d turn = (Eigen::AngleAxisd(o.pitch_deg * kDeg, Eigen::Vector3d::UnitX()) *
+                                Eigen::AngleAxisd(o.yaw_deg * kDeg, Eigen::Vector3d::UnitY()))
+                                   .toRotationMatrix();
   PinholeCamera cam;
   cam.width = o.width;
   cam.height = o.height;
@@ -41,7 +38,9 @@ cv::Mat RenderMeshView(const MeshPair& mesh, const PinholeCamera& reference,
 
   // Per-vertex normals (from the grid) and texture coordinates.
   const QuadGrid& g = mesh.grid;
-  auto at = [&](int r, int c) { return V[g.Index(std::clamp(r, 0, g.ny - 1), std::clamp(c, 0, g.nx - 1))]; };
+  auto at = [&](int r, int c) {
+    return V[g.Index(std::clamp(r, 0, g.ny - 1), std::clamp(c, 0, g.nx - 1))];
+  };
   Eigen::MatrixXf attributes(V.size(), 5);
   for (int r = 0; r < g.ny; ++r)
     for (int c = 0; c < g.nx; ++c) {

@@ -5,10 +5,9 @@
 #include <ctime>
 #include <fstream>
 #include <map>
-#include <sstream>
-
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <sstream>
 
 #include "common/camera.h"
 #include "common/cli.h"
@@ -69,7 +68,9 @@ class Page {
   void Add(const std::string& html) { body_ += html; }
   std::string Html(const std::string& title, const std::string& summary) const {
     return "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
-           "<title>" + Escape(title) + "</title><style>"
+           "<title>" +
+           Escape(title) +
+           "</title><style>"
            "body{font-family:sans-serif;margin:1.5em auto;max-width:1200px;color:#222}"
            "h1{margin-bottom:0.2em}h2{border-bottom:1px solid #ccc;padding-bottom:0.2em;"
            "margin-top:1.6em}nav a{margin-right:1em}figure{display:inline-block;margin:0.4em;"
@@ -78,8 +79,9 @@ class Page {
            "padding:3px 8px;text-align:right}th{background:#f0f0f0}td.l,th.l{text-align:left}"
            ".ref{outline:4px solid #d62728}.missing{color:#a00;font-style:italic}"
            "code{background:#f4f4f4;padding:1px 3px}img{max-width:100%;height:auto}"
-           "</style></head><body>\n<h1>" + Escape(title) + "</h1><p>" + summary +
-           "</p><nav>" + toc_ + "</nav>\n" + body_ + "</body></html>\n";
+           "</style></head><body>\n<h1>" +
+           Escape(title) + "</h1><p>" + summary + "</p><nav>" + toc_ + "</nav>\n" + body_ +
+           "</body></html>\n";
   }
 
  private:
@@ -128,12 +130,12 @@ void PhotosSection(const ReportOptions& o, const DataSet& data, const Json& came
   if (!cameras.is_object()) {
     page->Add(Missing("sfm has not run yet (10_sfm/cameras.json is missing)."));
   } else {
-    std::string why = "Chosen automatically by sfm: the registered view that sees the whole "
-                      "page and resolves its worst-seen tenth best (resolution = pixels per "
-                      "unit of page length across the foreshortening).";
+    std::string why =
+        "Chosen automatically by sfm: the registered view that sees the whole "
+        "page and resolves its worst-seen tenth best (resolution = pixels per "
+        "unit of page length across the foreshortening).";
     const std::string flags = ReadText(o.work / ".flags/sfm");
-    if (flags.find("--ref") != std::string::npos)
-      why = "Chosen by the user (<code>REF=</code>).";
+    if (flags.find("--ref") != std::string::npos) why = "Chosen by the user (<code>REF=</code>).";
     // sfm's scores of every view (cameras.json /reference_selection/views).
     if (cameras.contains("reference_selection")) {
       const Json& c = cameras["reference_selection"];
@@ -147,9 +149,10 @@ void PhotosSection(const ReportOptions& o, const DataSet& data, const Json& came
         for (const Json& cand : c["views"]) {
           why += "<tr><td class=l>" + Escape(cand.value("image", "?")) + "</td>";
           for (const auto& k : keys)
-            why += "<td>" + (cand.contains(k) && cand[k].is_number()
-                                 ? Fmt(cand[k].get<double>(), "%.3g")
-                                 : std::string("–")) + "</td>";
+            why += "<td>" +
+                   (cand.contains(k) && cand[k].is_number() ? Fmt(cand[k].get<double>(), "%.3g")
+                                                            : std::string("–")) +
+                   "</td>";
           why += "</tr>";
         }
         why += "</table>";
@@ -183,11 +186,11 @@ void BoundarySection(const ReportOptions& o, Page* page) {
   std::string caption;
   if (features.is_object() && features.contains("segments")) {
     int text = 0, edge = 0;
-    for (const Json& s : features["segments"])
-      (s.value("kind", "") == "text" ? text : edge)++;
+    for (const Json& s : features["segments"]) (s.value("kind", "") == "text" ? text : edge)++;
     caption = std::to_string(text) + " text and " + std::to_string(edge) +
               " edge segments (30_features/features.json).";
-    if (features.contains("producer") && features["producer"].value("stage", "") != "detect-features")
+    if (features.contains("producer") &&
+        features["producer"].value("stage", "") != "detect-features")
       caption += " From another detector.";
   }
   if (!foverlay.empty())
@@ -238,8 +241,9 @@ void MeshSection(const ReportOptions& o, const Json& cameras, Page* page, fs::pa
     const cv::Mat points_overlay = TryImage(o.work / "25_points/overlay.png");
     if (!points_overlay.empty()) {
       const Json counts = TryJson(o.work / "25_points/points.json");
-      std::string caption = "The points fitted (25_points/overlay.png): sfm's (blue), texture "
-                            "(green) and outline (magenta) points of densify.";
+      std::string caption =
+          "The points fitted (25_points/overlay.png): sfm's (blue), texture "
+          "(green) and outline (magenta) points of densify.";
       if (counts.is_object() && counts.contains("points"))
         caption += " " + std::to_string(counts["points"].value("sfm_in_region", 0)) +
                    " sfm points on the page, " +
@@ -247,8 +251,8 @@ void MeshSection(const ReportOptions& o, const Json& cameras, Page* page, fs::pa
                    std::to_string(counts["points"].value("outline", 0)) + " outline.";
       page->Add(Figure(InlineImage(points_overlay, o.figure_width / 2 + 100, "points"), caption));
     }
-    page->Add("<p>M and M' from <code>" + Escape(mesh_dir->filename().string()) + "/</code>: " +
-              std::to_string(mesh.grid.nx) + " × " + std::to_string(mesh.grid.ny) +
+    page->Add("<p>M and M' from <code>" + Escape(mesh_dir->filename().string()) +
+              "/</code>: " + std::to_string(mesh.grid.nx) + " × " + std::to_string(mesh.grid.ny) +
               " vertices; " + std::to_string(points.size()) +
               " points. Open <code>mesh3d.ply</code> in MeshLab to see M textured, or "
               "<code>50_optimize/scene.glb</code> in any glTF viewer.</p>");
@@ -271,8 +275,9 @@ void ConvergenceSection(const ReportOptions& o, Page* page) {
   plot.x_label = "time (s)";
   plot.y_label = "F";
   plot.log_y = true;
-  std::string table = "<table><tr><th class=l>round</th><th>grid</th><th>iterations</th>"
-                      "<th>final F</th><th>seconds</th><th class=l>stopped</th></tr>";
+  std::string table =
+      "<table><tr><th class=l>round</th><th>grid</th><th>iterations</th>"
+      "<th>final F</th><th>seconds</th><th class=l>stopped</th></tr>";
   for (const Json& round : log["rounds"]) {
     const int r = round.value("round", 0);
     plot.series_names.push_back("round " + std::to_string(r));
@@ -293,22 +298,25 @@ void ConvergenceSection(const ReportOptions& o, Page* page) {
   }
   table += "</table>";
   page->Add(SvgScatter(points, plot));
-  page->Add("<p>Each dot is one outer iteration (footpoints, outliers and feature lines "
-            "recomputed, then one solver step); colours are rounds, separated by "
-            "Catmull–Clark subdivision.</p>" + table);
+  page->Add(
+      "<p>Each dot is one outer iteration (footpoints, outliers and feature lines "
+      "recomputed, then one solver step); colours are rounds, separated by "
+      "Catmull–Clark subdivision.</p>" +
+      table);
   page->End();
 }
 
 std::string MetricsRow(const Json& m) {
   const Json& v = m.at("metrics");
   auto cell = [&](const char* key, const char* format) {
-    return "<td>" + (v.contains(key) && v[key].is_number() ? Fmt(v[key].get<double>(), format)
-                                                           : std::string("–")) + "</td>";
+    return "<td>" +
+           (v.contains(key) && v[key].is_number() ? Fmt(v[key].get<double>(), format)
+                                                  : std::string("–")) +
+           "</td>";
   };
-  return "<tr><td class=l>" + Escape(m.value("method", "?")) + "</td>" +
-         cell("ms_ssim", "%.4f") + cell("ld", "%.2f") + cell("li_d", "%.2f") +
-         cell("cer", "%.3f") + cell("wer", "%.3f") + cell("surface_mean_pct", "%.2f") +
-         cell("isometry_mean", "%.4f") + "</tr>";
+  return "<tr><td class=l>" + Escape(m.value("method", "?")) + "</td>" + cell("ms_ssim", "%.4f") +
+         cell("ld", "%.2f") + cell("li_d", "%.2f") + cell("cer", "%.3f") + cell("wer", "%.3f") +
+         cell("surface_mean_pct", "%.2f") + cell("isometry_mean", "%.4f") + "</tr>";
 }
 
 // evaluate --front-end's figures in one sentence, misses marked.
@@ -320,20 +328,19 @@ std::string FrontEndParagraph(const Json& f) {
   auto miss = [](const Json& o, const char* key) {
     return o.contains("holds") && !o["holds"].value(key, true) ? std::string(" ✗") : "";
   };
-  std::string p = "<p>Front end against the ground truth in " +
-                  Escape(f.value("reference", "?")) + ": ";
+  std::string p =
+      "<p>Front end against the ground truth in " + Escape(f.value("reference", "?")) + ": ";
   const Json& b = f.value("boundary", Json::object());
   if (b.contains("iou"))
-    p += "boundary IoU " + number(b, "iou", "%.4f") + miss(b, "iou") +
-         ", worst visible corner " + number(b, "worst_corner_fraction", "%.2f", 100) +
-         " % of the page diagonal" + miss(b, "corners") + ", " +
-         std::to_string(b.value("sides_not_real", 0)) + " side(s) flagged cut" +
-         (b.value("page_cut", false) ? " (the page is cut)" : "") + miss(b, "cut_flags") +
-         "; ";
+    p += "boundary IoU " + number(b, "iou", "%.4f") + miss(b, "iou") + ", worst visible corner " +
+         number(b, "worst_corner_fraction", "%.2f", 100) + " % of the page diagonal" +
+         miss(b, "corners") + ", " + std::to_string(b.value("sides_not_real", 0)) +
+         " side(s) flagged cut" + (b.value("page_cut", false) ? " (the page is cut)" : "") +
+         miss(b, "cut_flags") + "; ";
   const Json& l = f.value("features", Json::object());
   if (l.contains("precision"))
-    p += "feature segments: precision " + number(l, "precision", "%.3f") +
-         miss(l, "precision") + ", recall " + number(l, "recall", "%.3f") + miss(l, "recall") +
+    p += "feature segments: precision " + number(l, "precision", "%.3f") + miss(l, "precision") +
+         ", recall " + number(l, "recall", "%.3f") + miss(l, "recall") +
          (l.value("recall_required", false) ? "" : " (not required on this kind of page)");
   return p + ". ✗ = short of issue 3's threshold (evaluate --front-end).</p>";
 }
@@ -343,15 +350,16 @@ std::string FrontEndParagraph(const Json& f) {
 // crop, the scale and the quarter turns of render.json. Empty when render did
 // not texture optimize's meshes or a file is missing.
 cv::Mat DrawFeatureLines(const cv::Mat& rectified, const Json& render, const Json& lines) {
-  if (rectified.empty() || !render.is_object() || !lines.is_object() ||
-      !lines.contains("lines") || !render.contains("crop"))
+  if (rectified.empty() || !render.is_object() || !lines.is_object() || !lines.contains("lines") ||
+      !render.contains("crop"))
     return {};
   const std::string meshes = render.value("/inputs/meshes"_json_pointer, std::string());
   if (fs::path(meshes).filename() != "50_optimize") return {};
   const double angle = render.value("rotation_deg", 0.0) * CV_PI / 180;
   const double scale = render.value("pixels_per_unit", 0.0);
   const double x0 = render["crop"].value("x0", 0.0), y0 = render["crop"].value("y0", 0.0);
-  const int turns = ((render.value("/orientation/quarter_turns_clockwise"_json_pointer, 0) % 4) + 4) % 4;
+  const int turns =
+      ((render.value("/orientation/quarter_turns_clockwise"_json_pointer, 0) % 4) + 4) % 4;
   if (!(scale > 0)) return {};
   // Size before the quarter turns.
   const int w = turns % 2 ? rectified.rows : rectified.cols;
@@ -362,10 +370,14 @@ cv::Mat DrawFeatureLines(const cv::Mat& rectified, const Json& render, const Jso
     const double u = (c * fx - sn * fy - x0) * scale - 0.5;
     const double v = (sn * fx + c * fy - y0) * scale - 0.5;
     switch (turns) {  // as cv::rotate turns the image clockwise
-      case 1: return cv::Point2d(h - 1 - v, u);
-      case 2: return cv::Point2d(w - 1 - u, h - 1 - v);
-      case 3: return cv::Point2d(v, w - 1 - u);
-      default: return cv::Point2d(u, v);
+      case 1:
+        return cv::Point2d(h - 1 - v, u);
+      case 2:
+        return cv::Point2d(w - 1 - u, h - 1 - v);
+      case 3:
+        return cv::Point2d(v, w - 1 - u);
+      default:
+        return cv::Point2d(u, v);
     }
   };
   cv::Mat out = rectified.clone();
@@ -402,9 +414,9 @@ void ResultSection(const ReportOptions& o, const DataSet& data, const fs::path& 
                             "60_render/rectified.png (" + std::to_string(rectified.cols) + " × " +
                                 std::to_string(rectified.rows) + ")");
   if (!grid.empty())
-    html += Figure(InlineImage(grid, o.figure_width / 2, "rectified with M'"),
-                   "The same with the edges of M' (from " +
-                       Escape(mesh_dir.filename().string()) + ")");
+    html +=
+        Figure(InlineImage(grid, o.figure_width / 2, "rectified with M'"),
+               "The same with the edges of M' (from " + Escape(mesh_dir.filename().string()) + ")");
   const Json lines = TryJson(o.work / "50_optimize/lines.json");
   const cv::Mat with_lines =
       DrawFeatureLines(rectified, TryJson(o.work / "60_render/render.json"), lines);
@@ -440,13 +452,15 @@ void ResultSection(const ReportOptions& o, const DataSet& data, const fs::path& 
     return a.value("method", "") < b.value("method", "");
   });
   if (!metrics.empty()) {
-    std::string t = "<table><tr><th class=l>method</th><th>MS-SSIM</th><th>LD</th>"
-                    "<th>Li-D</th><th>CER</th><th>WER</th><th>surface %</th>"
-                    "<th>isometry</th></tr>";
+    std::string t =
+        "<table><tr><th class=l>method</th><th>MS-SSIM</th><th>LD</th>"
+        "<th>Li-D</th><th>CER</th><th>WER</th><th>surface %</th>"
+        "<th>isometry</th></tr>";
     for (const Json& m : metrics) t += MetricsRow(m);
-    page->Add(t + "</table><p>MS-SSIM as on the DocUNet benchmark; LD and Li-D from DeepFlow; "
-                  "CER and WER from Tesseract against the OCR of flat.png; surface: mean "
-                  "distance of M to the true surface in % of the page diagonal.</p>");
+    page->Add(t +
+              "</table><p>MS-SSIM as on the DocUNet benchmark; LD and Li-D from DeepFlow; "
+              "CER and WER from Tesseract against the OCR of flat.png; surface: mean "
+              "distance of M to the true surface in % of the page diagonal.</p>");
   }
   const Json front = TryJson(o.work / "70_eval" / "front_end.json");
   if (front.is_object() && front.value("format", "") == "docunfold.front-end-metrics")
@@ -463,16 +477,18 @@ void StagesSection(const ReportOptions& o, Page* page) {
   page->Section("stages", "Stages: time, memory and flags");
   const auto timings = StageTimings(o.work);
   const std::vector<std::pair<std::string, std::string>> stages = {
-      {"sfm", "sfm"},           {"segment-boundary", "boundary"}, {"densify", "points"},
-      {"detect-features", "features"},
-      {"init-mesh", "init"},    {"optimize", "optimize"},         {"render", "render"},
-      {"evaluate", "evaluate"}};
-  std::string t = "<table><tr><th class=l>stage</th><th>wall time (s)</th><th>peak memory (MB)"
-                  "</th><th class=l>flags</th></tr>";
+      {"sfm", "sfm"},        {"segment-boundary", "boundary"},
+      {"densify", "points"}, {"detect-features", "features"},
+      {"init-mesh", "init"}, {"optimize", "optimize"},
+      {"render", "render"},  {"evaluate", "evaluate"}};
+  std::string t =
+      "<table><tr><th class=l>stage</th><th>wall time (s)</th><th>peak memory (MB)"
+      "</th><th class=l>flags</th></tr>";
   double total = 0;
   for (const auto& [stage, flag_file] : stages) {
     std::string flags = ReadText(o.work / ".flags" / flag_file);
-    while (!flags.empty() && std::isspace(static_cast<unsigned char>(flags.back()))) flags.pop_back();
+    while (!flags.empty() && std::isspace(static_cast<unsigned char>(flags.back())))
+      flags.pop_back();
     auto it = timings.find(stage);
     std::string secs = "–", mem = "–";
     if (it != timings.end()) {
@@ -485,9 +501,10 @@ void StagesSection(const ReportOptions& o, Page* page) {
          "</code></td></tr>";
   }
   t += "<tr><th class=l>total</th><th>" + Fmt(total, "%.1f") + "</th><th></th><th></th></tr>";
-  page->Add(t + "</table><p>Times are those of each stage's last run (work/&lt;name&gt;/"
-                "timings.jsonl). To rerun a stage with other flags: <code>make -f pipeline.mk "
-                "DATA=… OPTIMIZE_FLAGS=\"…\"</code>.</p>");
+  page->Add(t +
+            "</table><p>Times are those of each stage's last run (work/&lt;name&gt;/"
+            "timings.jsonl). To rerun a stage with other flags: <code>make -f pipeline.mk "
+            "DATA=… OPTIMIZE_FLAGS=\"…\"</code>.</p>");
   page->End();
 }
 

@@ -11,9 +11,9 @@ namespace docunfold::report {
 namespace fs = std::filesystem;
 
 struct ReportOptions {
-  fs::path data;          // data-set folder (images/, optional ground_truth/)
-  fs::path work;          // its work directory (10_sfm/ ... 70_eval/)
-  fs::path out;           // the HTML file, usually <work>/report.html
+  fs::path data;              // data-set folder (images/, optional ground_truth/)
+  fs::path work;              // its work directory (10_sfm/ ... 70_eval/)
+  fs::path out;               // the HTML file, usually <work>/report.html
   int thumbnail_width = 220;  // pixels
   int figure_width = 900;     // pixels, large pictures
 };

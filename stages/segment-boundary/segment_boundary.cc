@@ -4,7 +4,6 @@
 #include <chrono>
 #include <cmath>
 #include <numeric>
-
 #include <opencv2/imgproc.hpp>
 
 #include "common/cli.h"
@@ -120,8 +119,7 @@ std::vector<cv::Rect> TableFrameBlocks(const FeatureImage& lab, int b) {
 // A robust Gaussian of the table's colours in the image frame: pixels far
 // from the dominant colour are left out (iteratively reweighted).
 TableModel LearnTableModel(const FeatureImage& lab, double frame_fraction) {
-  const int b = std::max(2, int(std::lround(frame_fraction *
-                                            std::min(lab.rows, lab.cols))));
+  const int b = std::max(2, int(std::lround(frame_fraction * std::min(lab.rows, lab.cols))));
   std::vector<Feature> samples;
   for (const cv::Rect& block : TableFrameBlocks(lab, b))
     for (int y = block.y; y < block.y + block.height; ++y)
@@ -148,7 +146,10 @@ TableModel LearnTableModel(const FeatureImage& lab, double frame_fraction) {
   {
     size_t n = 0;
     for (size_t i = 0; i < samples.size(); ++i)
-      if (labels(int(i)) == larger) { mean += samples[i]; ++n; }
+      if (labels(int(i)) == larger) {
+        mean += samples[i];
+        ++n;
+      }
     mean /= double(n);
     for (size_t i = 0; i < samples.size(); ++i)
       if (labels(int(i)) == larger) {
@@ -234,7 +235,10 @@ cv::Mat1b LargestFilledRegion(const cv::Mat1b& mask, double* area = nullptr) {
   double best_area = 0;
   for (size_t i = 0; i < contours.size(); ++i) {
     const double a = cv::contourArea(contours[i]);
-    if (a > best_area) { best_area = a; best = int(i); }
+    if (a > best_area) {
+      best_area = a;
+      best = int(i);
+    }
   }
   if (best >= 0) cv::drawContours(out, contours, best, 255, cv::FILLED);
   if (area) *area = best_area;
@@ -246,8 +250,8 @@ cv::Mat1b LargestFilledRegion(const cv::Mat1b& mask, double* area = nullptr) {
 // Sums of `image` weighted by `weight`, and of the weights, blurred: their
 // ratio is the mean colour of the weighted pixels nearby (normalised
 // convolution). Kept apart so that they can be interpolated before dividing.
-void BlurredWeightedSums(const cv::Mat3f& image, const cv::Mat1f& weight,
-                         double sigma, cv::Mat3f* sum, cv::Mat1f* weight_sum) {
+void BlurredWeightedSums(const cv::Mat3f& image, const cv::Mat1f& weight, double sigma,
+                         cv::Mat3f* sum, cv::Mat1f* weight_sum) {
   cv::Mat3f w3;
   cv::merge(std::vector<cv::Mat>{weight, weight, weight}, w3);
   cv::multiply(image, w3, *sum);
@@ -358,8 +362,7 @@ std::vector<cv::Point2d> ToDouble(const std::vector<cv::Point>& pts) {
   return std::vector<cv::Point2d>(pts.begin(), pts.end());
 }
 
-std::vector<cv::Point2d> Simplify(const std::vector<cv::Point2d>& pts, double eps,
-                                  bool closed) {
+std::vector<cv::Point2d> Simplify(const std::vector<cv::Point2d>& pts, double eps, bool closed) {
   if (pts.size() < 3) return pts;
   std::vector<cv::Point2f> in(pts.begin(), pts.end()), out;
   cv::approxPolyDP(in, out, eps, closed);
@@ -368,9 +371,7 @@ std::vector<cv::Point2d> Simplify(const std::vector<cv::Point2d>& pts, double ep
 
 // Outline points on either side of a point over which its turning is
 // measured, and its corner's sides fitted: a few percent of the outline.
-int CornerReach(size_t outline_points) {
-  return std::max(2, int(0.025 * double(outline_points)));
-}
+int CornerReach(size_t outline_points) { return std::max(2, int(0.025 * double(outline_points))); }
 
 double PolylineLength(const std::vector<cv::Point2d>& p) {
   double l = 0;
@@ -400,8 +401,8 @@ std::vector<cv::Point2d> TrimBehindCorners(std::vector<cv::Point2d> p) {
 // Outline steps from corner `i` of `corners` to the next corner
 // (`direction` +1) or back to the previous one (-1).
 int ArmLength(const std::array<int, 4>& corners, int i, int direction, int n) {
-  const int steps = direction > 0 ? corners[(i + 1) % 4] - corners[i]
-                                  : corners[i] - corners[(i + 3) % 4];
+  const int steps =
+      direction > 0 ? corners[(i + 1) % 4] - corners[i] : corners[i] - corners[(i + 3) % 4];
   return ((steps % n) + n) % n;
 }
 
@@ -410,9 +411,8 @@ int ArmLength(const std::array<int, 4>& corners, int i, int direction, int n) {
 // neighbours within `window` steps that lie `compared_from` or more steps
 // from the corner; -1 if none. Stops at the image border.
 int SharpestTurnOnArm(const std::vector<cv::Point>& contour, const std::vector<double>& angle,
-                      int corner, int direction, int first, int last, int window,
-                      int compared_from, double min_turn,
-                      const std::function<bool(const cv::Point&)>& on_border) {
+                      int corner, int direction, int first, int last, int window, int compared_from,
+                      double min_turn, const std::function<bool(const cv::Point&)>& on_border) {
   const int n = int(contour.size());
   auto wrap = [n](int k) { return ((k % n) + n) % n; };
   int best = -1;
@@ -491,8 +491,7 @@ std::array<int, 4> FindCornerIndices(const std::vector<cv::Point>& contour,
       const int shorter_to = shorter_from == a ? b : a;
       const double weaker = std::min(angle[a], angle[b]);
       for (const int c : candidates)
-        if (c != a && c != b && OnOutlinePath(n, shorter_from, shorter_to, c) &&
-            angle[c] >= weaker)
+        if (c != a && c != b && OnOutlinePath(n, shorter_from, shorter_to, c) && angle[c] >= weaker)
           return true;
       return false;
     };
@@ -521,7 +520,10 @@ std::array<int, 4> FindCornerIndices(const std::vector<cv::Point>& contour,
       for (size_t i = 0; i < h; ++i) {
         const double a = TriangleArea(contour[hull[(i + h - 1) % h]], contour[hull[i]],
                                       contour[hull[(i + 1) % h]]);
-        if (a < worst_area) { worst_area = a; worst = i; }
+        if (a < worst_area) {
+          worst_area = a;
+          worst = i;
+        }
       }
       hull.erase(hull.begin() + long(worst));
     }
@@ -590,9 +592,9 @@ std::array<int, 4> MoveBorderCornersToPageCorners(
     const int direction = forward_cut ? -1 : +1;
     const int length = forward_cut ? backward : forward;
     // Past the exit's own turning window, and compared only with points past it.
-    const int best = SharpestTurnOnArm(contour, angle, corner, direction, reach,
-                                       int(max_arm_fraction * length), reach / 2, reach,
-                                       min_turn_deg * CV_PI / 180, on_border);
+    const int best =
+        SharpestTurnOnArm(contour, angle, corner, direction, reach, int(max_arm_fraction * length),
+                          reach / 2, reach, min_turn_deg * CV_PI / 180, on_border);
     if (best >= 0) idx[i] = best;
   }
   return idx;
@@ -638,8 +640,8 @@ std::array<int, 4> MoveFoldEndsToPageCorners(const std::vector<cv::Point>& conto
   return idx;
 }
 
-bool IsShadingStep(const cv::Mat1f& grey, const cv::Mat1b& mask, double scale,
-                   const cv::Point& a, const cv::Point& b, double offset_px) {
+bool IsShadingStep(const cv::Mat1f& grey, const cv::Mat1b& mask, double scale, const cv::Point& a,
+                   const cv::Point& b, double offset_px) {
   const cv::Point2d p = cv::Point2d(a) * scale, q = cv::Point2d(b) * scale;
   const double length = cv::norm(q - p);
   if (length < 20) return false;
@@ -720,7 +722,10 @@ int GeometricTopSide(const std::array<cv::Point2d, 4>& corners) {
     const cv::Point2d d = corners[(i + 1) % 4] - corners[i];
     // Outward normal of a clockwise (image y down) polygon: (d.y, -d.x).
     const double ny = -d.x / std::max(1e-9, cv::norm(d));
-    if (ny < best) { best = ny; top = i; }
+    if (ny < best) {
+      best = ny;
+      top = i;
+    }
   }
   return top;
 }
@@ -741,15 +746,15 @@ Json BoundaryOptions::ToJson() const {
 }
 
 BoundaryResult SegmentBoundary(const cv::Mat& image, const BoundaryOptions& options) {
-  if (image.empty() || image.type() != CV_8UC3)
-    throw InputError("expected an 8-bit colour image");
+  if (image.empty() || image.type() != CV_8UC3) throw InputError("expected an 8-bit colour image");
   if (image.cols < 16 || image.rows < 16)
     throw InputError("image too small (" + std::to_string(image.cols) + "x" +
                      std::to_string(image.rows) + ")");
   const cv::Mat3b full = image;
   const auto start = std::chrono::steady_clock::now();
   auto step = [&](const std::string& what) {
-    if (options.verbose) Log(what + " (" + std::to_string(SecondsSince(start)).substr(0, 5) + " s)");
+    if (options.verbose)
+      Log(what + " (" + std::to_string(SecondsSince(start)).substr(0, 5) + " s)");
   };
 
   // 1. Page region on a downscaled image: everything that is not table.
@@ -785,10 +790,11 @@ BoundaryResult SegmentBoundary(const cv::Mat& image, const BoundaryOptions& opti
   cv::Mat1b coarse = LargestFilledRegion(candidate, &area);
   const double work_area = double(small.cols) * small.rows;
   if (area < options.min_area_fraction * work_area)
-    throw InputError("no document found: no region distinct from the background "
-                     "covers " + std::to_string(int(options.min_area_fraction * 100)) +
-                     "% of the image (largest: " +
-                     std::to_string(area / work_area * 100).substr(0, 4) + "%)");
+    throw InputError(
+        "no document found: no region distinct from the background "
+        "covers " +
+        std::to_string(int(options.min_area_fraction * 100)) +
+        "% of the image (largest: " + std::to_string(area / work_area * 100).substr(0, 4) + "%)");
 
   step("coarse region");
   // 2. Outline at full resolution.
@@ -811,9 +817,8 @@ BoundaryResult SegmentBoundary(const cv::Mat& image, const BoundaryOptions& opti
   cv::findContours(mask, contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE);
   if (contours.empty()) throw InputError("no document found after refinement");
   std::vector<cv::Point> contour = *std::max_element(
-      contours.begin(), contours.end(), [](const auto& a, const auto& b) {
-        return cv::contourArea(a) < cv::contourArea(b);
-      });
+      contours.begin(), contours.end(),
+      [](const auto& a, const auto& b) { return cv::contourArea(a) < cv::contourArea(b); });
   if (SignedArea(contour) < 0) std::reverse(contour.begin(), contour.end());
   result.contour = Simplify(ToDouble(contour), options.contour_epsilon_px, true);
 
@@ -832,8 +837,7 @@ BoundaryResult SegmentBoundary(const cv::Mat& image, const BoundaryOptions& opti
   };
   const double tol = options.border_tolerance_px;
   auto on_border = [&](const cv::Point& p) {
-    return p.x <= tol || p.y <= tol || p.x >= mask.cols - 1 - tol ||
-           p.y >= mask.rows - 1 - tol;
+    return p.x <= tol || p.y <= tol || p.x >= mask.cols - 1 - tol || p.y >= mask.rows - 1 - tol;
   };
   // A fold's crease a little way from a page corner, along a side: sampled
   // close to the crease, as the panel beyond it may be narrow.
@@ -865,7 +869,8 @@ BoundaryResult SegmentBoundary(const cv::Mat& image, const BoundaryOptions& opti
   std::rotate(idx.begin(), idx.begin() + top, idx.end());
   for (int i = 0; i < 4; ++i) {
     const cv::Point2d c = detail::RefineCorner(contour, idx[i], CornerReach(contour.size()));
-    result.corners[i] = {std::clamp(c.x, 0.0, mask.cols - 1.0), std::clamp(c.y, 0.0, mask.rows - 1.0)};
+    result.corners[i] = {std::clamp(c.x, 0.0, mask.cols - 1.0),
+                         std::clamp(c.y, 0.0, mask.rows - 1.0)};
   }
 
   // 4. Sides along the outline, and which parts of them lie on the image border.
@@ -897,7 +902,10 @@ BoundaryResult SegmentBoundary(const cv::Mat& image, const BoundaryOptions& opti
         total += l;
         if (border && on_border(path[k - 1])) cut += l;
       }
-      if (border) flush(); else run.push_back(path[k]);
+      if (border)
+        flush();
+      else
+        run.push_back(path[k]);
     }
     flush();
     side.cut_fraction = total > 0 ? cut / total : 0;
@@ -914,8 +922,8 @@ BoundaryResult SegmentBoundary(const cv::Mat& image, const BoundaryOptions& opti
   return result;
 }
 
-Json BoundaryToJson(const BoundaryResult& r, const std::string& image_name, int width,
-                    int height, const BoundaryOptions& options) {
+Json BoundaryToJson(const BoundaryResult& r, const std::string& image_name, int width, int height,
+                    const BoundaryOptions& options) {
   auto pt = [](const cv::Point2d& p) { return Json::array({p.x, p.y}); };
   auto line = [&](const std::vector<cv::Point2d>& pts) {
     Json a = Json::array();
@@ -989,30 +997,28 @@ cv::Mat DrawBoundaryOverlay(const cv::Mat& image, const BoundaryResult& r, int m
     for (const auto& c : r.corners) centre += c * 0.25;
     cv::Point2d dir = centre - mid;
     dir *= 1.0 / std::max(1e-9, cv::norm(dir));
-    const std::string label =
-        std::string(kSideNames[i]) + (side.real ? "" : " (cut)");
+    const std::string label = std::string(kSideNames[i]) + (side.real ? "" : " (cut)");
     const double font = 0.5 * thick;
     int base = 0;
     const cv::Size ts = cv::getTextSize(label, cv::FONT_HERSHEY_SIMPLEX, font, thick, &base);
-    const cv::Point at = scaled(mid) + cv::Point(dir * 14.0 * thick) -
-                         cv::Point(ts.width / 2, -ts.height / 2);
-    cv::putText(out, label, at, cv::FONT_HERSHEY_SIMPLEX, font, cv::Scalar(0, 0, 0),
-                thick + 2, cv::LINE_AA);
-    cv::putText(out, label, at, cv::FONT_HERSHEY_SIMPLEX, font,
-                side.real ? kReal : kCut, thick, cv::LINE_AA);
+    const cv::Point at =
+        scaled(mid) + cv::Point(dir * 14.0 * thick) - cv::Point(ts.width / 2, -ts.height / 2);
+    cv::putText(out, label, at, cv::FONT_HERSHEY_SIMPLEX, font, cv::Scalar(0, 0, 0), thick + 2,
+                cv::LINE_AA);
+    cv::putText(out, label, at, cv::FONT_HERSHEY_SIMPLEX, font, side.real ? kReal : kCut, thick,
+                cv::LINE_AA);
   }
   for (int i = 0; i < 4; ++i) {
     const cv::Point c = scaled(r.corners[i]);
     cv::circle(out, c, 3 * thick, kCorner, thick, cv::LINE_AA);
     cv::putText(out, kCornerNames[i], c + cv::Point(4 * thick, -4 * thick),
-                cv::FONT_HERSHEY_SIMPLEX, 0.6 * thick, cv::Scalar(0, 0, 0), thick + 2,
-                cv::LINE_AA);
+                cv::FONT_HERSHEY_SIMPLEX, 0.6 * thick, cv::Scalar(0, 0, 0), thick + 2, cv::LINE_AA);
     cv::putText(out, kCornerNames[i], c + cv::Point(4 * thick, -4 * thick),
                 cv::FONT_HERSHEY_SIMPLEX, 0.6 * thick, kCorner, thick, cv::LINE_AA);
   }
   const std::string note = "orientation: " + r.orientation.method;
-  cv::putText(out, note, cv::Point(10, 10 + 12 * thick), cv::FONT_HERSHEY_SIMPLEX,
-              0.5 * thick, cv::Scalar(255, 255, 255), thick, cv::LINE_AA);
+  cv::putText(out, note, cv::Point(10, 10 + 12 * thick), cv::FONT_HERSHEY_SIMPLEX, 0.5 * thick,
+              cv::Scalar(255, 255, 255), thick, cv::LINE_AA);
   return out;
 }
 

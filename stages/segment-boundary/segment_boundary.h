@@ -13,10 +13,9 @@
 
 #include <array>
 #include <functional>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "common/json_io.h"
 
@@ -74,9 +73,9 @@ constexpr const char* kSideNames[4] = {"top", "right", "bottom", "left"};
 constexpr const char* kCornerNames[4] = {"TL", "TR", "BR", "BL"};
 
 struct Orientation {
-  std::string method;        // "text" or "geometry"
-  double confidence = 0;     // text: fraction of votes for the chosen top
-  int votes = 0;             // text: characters that voted
+  std::string method;     // "text" or "geometry"
+  double confidence = 0;  // text: fraction of votes for the chosen top
+  int votes = 0;          // text: characters that voted
 };
 
 struct BoundaryResult {
@@ -94,17 +93,16 @@ struct BoundaryResult {
 
 // Finds the page. Throws InputError("no document found: ...") when there is
 // no page-like region (an empty table, a blank image).
-BoundaryResult SegmentBoundary(const cv::Mat& bgr_image,
-                               const BoundaryOptions& options);
+BoundaryResult SegmentBoundary(const cv::Mat& bgr_image, const BoundaryOptions& options);
 
 // boundary.json (format docunfold.boundary, version 1).
-Json BoundaryToJson(const BoundaryResult& result, const std::string& image_name,
-                    int width, int height, const BoundaryOptions& options);
+Json BoundaryToJson(const BoundaryResult& result, const std::string& image_name, int width,
+                    int height, const BoundaryOptions& options);
 
 // The reference image with the outline, corners and side names drawn: real
 // sides in green, cut sides dashed in red; at most `max_size` pixels long.
-cv::Mat DrawBoundaryOverlay(const cv::Mat& bgr_image,
-                            const BoundaryResult& result, int max_size = 1600);
+cv::Mat DrawBoundaryOverlay(const cv::Mat& bgr_image, const BoundaryResult& result,
+                            int max_size = 1600);
 
 // Internals exposed for tests.
 namespace detail {
@@ -128,8 +126,8 @@ std::array<int, 4> FindCornerIndices(const std::vector<cv::Point>& contour,
 // `scale` work pixels per full pixel; `mask` the page region at that size.
 // `offset_px` (work pixels) is how far either side of the segment the two
 // panels are sampled; 0: 2 % of its length, at least 4.
-bool IsShadingStep(const cv::Mat1f& grey, const cv::Mat1b& mask, double scale,
-                   const cv::Point& a, const cv::Point& b, double offset_px = 0);
+bool IsShadingStep(const cv::Mat1f& grey, const cv::Mat1b& mask, double scale, const cv::Point& a,
+                   const cv::Point& b, double offset_px = 0);
 // Where a corner in the image is the end of a fold's crease that meets a
 // side a short way from the page's corner, moves the corner there: with the
 // narrow panel beyond the crease seen foreshortened, the crease's end turns

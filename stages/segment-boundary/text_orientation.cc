@@ -2,10 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <vector>
-
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
+#include <vector>
 
 namespace docunfold::boundary {
 namespace {
@@ -24,10 +23,12 @@ Votes ProfileVotes(const cv::Mat1b& ink, double char_height) {
   std::vector<int> profile(ink.rows);
   for (int x0 = 0; x0 + strip / 2 < ink.cols; x0 += strip) {
     const int x1 = std::min(ink.cols, x0 + strip);
-    for (int y = 0; y < ink.rows; ++y)
-      profile[y] = cv::countNonZero(ink.row(y).colRange(x0, x1));
+    for (int y = 0; y < ink.rows; ++y) profile[y] = cv::countNonZero(ink.row(y).colRange(x0, x1));
     for (int y = 0; y < ink.rows;) {
-      if (profile[y] == 0) { ++y; continue; }
+      if (profile[y] == 0) {
+        ++y;
+        continue;
+      }
       int end = y;
       while (end < ink.rows && profile[end] > 0) ++end;
       const int height = end - y;
@@ -64,8 +65,8 @@ TextOrientation EstimateTextTopSide(const cv::Mat3b& image, const cv::Mat1b& mas
   const double scale = std::min(1.0, 2000.0 / std::max(w, h));
   const int W = std::max(8, int(w * scale)), H = std::max(8, int(h * scale));
   std::vector<cv::Point2f> src(c.begin(), c.end());
-  std::vector<cv::Point2f> dst = {{0, 0}, {float(W - 1), 0}, {float(W - 1), float(H - 1)},
-                                  {0, float(H - 1)}};
+  std::vector<cv::Point2f> dst = {
+      {0, 0}, {float(W - 1), 0}, {float(W - 1), float(H - 1)}, {0, float(H - 1)}};
   const cv::Mat homography = cv::getPerspectiveTransform(src, dst);
   cv::Mat1b grey, page, region;
   cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
@@ -79,8 +80,8 @@ TextOrientation EstimateTextTopSide(const cv::Mat3b& image, const cv::Mat1b& mas
   // 2. Ink: darker than its surroundings, as characters are.
   cv::Mat1b ink;
   const int block = std::max(15, int(0.03 * std::max(W, H)) | 1);
-  cv::adaptiveThreshold(page, ink, 255, cv::ADAPTIVE_THRESH_MEAN_C, cv::THRESH_BINARY_INV,
-                        block, 12);
+  cv::adaptiveThreshold(page, ink, 255, cv::ADAPTIVE_THRESH_MEAN_C, cv::THRESH_BINARY_INV, block,
+                        12);
   ink &= region;
 
   // 3. Character-sized components only.
@@ -115,8 +116,7 @@ TextOrientation EstimateTextTopSide(const cv::Mat3b& image, const cv::Mat1b& mas
     if (keep[i]) centres.emplace_back(centroids(i, 0), centroids(i, 1));
   std::vector<int> order(centres.size());
   for (size_t i = 0; i < order.size(); ++i) order[i] = int(i);
-  std::sort(order.begin(), order.end(),
-            [&](int a, int b) { return centres[a].x < centres[b].x; });
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return centres[a].x < centres[b].x; });
   int along_x = 0, along_y = 0;
   const double reach = 4 * char_size;
   for (size_t oi = 0; oi < order.size(); ++oi) {
@@ -128,12 +128,17 @@ TextOrientation EstimateTextTopSide(const cv::Mat3b& image, const cv::Mat1b& mas
         const cv::Point2d d = centres[order[oj]] - p;
         if (std::abs(d.x) > reach) break;
         const double d2 = d.dot(d);
-        if (d2 < best && d2 > 0) { best = d2; best_d = d; }
+        if (d2 < best && d2 > 0) {
+          best = d2;
+          best_d = d;
+        }
       }
     if (best_d == cv::Point2d(0, 0)) continue;
     const double ax = std::abs(best_d.x), ay = std::abs(best_d.y);
-    if (ax > 2 * ay) ++along_x;
-    else if (ay > 2 * ax) ++along_y;
+    if (ax > 2 * ay)
+      ++along_x;
+    else if (ay > 2 * ax)
+      ++along_y;
   }
   const bool horizontal = along_x >= along_y;
 
@@ -159,8 +164,10 @@ TextOrientation EstimateTextTopSide(const cv::Mat3b& image, const cv::Mat1b& mas
   }
   // Side i runs from corner i to i+1: 0 is y = 0 of the rectangle, 1 is
   // x = W-1, 2 is y = H-1, 3 is x = 0.
-  if (horizontal) out.top_side = v.up > v.down ? 0 : 2;
-  else out.top_side = v.up > v.down ? 3 : 1;
+  if (horizontal)
+    out.top_side = v.up > v.down ? 0 : 2;
+  else
+    out.top_side = v.up > v.down ? 3 : 1;
   return out;
 }
 

@@ -5,9 +5,8 @@
 #pragma once
 
 #include <array>
-#include <string>
-
 #include <opencv2/core.hpp>
+#include <string>
 
 namespace docunfold::boundary {
 

@@ -8,13 +8,16 @@ namespace docunfold::sfm {
 
 std::string CameraModelName(int model_id) {
   switch (model_id) {
-    case 0: return "SIMPLE_PINHOLE";
-    case 1: return "PINHOLE";
-    case 2: return "SIMPLE_RADIAL";
-    case 3: return "RADIAL";
+    case 0:
+      return "SIMPLE_PINHOLE";
+    case 1:
+      return "PINHOLE";
+    case 2:
+      return "SIMPLE_RADIAL";
+    case 3:
+      return "RADIAL";
   }
-  throw std::invalid_argument("unsupported COLMAP camera model id " +
-                              std::to_string(model_id));
+  throw std::invalid_argument("unsupported COLMAP camera model id " + std::to_string(model_id));
 }
 
 int CameraModelId(const std::string& name) {
@@ -25,10 +28,14 @@ int CameraModelId(const std::string& name) {
 
 int CameraModelNumParams(int model_id) {
   switch (model_id) {
-    case 0: return 3;
-    case 1: return 4;
-    case 2: return 4;
-    case 3: return 5;
+    case 0:
+      return 3;
+    case 1:
+      return 4;
+    case 2:
+      return 4;
+    case 3:
+      return 5;
   }
   return -1;
 }
@@ -99,8 +106,7 @@ class BinaryReader {
   template <typename T>
   T Read() {
     if (pos_ + sizeof(T) > data_.size())
-      throw std::runtime_error(path_.string() + ": truncated at byte " +
-                               std::to_string(pos_));
+      throw std::runtime_error(path_.string() + ": truncated at byte " + std::to_string(pos_));
     T value;
     std::memcpy(&value, data_.data() + pos_, sizeof(T));
     pos_ += sizeof(T);
@@ -113,16 +119,14 @@ class BinaryReader {
   }
   void Skip(size_t bytes) {
     if (pos_ + bytes > data_.size())
-      throw std::runtime_error(path_.string() + ": truncated at byte " +
-                               std::to_string(pos_));
+      throw std::runtime_error(path_.string() + ": truncated at byte " + std::to_string(pos_));
     pos_ += bytes;
   }
   // A count that cannot possibly fit in the remaining data is corruption.
   uint64_t ReadCount(size_t min_bytes_each) {
     const uint64_t n = Read<uint64_t>();
     if (min_bytes_each && n > (data_.size() - pos_) / min_bytes_each)
-      throw std::runtime_error(path_.string() + ": implausible count " +
-                               std::to_string(n));
+      throw std::runtime_error(path_.string() + ": implausible count " + std::to_string(n));
     return n;
   }
   bool AtEnd() const { return pos_ == data_.size(); }
@@ -149,8 +153,7 @@ ColmapModel ReadColmapModel(const fs::path& dir) {
       c.height = int(r.Read<uint64_t>());
       const int np = CameraModelNumParams(c.model_id);
       if (np < 0)
-        throw std::runtime_error(r.path().string() +
-                                 ": unsupported camera model id " +
+        throw std::runtime_error(r.path().string() + ": unsupported camera model id " +
                                  std::to_string(c.model_id));
       for (int k = 0; k < np; ++k) c.params.push_back(r.Read<double>());
       model.cameras[c.id] = c;
@@ -162,8 +165,8 @@ ColmapModel ReadColmapModel(const fs::path& dir) {
     for (uint64_t i = 0; i < n; ++i) {
       ColmapImage im;
       im.id = r.Read<uint32_t>();
-      const double qw = r.Read<double>(), qx = r.Read<double>(),
-                   qy = r.Read<double>(), qz = r.Read<double>();
+      const double qw = r.Read<double>(), qx = r.Read<double>(), qy = r.Read<double>(),
+                   qz = r.Read<double>();
       im.q = Eigen::Quaterniond(qw, qx, qy, qz).normalized();
       for (int k = 0; k < 3; ++k) im.t[k] = r.Read<double>();
       im.camera_id = r.Read<uint32_t>();
@@ -175,8 +178,7 @@ ColmapModel ReadColmapModel(const fs::path& dir) {
       }
       if (!model.cameras.count(im.camera_id))
         throw std::runtime_error(r.path().string() + ": image " + im.name +
-                                 " refers to unknown camera " +
-                                 std::to_string(im.camera_id));
+                                 " refers to unknown camera " + std::to_string(im.camera_id));
       model.images[im.id] = im;
     }
   }
@@ -195,10 +197,8 @@ ColmapModel ReadColmapModel(const fs::path& dir) {
         const uint32_t image_id = r.Read<uint32_t>();
         r.Skip(4);  // point2D_idx
         if (!model.images.count(image_id))
-          throw std::runtime_error(r.path().string() + ": point " +
-                                   std::to_string(p.id) +
-                                   " is seen by unknown image " +
-                                   std::to_string(image_id));
+          throw std::runtime_error(r.path().string() + ": point " + std::to_string(p.id) +
+                                   " is seen by unknown image " + std::to_string(image_id));
         p.image_ids.push_back(image_id);
       }
       model.points.push_back(std::move(p));

@@ -8,15 +8,14 @@
 // OpenCvDistortion() can be used with our K and cv::undistort & co.
 #pragma once
 
+#include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <array>
 #include <cstdint>
 #include <filesystem>
 #include <map>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
-#include <Eigen/Geometry>
 
 namespace docunfold::sfm {
 
@@ -72,8 +71,8 @@ struct ColmapPoint {
   uint64_t id = 0;
   Eigen::Vector3d xyz = Eigen::Vector3d::Zero();
   std::array<uint8_t, 3> rgb{};
-  double error = 0;                   // mean reprojection error, pixels
-  std::vector<uint32_t> image_ids;    // the track (one entry per observation)
+  double error = 0;                 // mean reprojection error, pixels
+  std::vector<uint32_t> image_ids;  // the track (one entry per observation)
 };
 
 struct ColmapModel {

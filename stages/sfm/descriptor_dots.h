@@ -22,7 +22,7 @@ bool HaveDescriptorDotsAvx2();
 // dots[i * stride + j] = a_i . b_j for i < na and j < 8 * blocks (the padded
 // columns get 0): a holds na rows of 128 values in 0..255, b_packed `blocks`
 // blocks as above; stride >= 8 * blocks. Integer sums: exact.
-void DescriptorDotsAvx2(const int16_t* a, int na, const int16_t* b_packed,
-                        int blocks, int32_t* dots, size_t stride);
+void DescriptorDotsAvx2(const int16_t* a, int na, const int16_t* b_packed, int blocks,
+                        int32_t* dots, size_t stride);
 
 }  // namespace docunfold::sfm

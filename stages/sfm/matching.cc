@@ -40,17 +40,15 @@ double Angle(float dot) {
 }
 
 // The one-way matches that pass the distance and ratio tests; -1 elsewhere.
-std::vector<int> OneWay(const std::vector<Nearest>& nearest,
-                        const MatchCriteria& c) {
+std::vector<int> OneWay(const std::vector<Nearest>& nearest, const MatchCriteria& c) {
   std::vector<int> match(nearest.size(), -1);
   for (size_t i = 0; i < nearest.size(); ++i) {
     const Nearest& n = nearest[i];
     if (n.index < 0) continue;
     const double best = Angle(n.best);
     if (best > c.max_distance) continue;
-    const double second = std::isfinite(n.second)
-                              ? Angle(n.second)
-                              : std::numeric_limits<double>::infinity();
+    const double second =
+        std::isfinite(n.second) ? Angle(n.second) : std::numeric_limits<double>::infinity();
     if (best >= c.max_ratio * second) continue;
     match[i] = n.index;
   }
@@ -76,13 +74,10 @@ void NumberImagesByName(const fs::path& database) {
   std::vector<int> old_ids;
   {
     sqlite3_stmt* stmt = nullptr;
-    if (sqlite3_prepare_v2(db.get(),
-                           "SELECT image_id FROM images ORDER BY name", -1,
-                           &stmt, nullptr) != SQLITE_OK)
-      throw std::runtime_error(database.string() + ": " +
-                               sqlite3_errmsg(db.get()));
-    while (sqlite3_step(stmt) == SQLITE_ROW)
-      old_ids.push_back(sqlite3_column_int(stmt, 0));
+    if (sqlite3_prepare_v2(db.get(), "SELECT image_id FROM images ORDER BY name", -1, &stmt,
+                           nullptr) != SQLITE_OK)
+      throw std::runtime_error(database.string() + ": " + sqlite3_errmsg(db.get()));
+    while (sqlite3_step(stmt) == SQLITE_ROW) old_ids.push_back(sqlite3_column_int(stmt, 0));
     sqlite3_finalize(stmt);
   }
   // Moved out of the way first, so that no id is ever taken twice.
@@ -92,23 +87,19 @@ void NumberImagesByName(const fs::path& database) {
     sql += std::string("UPDATE ") + table + " SET image_id = image_id + " +
            std::to_string(kOffset) + ";";
     for (size_t k = 0; k < old_ids.size(); ++k)
-      sql += std::string("UPDATE ") + table +
-             " SET image_id = " + std::to_string(k + 1) +
+      sql += std::string("UPDATE ") + table + " SET image_id = " + std::to_string(k + 1) +
              " WHERE image_id = " + std::to_string(old_ids[k] + kOffset) + ";";
   }
   sql += "COMMIT;";
   char* error = nullptr;
-  if (sqlite3_exec(db.get(), sql.c_str(), nullptr, nullptr, &error) !=
-      SQLITE_OK) {
+  if (sqlite3_exec(db.get(), sql.c_str(), nullptr, nullptr, &error) != SQLITE_OK) {
     const std::string why = error ? error : "failed";
     sqlite3_free(error);
-    throw std::runtime_error(database.string() +
-                             ": renumbering the images: " + why);
+    throw std::runtime_error(database.string() + ": renumbering the images: " + why);
   }
 }
 
-std::vector<ImageDescriptors> ReadDatabaseDescriptors(
-    const fs::path& database) {
+std::vector<ImageDescriptors> ReadDatabaseDescriptors(const fs::path& database) {
   const Database db = OpenDatabase(database, SQLITE_OPEN_READONLY);
   sqlite3_stmt* stmt_raw = nullptr;
   const char* sql =
@@ -117,33 +108,27 @@ std::vector<ImageDescriptors> ReadDatabaseDescriptors(
       "descriptors.data FROM images JOIN descriptors ON images.image_id = "
       "descriptors.image_id ORDER BY images.image_id";
   if (sqlite3_prepare_v2(db.get(), sql, -1, &stmt_raw, nullptr) != SQLITE_OK)
-    throw std::runtime_error(database.string() + ": " +
-                             sqlite3_errmsg(db.get()));
-  const std::unique_ptr<sqlite3_stmt, int (*)(sqlite3_stmt*)> stmt(
-      stmt_raw, sqlite3_finalize);
+    throw std::runtime_error(database.string() + ": " + sqlite3_errmsg(db.get()));
+  const std::unique_ptr<sqlite3_stmt, int (*)(sqlite3_stmt*)> stmt(stmt_raw, sqlite3_finalize);
   std::vector<ImageDescriptors> images;
   int step;
   while ((step = sqlite3_step(stmt.get())) == SQLITE_ROW) {
     ImageDescriptors d;
     d.image_id = sqlite3_column_int(stmt.get(), 0);
     d.name = reinterpret_cast<const char*>(sqlite3_column_text(stmt.get(), 1));
-    const int rows = sqlite3_column_int(stmt.get(), 2),
-              cols = sqlite3_column_int(stmt.get(), 3);
+    const int rows = sqlite3_column_int(stmt.get(), 2), cols = sqlite3_column_int(stmt.get(), 3);
     const int bytes = sqlite3_column_bytes(stmt.get(), 4);
-    const auto* data =
-        static_cast<const uint8_t*>(sqlite3_column_blob(stmt.get(), 4));
+    const auto* data = static_cast<const uint8_t*>(sqlite3_column_blob(stmt.get(), 4));
     if (cols != 128 || rows < 0 || bytes != rows * cols || (rows > 0 && !data))
-      throw std::runtime_error(
-          database.string() + ": descriptors of " + d.name + " are " +
-          std::to_string(rows) + "x" + std::to_string(cols) + " in " +
-          std::to_string(bytes) + " bytes, expected 128 bytes a row");
+      throw std::runtime_error(database.string() + ": descriptors of " + d.name + " are " +
+                               std::to_string(rows) + "x" + std::to_string(cols) + " in " +
+                               std::to_string(bytes) + " bytes, expected 128 bytes a row");
     d.rows.resize(rows, 128);
     for (int i = 0; i < rows * 128; ++i) d.rows.data()[i] = float(data[i]);
     images.push_back(std::move(d));
   }
   if (step != SQLITE_DONE)
-    throw std::runtime_error(database.string() + ": " +
-                             sqlite3_errmsg(db.get()));
+    throw std::runtime_error(database.string() + ": " + sqlite3_errmsg(db.get()));
   return images;
 }
 
@@ -164,9 +149,9 @@ bool HaveDescriptorDotsAvx2() {
 
 const char* AutoDotKernelName() { return HaveDescriptorDotsAvx2() ? "avx2" : "portable"; }
 
-std::vector<std::pair<int, int>> MatchDescriptors(
-    const ImageDescriptors& a, const ImageDescriptors& b,
-    const MatchCriteria& criteria, DotKernel kernel) {
+std::vector<std::pair<int, int>> MatchDescriptors(const ImageDescriptors& a,
+                                                  const ImageDescriptors& b,
+                                                  const MatchCriteria& criteria, DotKernel kernel) {
   const int na = int(a.rows.rows()), nb = int(b.rows.rows());
   std::vector<Nearest> a_to_b(na), b_to_a(nb);
   // Each dot product is a sum of 128 products of integers below 256: exact
@@ -214,8 +199,7 @@ std::vector<std::pair<int, int>> MatchDescriptors(
     }
   }
   const std::vector<int> ab = OneWay(a_to_b, criteria);
-  const std::vector<int> ba =
-      criteria.cross_check ? OneWay(b_to_a, criteria) : std::vector<int>();
+  const std::vector<int> ba = criteria.cross_check ? OneWay(b_to_a, criteria) : std::vector<int>();
   std::vector<std::pair<int, int>> matches;
   for (int i = 0; i < na; ++i) {
     if (ab[i] < 0) continue;
@@ -226,8 +210,8 @@ std::vector<std::pair<int, int>> MatchDescriptors(
 }
 
 std::vector<std::vector<std::pair<int, int>>> MatchAllPairs(
-    const std::vector<ImageDescriptors>& images, const MatchCriteria& criteria,
-    int threads, const std::function<void(int done)>& on_pair) {
+    const std::vector<ImageDescriptors>& images, const MatchCriteria& criteria, int threads,
+    const std::function<void(int done)>& on_pair) {
   std::vector<std::pair<size_t, size_t>> pairs;
   for (size_t a = 0; a < images.size(); ++a)
     for (size_t b = a + 1; b < images.size(); ++b) pairs.emplace_back(a, b);
@@ -241,8 +225,7 @@ std::vector<std::vector<std::pair<int, int>>> MatchAllPairs(
   auto work = [&] {
     try {
       for (size_t k; (k = next++) < pairs.size();) {
-        matches[k] = MatchDescriptors(images[pairs[k].first],
-                                      images[pairs[k].second], criteria);
+        matches[k] = MatchDescriptors(images[pairs[k].first], images[pairs[k].second], criteria);
         const std::lock_guard<std::mutex> lock(report);
         if (on_pair) on_pair(++done);
       }

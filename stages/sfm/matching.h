@@ -54,9 +54,10 @@ enum class DotKernel {
 
 // Index pairs (row of a, row of b) that pass `criteria`, in order of a's
 // rows. Distances are the angles between descriptors, as COLMAP's.
-std::vector<std::pair<int, int>> MatchDescriptors(
-    const ImageDescriptors& a, const ImageDescriptors& b,
-    const MatchCriteria& criteria, DotKernel kernel = DotKernel::kAuto);
+std::vector<std::pair<int, int>> MatchDescriptors(const ImageDescriptors& a,
+                                                  const ImageDescriptors& b,
+                                                  const MatchCriteria& criteria,
+                                                  DotKernel kernel = DotKernel::kAuto);
 
 // The kernel kAuto takes on this machine: "avx2" or "portable".
 const char* AutoDotKernelName();
@@ -65,7 +66,7 @@ const char* AutoDotKernelName();
 // (0,1), (0,2), ..., (1,2), ... Pairs run on `threads` threads (< 1: every
 // core); `on_pair` is called, one call at a time, after each.
 std::vector<std::vector<std::pair<int, int>>> MatchAllPairs(
-    const std::vector<ImageDescriptors>& images, const MatchCriteria& criteria,
-    int threads, const std::function<void(int done)>& on_pair = nullptr);
+    const std::vector<ImageDescriptors>& images, const MatchCriteria& criteria, int threads,
+    const std::function<void(int done)>& on_pair = nullptr);
 
 }  // namespace docunfold::sfm

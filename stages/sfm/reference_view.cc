@@ -1,13 +1,12 @@
 #include "stages/sfm/reference_view.h"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <map>
-#include <random>
-
-#include <Eigen/Eigenvalues>
 #include <nanoflann.hpp>
 #include <opencv2/imgproc.hpp>
+#include <random>
 
 namespace docunfold::sfm {
 namespace {
@@ -17,12 +16,14 @@ struct PointCloudAdaptor {
   size_t kdtree_get_point_count() const { return pts.size(); }
   double kdtree_get_pt(size_t i, size_t dim) const { return pts[i][int(dim)]; }
   template <class Box>
-  bool kdtree_get_bbox(Box&) const { return false; }
+  bool kdtree_get_bbox(Box&) const {
+    return false;
+  }
 };
 
-using KdTree = nanoflann::KDTreeSingleIndexAdaptor<
-    nanoflann::L2_Simple_Adaptor<double, PointCloudAdaptor>, PointCloudAdaptor,
-    3, size_t>;
+using KdTree =
+    nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, PointCloudAdaptor>,
+                                        PointCloudAdaptor, 3, size_t>;
 
 // The weighted q-quantile of (value, weight) pairs; 0 when empty.
 double WeightedQuantile(std::vector<std::pair<double, double>> v, double q) {
@@ -40,9 +41,8 @@ double WeightedQuantile(std::vector<std::pair<double, double>> v, double q) {
 
 }  // namespace
 
-std::vector<Eigen::Vector3d> EstimateNormals(
-    const std::vector<Eigen::Vector3d>& points, int neighbours,
-    std::vector<double>* spacing2) {
+std::vector<Eigen::Vector3d> EstimateNormals(const std::vector<Eigen::Vector3d>& points,
+                                             int neighbours, std::vector<double>* spacing2) {
   std::vector<Eigen::Vector3d> normals(points.size(), Eigen::Vector3d::UnitZ());
   if (spacing2) spacing2->assign(points.size(), 1.0);
   if (points.size() < 3) return normals;
@@ -139,8 +139,7 @@ std::vector<cv::Point2f> Hull(const std::vector<Eigen::Vector3d>& points, const 
 }
 
 // The plane with the most points within `tolerance` (RANSAC, fixed seed).
-std::vector<size_t> DominantPlane(const std::vector<Eigen::Vector3d>& points,
-                                  double tolerance) {
+std::vector<size_t> DominantPlane(const std::vector<Eigen::Vector3d>& points, double tolerance) {
   std::vector<size_t> best;
   if (points.size() < 3) return best;
   std::mt19937 rng(12345);
@@ -255,8 +254,7 @@ std::vector<bool> PagePoints(const ColmapModel& model,
   return page;
 }
 
-double ReferenceScore(const ViewScore& s, double max_resolution,
-                      const ReferenceOptions& options) {
+double ReferenceScore(const ViewScore& s, double max_resolution, const ReferenceOptions& options) {
   return std::pow(s.coverage, 4) * s.resolution / max_resolution * s.frontality *
          std::max(0.0, 1.0 - options.hidden_penalty * s.hidden);
 }
@@ -315,8 +313,7 @@ std::vector<ViewScore> ScoreReferenceViews(const ColmapModel& model,
     const std::vector<size_t> none;
     const std::vector<size_t>& mine = it == seen.end() ? none : it->second;
     s.points_seen = int(mine.size());
-    const double margin =
-        options.margin_fraction * std::min(camera.width, camera.height);
+    const double margin = options.margin_fraction * std::min(camera.width, camera.height);
     int inside = 0;
     double hidden_area = 0, total_area = 0;
     std::vector<std::pair<double, double>> cosines;     // (|cos|, pixels)
@@ -325,8 +322,7 @@ std::vector<ViewScore> ScoreReferenceViews(const ColmapModel& model,
       total_area += area[i];
       const Eigen::Vector3d xc = R * xyz[i] + image.t;
       const Eigen::Vector2d px = xc.z() > 0 ? camera.Project(xc) : Eigen::Vector2d(-1, -1);
-      if (px.x() < 0 || px.y() < 0 || px.x() > camera.width - 1 ||
-          px.y() > camera.height - 1) {
+      if (px.x() < 0 || px.y() < 0 || px.x() > camera.width - 1 || px.y() > camera.height - 1) {
         resolution.push_back({0, area[i]});  // not in the picture at all
         continue;
       }
@@ -339,8 +335,7 @@ std::vector<ViewScore> ScoreReferenceViews(const ColmapModel& model,
       const double weight = area[i] * c / (xc.z() * xc.z());
       cosines.push_back({c, weight});
       s.page_pixels += weight * camera.MeanFocal() * camera.MeanFocal();
-      if (px.x() >= margin && px.y() >= margin &&
-          px.x() <= camera.width - 1 - margin &&
+      if (px.x() >= margin && px.y() >= margin && px.x() <= camera.width - 1 - margin &&
           px.y() <= camera.height - 1 - margin)
         ++inside;
     }
@@ -352,11 +347,10 @@ std::vector<ViewScore> ScoreReferenceViews(const ColmapModel& model,
     scores.push_back(s);
   }
   for (ViewScore& s : scores) s.score = ReferenceScore(s, max_resolution, options);
-  std::stable_sort(scores.begin(), scores.end(),
-                   [](const ViewScore& a, const ViewScore& b) {
-                     if (a.score != b.score) return a.score > b.score;
-                     return a.image < b.image;
-                   });
+  std::stable_sort(scores.begin(), scores.end(), [](const ViewScore& a, const ViewScore& b) {
+    if (a.score != b.score) return a.score > b.score;
+    return a.image < b.image;
+  });
   return scores;
 }
 

@@ -2,12 +2,11 @@
 // whole page inside the picture and resolves its worst-seen part best.
 #pragma once
 
+#include <Eigen/Core>
 #include <map>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
-#include <opencv2/core.hpp>
 
 #include "stages/sfm/colmap_model.h"
 
@@ -16,7 +15,7 @@ namespace docunfold::sfm {
 struct ViewScore {
   std::string image;
   uint32_t image_id = 0;
-  int points_seen = 0;     // 3D points this view observes
+  int points_seen = 0;  // 3D points this view observes
   // |cos| of the angle between the viewing ray and the local surface normal
   // of the point cloud (1 = head-on): the median over the page's points in
   // the image, weighted by the area each point stands for as the view sees
@@ -37,12 +36,12 @@ struct ViewScore {
   // Fraction of the page's area this view sees from behind (a curled corner
   // turned away from it).
   double hidden = 0;
-  double score = 0;        // see ScoreReferenceViews
+  double score = 0;  // see ScoreReferenceViews
 };
 
 struct ReferenceOptions {
-  int normal_neighbours = 12;    // points in each local plane fit
-  double margin_fraction = 0.02; // of the image's short side
+  int normal_neighbours = 12;        // points in each local plane fit
+  double margin_fraction = 0.02;     // of the image's short side
   double resolution_quantile = 0.1;  // of ViewScore::resolution
   // Each unit of ViewScore::hidden costs this much of the score (1 % hidden
   // = 10 % off). A part seen from behind cannot be textured from the view,
@@ -87,9 +86,9 @@ double ReferenceScore(const ViewScore& view, double max_resolution,
 // has no point there (set08 view_03: its score came within 3 % of view_00's,
 // above it in 6 of 13 sfm runs, and init-mesh's M was then 0.5-1.4 % of the
 // diagonal off the truth on the band).
-std::vector<ViewScore> ScoreReferenceViews(
-    const ColmapModel& model, const std::map<std::string, cv::Mat1b>& masks = {},
-    const ReferenceOptions& options = {});
+std::vector<ViewScore> ScoreReferenceViews(const ColmapModel& model,
+                                           const std::map<std::string, cv::Mat1b>& masks = {},
+                                           const ReferenceOptions& options = {});
 
 // A rough mask of the page in a photo: paper is light and colourless
 // (Lab lightness minus twice the chroma, Otsu threshold, the convex hull of
@@ -100,8 +99,8 @@ cv::Mat1b RoughPageMask(const cv::Mat& bgr);
 // Unit normals of the point cloud by a plane fit through each point's
 // nearest neighbours (sign arbitrary), and optionally the squared distance
 // to the farthest of them (the area a point stands for). For tests too.
-std::vector<Eigen::Vector3d> EstimateNormals(
-    const std::vector<Eigen::Vector3d>& points, int neighbours,
-    std::vector<double>* spacing2 = nullptr);
+std::vector<Eigen::Vector3d> EstimateNormals(const std::vector<Eigen::Vector3d>& points,
+                                             int neighbours,
+                                             std::vector<double>* spacing2 = nullptr);
 
 }  // namespace docunfold::sfm

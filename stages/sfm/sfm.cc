@@ -7,15 +7,14 @@
 #include <cmath>
 #include <fstream>
 #include <iomanip>
-#include <random>
-#include <regex>
-#include <set>
-#include <sstream>
-
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <random>
+#include <regex>
+#include <set>
+#include <sstream>
 
 #include "common/atomic_file.h"
 #include "common/cli.h"
@@ -70,8 +69,7 @@ std::string Fixed(double v, int digits) {
 
 std::string JoinNames(const std::vector<std::string>& names, size_t max = 8) {
   std::string s;
-  for (size_t i = 0; i < names.size() && i < max; ++i)
-    s += (i ? ", " : "") + names[i];
+  for (size_t i = 0; i < names.size() && i < max; ++i) s += (i ? ", " : "") + names[i];
   if (names.size() > max) s += ", ...";
   return s;
 }
@@ -81,12 +79,11 @@ std::string JoinNames(const std::vector<std::string>& names, size_t max = 8) {
 class StagingDir {
  public:
   explicit StagingDir(const fs::path& target) : target_(target) {
-    const fs::path parent =
-        target.has_parent_path() ? target.parent_path() : fs::path(".");
+    const fs::path parent = target.has_parent_path() ? target.parent_path() : fs::path(".");
     EnsureDirectory(parent);
     std::random_device rd;
-    path_ = parent / ("." + target.filename().string() + ".tmp-" +
-                      std::to_string(::getpid()) + "-" + std::to_string(rd() % 100000));
+    path_ = parent / ("." + target.filename().string() + ".tmp-" + std::to_string(::getpid()) +
+                      "-" + std::to_string(rd() % 100000));
     std::error_code ec;
     fs::remove_all(path_, ec);
     fs::create_directories(path_, ec);
@@ -109,15 +106,13 @@ class StagingDir {
       fs::remove_all(old, ec);
       fs::rename(target_, old, ec);
       if (ec)
-        throw OutputError(target_.string() + ": cannot move the old output aside: " +
-                          ec.message());
+        throw OutputError(target_.string() + ": cannot move the old output aside: " + ec.message());
     }
     fs::rename(path_, target_, ec);
     if (ec) {
       std::error_code ignored;
       if (!old.empty()) fs::rename(old, target_, ignored);
-      throw OutputError(target_.string() + ": cannot rename into place: " +
-                        ec.message());
+      throw OutputError(target_.string() + ": cannot rename into place: " + ec.message());
     }
     committed_ = true;
     if (!old.empty()) fs::remove_all(old, ec);
@@ -168,11 +163,10 @@ struct Colmap {
     SubprocessResult r = RunSubprocess(args, sub);
     if (r.not_found) throw std::runtime_error(NotFoundMessage(exe.string()));
     if (throw_on_failure && (r.timed_out || r.exit_code != 0)) {
-      std::string why = r.timed_out
-                            ? "stopped after " + Fixed(options->timeout_seconds, 0) +
-                                  " s (--timeout)"
-                            : r.signal ? "killed by signal " + std::to_string(r.signal)
-                                       : "exit code " + std::to_string(r.exit_code);
+      std::string why =
+          r.timed_out ? "stopped after " + Fixed(options->timeout_seconds, 0) + " s (--timeout)"
+          : r.signal  ? "killed by signal " + std::to_string(r.signal)
+                      : "exit code " + std::to_string(r.exit_code);
       throw std::runtime_error("COLMAP " + command + " failed (" + why + ")" +
                                (last.empty() ? "" : ": " + last) +
                                "; run with --verbose to see its output");
@@ -243,24 +237,22 @@ std::vector<std::string> CheckImages(const fs::path& data_dir, int* width, int* 
   const DataSet set = OpenDataSet(data_dir);
   const fs::path images_dir = data_dir / "images";
   if (set.images.size() < 2)
-    throw InputError(images_dir.string() + ": " + std::to_string(set.images.size()) +
-                     " photo" + (set.images.size() == 1 ? "" : "s") +
+    throw InputError(images_dir.string() + ": " + std::to_string(set.images.size()) + " photo" +
+                     (set.images.size() == 1 ? "" : "s") +
                      " (jpg, png or tif); sfm needs at least 2 views of the page");
   std::vector<std::string> names;
   Progress progress("checking images", long(set.images.size()));
   for (size_t i = 0; i < set.images.size(); ++i) {
     const fs::path& path = set.images[i];
     const cv::Mat image = ReadPhoto(path);
-    if (image.empty())
-      throw InputError(path.string() + ": cannot be decoded as an image");
+    if (image.empty()) throw InputError(path.string() + ": cannot be decoded as an image");
     if (i == 0) {
       *width = image.cols;
       *height = image.rows;
     } else if (image.cols != *width || image.rows != *height) {
       throw InputError(path.string() + ": " + std::to_string(image.cols) + "x" +
-                       std::to_string(image.rows) + ", but " +
-                       set.images[0].filename().string() + " is " +
-                       std::to_string(*width) + "x" + std::to_string(*height) +
+                       std::to_string(image.rows) + ", but " + set.images[0].filename().string() +
+                       " is " + std::to_string(*width) + "x" + std::to_string(*height) +
                        "; all photos must come from one camera at one size");
     }
     names.push_back(path.filename().string());
@@ -275,8 +267,8 @@ std::vector<std::string> CheckImages(const fs::path& data_dir, int* width, int* 
   return names;
 }
 
-double ToReferenceFrame(const ColmapModel& model, const std::string& reference,
-                        CameraSet* cameras, std::vector<Eigen::Vector3d>* points) {
+double ToReferenceFrame(const ColmapModel& model, const std::string& reference, CameraSet* cameras,
+                        std::vector<Eigen::Vector3d>* points) {
   const ColmapImage* ref = nullptr;
   for (const auto& [id, im] : model.images)
     if (im.name == reference) ref = &im;
@@ -292,8 +284,8 @@ double ToReferenceFrame(const ColmapModel& model, const std::string& reference,
   std::nth_element(depths.begin(), depths.begin() + depths.size() / 2, depths.end());
   const double divisor = depths[depths.size() / 2];
   if (!(divisor > 0))
-    throw std::runtime_error("the points seen by " + reference +
-                             " lie behind it (median depth " + std::to_string(divisor) + ")");
+    throw std::runtime_error("the points seen by " + reference + " lie behind it (median depth " +
+                             std::to_string(divisor) + ")");
 
   cameras->reference = reference;
   cameras->views.clear();
@@ -318,8 +310,7 @@ double ToReferenceFrame(const ColmapModel& model, const std::string& reference,
             [](const PinholeCamera& a, const PinholeCamera& b) { return a.image < b.image; });
   points->clear();
   points->reserve(model.points.size());
-  for (const ColmapPoint& p : model.points)
-    points->push_back((R_ref * p.xyz + t_ref) / divisor);
+  for (const ColmapPoint& p : model.points) points->push_back((R_ref * p.xyz + t_ref) / divisor);
   return divisor;
 }
 
@@ -348,15 +339,15 @@ Json CamerasJson(const SfmResult& r, const SfmOptions& options) {
   doc["frame"] =
       "camera frame of the reference view (x right, y down, z forward), scaled so "
       "that the median depth of the points it sees is 1; x_cam = R x_world + t";
-  const bool distorted = std::any_of(r.distortion.begin(), r.distortion.end(),
-                                     [](double d) { return d != 0; });
+  const bool distorted =
+      std::any_of(r.distortion.begin(), r.distortion.end(), [](double d) { return d != 0; });
   doc["views"] = Json::array();
   for (const PinholeCamera& c : r.cameras.views) {
     Json v = CameraToJson(c);
     if (distorted && c.image != r.reference)
-      v["distortion"] = {{"model", "opencv"},
-                         {"coefficients", {r.distortion[0], r.distortion[1],
-                                           r.distortion[2], r.distortion[3]}}};
+      v["distortion"] = {
+          {"model", "opencv"},
+          {"coefficients", {r.distortion[0], r.distortion[1], r.distortion[2], r.distortion[3]}}};
     doc["views"].push_back(v);
   }
   doc["reference_undistorted"] = distorted;
@@ -370,9 +361,8 @@ Json CamerasJson(const SfmResult& r, const SfmOptions& options) {
                       {"resolution", s.resolution},
                       {"hidden", s.hidden},
                       {"points_seen", s.points_seen}});
-  doc["reference_selection"] = {{"method", r.reference_choice},
-                                {"page_points", r.page_points},
-                                {"views", scores}};
+  doc["reference_selection"] = {
+      {"method", r.reference_choice}, {"page_points", r.page_points}, {"views", scores}};
   Json attempts = Json::array();
   for (const MapperAttempt& a : r.attempts)
     attempts.push_back({{"setting", a.description},
@@ -416,11 +406,10 @@ SfmResult RunSfm(const SfmOptions& o) {
   result.images = CheckImages(o.data_dir, &width, &height, &thumbnails);
   result.seconds_reading = SecondsSince(start);
   if (!o.reference.empty() &&
-      std::find(result.images.begin(), result.images.end(), o.reference) ==
-          result.images.end())
+      std::find(result.images.begin(), result.images.end(), o.reference) == result.images.end())
     throw InputError("--ref " + o.reference + ": no such photo in " +
-                     (o.data_dir / "images").string() + " (there are " +
-                     JoinNames(result.images) + ")");
+                     (o.data_dir / "images").string() + " (there are " + JoinNames(result.images) +
+                     ")");
   CheckOutputDir(o.out_dir);
 
   Colmap colmap;
@@ -442,8 +431,7 @@ SfmResult RunSfm(const SfmOptions& o) {
   const int long_side = std::max(width, height);
   // Keypoints come back at full resolution: a pixel at matching resolution
   // is this many photo pixels.
-  const double matching_scale =
-      double(long_side) / std::min(long_side, o.max_image_size);
+  const double matching_scale = double(long_side) / std::min(long_side, o.max_image_size);
   const int n = int(result.images.size());
 
   // 1. Features.
@@ -454,11 +442,10 @@ SfmResult RunSfm(const SfmOptions& o) {
     colmap.Run("feature_extractor",
                {"--database_path", database.string(), "--image_path", image_dir.string(),
                 "--image_list_path", (colmap.dir / "image_list.txt").string(),
-                "--ImageReader.single_camera", "1", "--ImageReader.camera_model",
-                o.camera_model, "--SiftExtraction.use_gpu", "0",
-                "--SiftExtraction.max_image_size", std::to_string(o.max_image_size),
-                "--SiftExtraction.max_num_features", std::to_string(o.max_num_features),
-                "--SiftExtraction.num_threads", threads},
+                "--ImageReader.single_camera", "1", "--ImageReader.camera_model", o.camera_model,
+                "--SiftExtraction.use_gpu", "0", "--SiftExtraction.max_image_size",
+                std::to_string(o.max_image_size), "--SiftExtraction.max_num_features",
+                std::to_string(o.max_num_features), "--SiftExtraction.num_threads", threads},
                "feature_extractor.log", [&](const std::string& line) {
                  std::smatch m;
                  if (std::regex_search(line, m, processed)) progress.Update(std::stol(m[1]));
@@ -472,10 +459,9 @@ SfmResult RunSfm(const SfmOptions& o) {
     const auto t0 = std::chrono::steady_clock::now();
     const int pairs = n * (n - 1) / 2;
     // matches_importer's list names a pair by its two names split at a space.
-    const bool spaced_names =
-        std::any_of(result.images.begin(), result.images.end(), [](const std::string& name) {
-          return name.find_first_of(" \t") != std::string::npos;
-        });
+    const bool spaced_names = std::any_of(
+        result.images.begin(), result.images.end(),
+        [](const std::string& name) { return name.find_first_of(" \t") != std::string::npos; });
     const bool exact = o.matcher == "exact" && !spaced_names;
     if (o.matcher == "exact" && spaced_names)
       Log("an image name has a space, which COLMAP's match list cannot carry: COLMAP's "
@@ -501,11 +487,10 @@ SfmResult RunSfm(const SfmOptions& o) {
       list.close();
       if (!list) throw OutputError(list_file.string() + ": write failed");
       progress.Done();
-      Log("matching features: " + std::to_string(total) +
-          " matches before geometric verification");
+      Log("matching features: " + std::to_string(total) + " matches before geometric verification");
       colmap.Run("matches_importer",
-                 {"--database_path", database.string(), "--match_list_path",
-                  list_file.string(), "--match_type", "raw", "--SiftMatching.use_gpu", "0",
+                 {"--database_path", database.string(), "--match_list_path", list_file.string(),
+                  "--match_type", "raw", "--SiftMatching.use_gpu", "0",
                   "--SiftMatching.num_threads", threads},
                  "matches_importer.log", nullptr);
     } else {
@@ -535,11 +520,11 @@ SfmResult RunSfm(const SfmOptions& o) {
   for (size_t a = 0; a < settings.size(); ++a) {
     const Setting& s = settings[a];
     MapperAttempt attempt;
-    attempt.description = o.camera_model +
-                          (model_id >= 2 ? (s.refine ? ", distortion refined"
-                                                     : ", distortion fixed at 0")
-                                         : std::string()) +
-                          ", filter " + Fixed(s.filter, 1) + " px";
+    attempt.description =
+        o.camera_model +
+        (model_id >= 2 ? (s.refine ? ", distortion refined" : ", distortion fixed at 0")
+                       : std::string()) +
+        ", filter " + Fixed(s.filter, 1) + " px";
     const fs::path dir = attempts_dir / std::to_string(a);
     EnsureDirectory(dir);
     Log("mapping (" + attempt.description + ")");
@@ -548,11 +533,11 @@ SfmResult RunSfm(const SfmOptions& o) {
     auto last_log = std::chrono::steady_clock::now();
     const SubprocessResult run = colmap.Run(
         "mapper",
-        {"--database_path", database.string(), "--image_path", image_dir.string(),
-         "--output_path", dir.string(), "--Mapper.num_threads", threads,
-         "--Mapper.ba_refine_extra_params", s.refine ? "1" : "0",
-         "--Mapper.filter_max_reproj_error", Fixed(s.filter * matching_scale, 3),
-         "--Mapper.tri_ignore_two_view_tracks", o.two_view_tracks ? "0" : "1"},
+        {"--database_path", database.string(), "--image_path", image_dir.string(), "--output_path",
+         dir.string(), "--Mapper.num_threads", threads, "--Mapper.ba_refine_extra_params",
+         s.refine ? "1" : "0", "--Mapper.filter_max_reproj_error",
+         Fixed(s.filter * matching_scale, 3), "--Mapper.tri_ignore_two_view_tracks",
+         o.two_view_tracks ? "0" : "1"},
         "mapper.log",
         [&](const std::string& line) {
           std::smatch m;
@@ -579,28 +564,26 @@ SfmResult RunSfm(const SfmOptions& o) {
       const double factor = attempt.focal / long_side;
       std::vector<std::string> problems;
       if (attempt.registered < n)
-        problems.push_back(std::to_string(n - attempt.registered) + " of " +
-                           std::to_string(n) + " views not registered");
+        problems.push_back(std::to_string(n - attempt.registered) + " of " + std::to_string(n) +
+                           " views not registered");
       if (factor < o.min_focal_factor || factor > o.max_focal_factor)
         problems.push_back("implausible focal length " + Fixed(attempt.focal, 0) + " px");
       if (attempt.points < o.min_points)
         problems.push_back("only " + std::to_string(attempt.points) + " points");
       attempt.plausible = problems.empty();
-      for (size_t i = 0; i < problems.size(); ++i)
-        attempt.problem += (i ? "; " : "") + problems[i];
+      for (size_t i = 0; i < problems.size(); ++i) attempt.problem += (i ? "; " : "") + problems[i];
     } else {
       attempt.problem = run.timed_out ? "stopped after the time limit"
                                       : "no model (no initial pair of views found)";
     }
     Log("mapping (" + attempt.description + "): " +
         (attempt.produced_model
-             ? std::to_string(attempt.registered) + "/" + std::to_string(n) +
-                   " views, " + std::to_string(attempt.points) + " points, focal " +
-                   Fixed(attempt.focal, 1) + " px, reprojection error " +
-                   Fixed(attempt.mean_reprojection_error, 2) + " px"
+             ? std::to_string(attempt.registered) + "/" + std::to_string(n) + " views, " +
+                   std::to_string(attempt.points) + " points, focal " + Fixed(attempt.focal, 1) +
+                   " px, reprojection error " + Fixed(attempt.mean_reprojection_error, 2) + " px"
              : std::string("failed")) +
-        (attempt.plausible ? "" : " (" + attempt.problem + ")") + ", " +
-        Fixed(run.seconds, 1) + " s");
+        (attempt.plausible ? "" : " (" + attempt.problem + ")") + ", " + Fixed(run.seconds, 1) +
+        " s");
     result.attempts.push_back(attempt);
     if (attempt.produced_model && (best < 0 || Better(attempt, result.attempts[best]))) {
       best = int(a);
@@ -625,23 +608,21 @@ SfmResult RunSfm(const SfmOptions& o) {
     fs::remove_all(attempts_dir, ec);
   }
   if (model.images.size() < 2)
-    throw InputError("only " + std::to_string(model.images.size()) + " of " +
-                     std::to_string(n) + " views registered; sfm needs at least 2");
+    throw InputError("only " + std::to_string(model.images.size()) + " of " + std::to_string(n) +
+                     " views registered; sfm needs at least 2");
 
   std::set<std::string> registered;
   for (const auto& [id, im] : model.images) registered.insert(im.name);
   for (const std::string& name : result.images)
     if (!registered.count(name)) result.unregistered.push_back(name);
   if (!result.unregistered.empty())
-    Log("warning: " + std::to_string(result.unregistered.size()) +
-        " views not registered (" + JoinNames(result.unregistered) + "); going on with " +
-        std::to_string(model.images.size()));
+    Log("warning: " + std::to_string(result.unregistered.size()) + " views not registered (" +
+        JoinNames(result.unregistered) + "); going on with " + std::to_string(model.images.size()));
 
   // 4. Reference view.
   std::map<std::string, cv::Mat1b> masks;
   for (size_t i = 0; i < result.images.size(); ++i)
-    if (registered.count(result.images[i]))
-      masks[result.images[i]] = RoughPageMask(thumbnails[i]);
+    if (registered.count(result.images[i])) masks[result.images[i]] = RoughPageMask(thumbnails[i]);
   result.view_scores = ScoreReferenceViews(model, masks, o.reference_options);
   {
     const std::vector<bool> page = PagePoints(model, masks);
@@ -664,8 +645,7 @@ SfmResult RunSfm(const SfmOptions& o) {
                      "): the photos share too little texture");
 
   // 5. The reference frame.
-  result.scale_divisor =
-      ToReferenceFrame(model, result.reference, &result.cameras, &result.points);
+  result.scale_divisor = ToReferenceFrame(model, result.reference, &result.cameras, &result.points);
   const ColmapCamera& camera = model.cameras.begin()->second;
   result.camera_model = CameraModelName(camera.model_id);
   result.colmap_params = camera.params;
@@ -685,29 +665,25 @@ SfmResult RunSfm(const SfmOptions& o) {
     if (image.cols != camera.width || image.rows != camera.height)
       throw std::runtime_error(photo.string() + ": " + std::to_string(image.cols) + "x" +
                                std::to_string(image.rows) + " but COLMAP's camera is " +
-                               std::to_string(camera.width) + "x" +
-                               std::to_string(camera.height));
+                               std::to_string(camera.width) + "x" + std::to_string(camera.height));
     image = UndistortPhoto(image, camera);
-    WriteImageAtomic(staging.path() / "reference.png", image,
-                     {cv::IMWRITE_PNG_COMPRESSION, 1});
+    WriteImageAtomic(staging.path() / "reference.png", image, {cv::IMWRITE_PNG_COMPRESSION, 1});
   }
   {
     PlyData ply;
     ply.vertices = result.points;
     ply.colors = result.colors;
     ply.SetProperty("track_length",
-                    std::vector<double>(result.track_lengths.begin(),
-                                        result.track_lengths.end()),
+                    std::vector<double>(result.track_lengths.begin(), result.track_lengths.end()),
                     PlyScalar::kUint32);
     ply.SetProperty("reprojection_error", result.reprojection_errors);
-    ply.comments = {
-        "docunfold sfm: sparse point cloud of the page (and what else COLMAP matched)",
-        "frame: camera of the reference view " + result.reference +
-            " (x right, y down, z forward), scaled so the median depth of the points "
-            "it sees is 1",
-        "track_length: number of views observing the point; reprojection_error: "
-        "COLMAP's mean over the track, pixels of the photos",
-        "camera model " + result.camera_model + "; cameras in cameras.json"};
+    ply.comments = {"docunfold sfm: sparse point cloud of the page (and what else COLMAP matched)",
+                    "frame: camera of the reference view " + result.reference +
+                        " (x right, y down, z forward), scaled so the median depth of the points "
+                        "it sees is 1",
+                    "track_length: number of views observing the point; reprojection_error: "
+                    "COLMAP's mean over the track, pixels of the photos",
+                    "camera model " + result.camera_model + "; cameras in cameras.json"};
     WritePly(staging.path() / "points.ply", ply);
   }
   result.seconds_total = SecondsSince(start);

@@ -1,7 +1,7 @@
 // sfm: cameras and a sparse point cloud from the photos of a data set, by
 // COLMAP's command-line tools (CPU SIFT, every pair matched exactly by
-// matching.h and verified by COLMAP, incremental mapper), expressed in the frame of an automatically chosen reference view
-// (DESIGN §4-5).
+// matching.h and verified by COLMAP, incremental mapper), expressed in the frame of an
+// automatically chosen reference view (DESIGN §4-5).
 //
 // Writes into options.out_dir (all or nothing: everything is made in a
 // temporary directory beside it and renamed into place at the end):
@@ -17,12 +17,11 @@
 //                  *.log (everything COLMAP printed)
 #pragma once
 
+#include <Eigen/Core>
 #include <filesystem>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
-#include <opencv2/core.hpp>
 
 #include "common/camera.h"
 #include "common/json_io.h"
@@ -33,9 +32,9 @@ namespace docunfold::sfm {
 namespace fs = std::filesystem;
 
 struct SfmOptions {
-  fs::path data_dir;        // data set folder (with images/)
-  fs::path out_dir;         // e.g. work/set01/10_sfm
-  std::string reference;    // image name forcing the reference view ("" = auto)
+  fs::path data_dir;      // data set folder (with images/)
+  fs::path out_dir;       // e.g. work/set01/10_sfm
+  std::string reference;  // image name forcing the reference view ("" = auto)
 
   // Long side (pixels) of the copies SIFT runs on; keypoints are scaled back
   // to full resolution by COLMAP. 1600 keeps the 1600x1200 sets at full
@@ -73,11 +72,11 @@ struct SfmOptions {
   // exhaustive_matcher, whose FLANN search differs a little from run to run.
   std::string matcher = "exact";
 
-  int min_points = 100;     // fewer 3D points: bad input (exit 3)
-  int threads = -1;         // COLMAP threads; -1 = all cores
-  double timeout_seconds = 900;  // per COLMAP command
+  int min_points = 100;           // fewer 3D points: bad input (exit 3)
+  int threads = -1;               // COLMAP threads; -1 = all cores
+  double timeout_seconds = 900;   // per COLMAP command
   std::string colmap = "colmap";  // COLMAP executable (name in PATH or path)
-  bool verbose = false;     // echo COLMAP's output lines on stderr
+  bool verbose = false;           // echo COLMAP's output lines on stderr
 
   ReferenceOptions reference_options;
 
@@ -87,30 +86,30 @@ struct SfmOptions {
 
 // One run of COLMAP's mapper.
 struct MapperAttempt {
-  std::string description;      // e.g. "SIMPLE_RADIAL, distortion refined, filter 1 px"
+  std::string description;  // e.g. "SIMPLE_RADIAL, distortion refined, filter 1 px"
   bool produced_model = false;
   int registered = 0;
   int points = 0;
   double mean_reprojection_error = 0;
-  double focal = 0;             // pixels
-  std::vector<double> params;   // COLMAP's camera parameters
+  double focal = 0;            // pixels
+  std::vector<double> params;  // COLMAP's camera parameters
   bool plausible = false;
-  std::string problem;          // why not plausible
+  std::string problem;  // why not plausible
   double seconds = 0;
 };
 
 struct SfmResult {
-  std::string reference;               // image name
-  std::string reference_choice;        // "auto" or "--ref"
-  CameraSet cameras;                   // every registered view, reference frame
+  std::string reference;         // image name
+  std::string reference_choice;  // "auto" or "--ref"
+  CameraSet cameras;             // every registered view, reference frame
   // Distortion (OpenCV k1, k2, p1, p2 on normalized coordinates) of the
   // photos; all zero for pinhole models. reference.png is undistorted.
   std::array<double, 4> distortion{};
-  std::string camera_model;            // COLMAP model name
-  std::vector<double> colmap_params;   // COLMAP's camera parameters
-  std::vector<std::string> images;     // every image of the data set
+  std::string camera_model;           // COLMAP model name
+  std::vector<double> colmap_params;  // COLMAP's camera parameters
+  std::vector<std::string> images;    // every image of the data set
   std::vector<std::string> unregistered;
-  std::vector<Eigen::Vector3d> points; // reference frame
+  std::vector<Eigen::Vector3d> points;  // reference frame
   std::vector<std::array<uint8_t, 3>> colors;
   std::vector<int> track_lengths;
   std::vector<double> reprojection_errors;  // pixels, full resolution
@@ -121,8 +120,8 @@ struct SfmResult {
   std::vector<ViewScore> view_scores;  // best first
   int page_points = 0;                 // points the scores were computed on
   std::vector<MapperAttempt> attempts;
-  double seconds_reading = 0, seconds_extracting = 0, seconds_matching = 0,
-         seconds_mapping = 0, seconds_total = 0;
+  double seconds_reading = 0, seconds_extracting = 0, seconds_matching = 0, seconds_mapping = 0,
+         seconds_total = 0;
 };
 
 // Runs the whole stage and writes the outputs. Throws InputError (bad data
@@ -136,16 +135,15 @@ SfmResult RunSfm(const SfmOptions& options);
 // have the same size (one shared camera). Returns the image names, sorted,
 // and, when `thumbnails` is given, each photo scaled to a long side of at
 // most 640 px. Throws InputError naming the folder or file.
-std::vector<std::string> CheckImages(const fs::path& data_dir, int* width,
-                                     int* height,
+std::vector<std::string> CheckImages(const fs::path& data_dir, int* width, int* height,
                                      std::vector<cv::Mat>* thumbnails = nullptr);
 
 // The cameras and points of `model` in the frame of `reference`: rotation
 // and translation of the reference camera removed, scaled so that the median
 // depth of the points the reference sees is 1. K is COLMAP's pinhole part in
 // our pixel convention. Returns the divisor used.
-double ToReferenceFrame(const ColmapModel& model, const std::string& reference,
-                        CameraSet* cameras, std::vector<Eigen::Vector3d>* points);
+double ToReferenceFrame(const ColmapModel& model, const std::string& reference, CameraSet* cameras,
+                        std::vector<Eigen::Vector3d>* points);
 
 // The photo as the pinhole camera PinholeK() would have taken it (same size,
 // same K); a copy when the camera has no distortion.

@@ -23,8 +23,7 @@ fs::path FindExecutable(const std::string& program) {
   if (program.empty()) return {};
   auto executable = [](const fs::path& p) {
     struct stat st;
-    return ::stat(p.c_str(), &st) == 0 && S_ISREG(st.st_mode) &&
-           ::access(p.c_str(), X_OK) == 0;
+    return ::stat(p.c_str(), &st) == 0 && S_ISREG(st.st_mode) && ::access(p.c_str(), X_OK) == 0;
   };
   if (program.find('/') != std::string::npos)
     return executable(program) ? fs::path(program) : fs::path();
@@ -43,8 +42,7 @@ SubprocessResult RunSubprocess(const std::vector<std::string>& argv,
   SubprocessResult result;
   const auto start = std::chrono::steady_clock::now();
   std::ofstream log(options.log_file, std::ios::app);
-  if (!log)
-    throw OutputError(options.log_file.string() + ": cannot write log file");
+  if (!log) throw OutputError(options.log_file.string() + ": cannot write log file");
   const fs::path exe = FindExecutable(argv.at(0));
   if (exe.empty()) {
     result.not_found = true;
@@ -55,8 +53,7 @@ SubprocessResult RunSubprocess(const std::vector<std::string>& argv,
   log << "\n" << std::flush;
 
   int fds[2];
-  if (::pipe(fds) != 0)
-    throw std::runtime_error(std::string("pipe: ") + std::strerror(errno));
+  if (::pipe(fds) != 0) throw std::runtime_error(std::string("pipe: ") + std::strerror(errno));
   const pid_t pid = ::fork();
   if (pid < 0) {
     ::close(fds[0]);
@@ -87,8 +84,7 @@ SubprocessResult RunSubprocess(const std::vector<std::string>& argv,
   std::string pending;
   auto flush_lines = [&](bool all) {
     size_t begin = 0;
-    for (size_t nl; (nl = pending.find('\n', begin)) != std::string::npos;
-         begin = nl + 1) {
+    for (size_t nl; (nl = pending.find('\n', begin)) != std::string::npos; begin = nl + 1) {
       std::string line = pending.substr(begin, nl - begin);
       if (!line.empty() && line.back() == '\r') line.pop_back();
       if (options.on_line) options.on_line(line);
@@ -106,8 +102,7 @@ SubprocessResult RunSubprocess(const std::vector<std::string>& argv,
     if (options.timeout_seconds > 0) {
       const double left =
           options.timeout_seconds -
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
-              .count();
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       if (left <= 0) {
         result.timed_out = true;
         ::kill(-pid, SIGKILL);
@@ -143,9 +138,7 @@ SubprocessResult RunSubprocess(const std::vector<std::string>& argv,
     // execv failed in the child (e.g. permissions changed under us).
     result.not_found = true;
   }
-  result.seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
-          .count();
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   log << "# exit " << result.exit_code;
   if (result.signal) log << " (signal " << result.signal << ")";
   if (result.timed_out) log << " (killed after the time limit)";

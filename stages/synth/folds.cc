@@ -13,8 +13,8 @@ Eigen::Vector2d Perp(const Eigen::Vector2d& d) { return {-d.y(), d.x()}; }
 
 // The part of line (p, d) inside the rectangle [0, W] x [0, H], as the
 // parameter interval of p + s d; empty (lo > hi) when it misses.
-std::pair<double, double> ClipToSheet(const Eigen::Vector2d& p, const Eigen::Vector2d& d,
-                                      double W, double H) {
+std::pair<double, double> ClipToSheet(const Eigen::Vector2d& p, const Eigen::Vector2d& d, double W,
+                                      double H) {
   double lo = -1e9, hi = 1e9;
   for (int k = 0; k < 2; ++k) {
     const double extent = k == 0 ? W : H;
@@ -45,8 +45,8 @@ double SegmentDistance(const Eigen::Vector2d& a0, const Eigen::Vector2d& a1,
   const double d1 = cross(a1 - a0, b0 - a0), d2 = cross(a1 - a0, b1 - a0);
   const double d3 = cross(b1 - b0, a0 - b0), d4 = cross(b1 - b0, a1 - b0);
   if (d1 * d2 < 0 && d3 * d4 < 0) return 0;
-  return std::min({point_seg(a0, b0, b1), point_seg(a1, b0, b1), point_seg(b0, a0, a1),
-                   point_seg(b1, a0, a1)});
+  return std::min(
+      {point_seg(a0, b0, b1), point_seg(a1, b0, b1), point_seg(b0, a0, a1), point_seg(b1, a0, a1)});
 }
 
 }  // namespace
@@ -85,7 +85,8 @@ FoldedSheet::FoldedSheet(double width_m, double height_m, std::vector<Fold> fold
     // Rotation about t that takes n to n cos a + ez sin a.
     const double psi = (f.angle >= 0 ? a : -a) * (t.cross(n).z() >= 0 ? 1.0 : -1.0);
     const Eigen::Vector3d c0 = o + n * (f.width / 2);
-    const Eigen::Vector3d c1 = o - n * (f.width / 2) + n * r * std::sin(a) + ez * r * (1 - std::cos(a));
+    const Eigen::Vector3d c1 =
+        o - n * (f.width / 2) + n * r * std::sin(a) + ez * r * (1 - std::cos(a));
     Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
     T.linear() = Eigen::AngleAxisd(psi, t).toRotationMatrix();
     T.translation() = c1 - T.linear() * c0;
@@ -125,8 +126,7 @@ Eigen::Vector3d FoldedSheet::Map(const Eigen::Vector2d& uv) const {
   return x;
 }
 
-std::vector<Fold> RandomFolds(double W, double H, const FoldOptions& options,
-                              std::mt19937* rng) {
+std::vector<Fold> RandomFolds(double W, double H, const FoldOptions& options, std::mt19937* rng) {
   std::uniform_real_distribution<double> uni(0, 1);
   auto range = [&](double lo, double hi) { return lo + (hi - lo) * uni(*rng); };
   const Eigen::Vector2d centre(W / 2, H / 2);
@@ -152,8 +152,8 @@ std::vector<Fold> RandomFolds(double W, double H, const FoldOptions& options,
       for (const Eigen::Vector2d& c : {Eigen::Vector2d(0, 0), Eigen::Vector2d(W, 0),
                                        Eigen::Vector2d(0, H), Eigen::Vector2d(W, H)})
         extent = std::max(extent, std::abs(n.dot(c - centre)));
-      const double offset = (uni(*rng) < 0.5 ? -1 : 1) *
-                            (is_curl ? range(0.45, 0.7) : range(0.1, 0.6)) * extent;
+      const double offset =
+          (uni(*rng) < 0.5 ? -1 : 1) * (is_curl ? range(0.45, 0.7) : range(0.1, 0.6)) * extent;
       f.point = centre + n * offset;
       f.width = is_curl ? range(options.curl_width_min, options.curl_width_max)
                         : range(options.crease_width_min, options.crease_width_max);
@@ -164,7 +164,10 @@ std::vector<Fold> RandomFolds(double W, double H, const FoldOptions& options,
       // centre (the root panel) off its strip, and keep its strip clear of
       // every other fold's.
       auto [lo, hi] = ClipToSheet(f.point, f.direction, W, H);
-      if (hi - lo < 0.3 * std::min(W, H)) { ok = false; break; }
+      if (hi - lo < 0.3 * std::min(W, H)) {
+        ok = false;
+        break;
+      }
       const Eigen::Vector2d a = f.point + lo * f.direction, b = f.point + hi * f.direction;
       for (const Eigen::Vector2d& c : {Eigen::Vector2d(0, 0), Eigen::Vector2d(W, 0),
                                        Eigen::Vector2d(0, H), Eigen::Vector2d(W, H)})

@@ -3,11 +3,10 @@
 // crease, a wide one a curl.
 #pragma once
 
-#include <random>
-#include <vector>
-
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <random>
+#include <vector>
 
 namespace docunfold::synth {
 
@@ -36,20 +35,20 @@ class FoldedSheet {
   double Side(int i, const Eigen::Vector2d& uv) const;
 
   double width_, height_;
-  std::vector<Fold> folds_;      // normals oriented away from the root
+  std::vector<Fold> folds_;  // normals oriented away from the root
   std::vector<Eigen::Vector2d> normals_;
-  std::vector<int> order_;       // folds sorted from the root outwards
+  std::vector<int> order_;                   // folds sorted from the root outwards
   std::vector<Eigen::Isometry3d> far_side_;  // rigid motion of the far side
 };
 
 struct FoldOptions {
-  int creases = 1;              // number of narrow folds
+  int creases = 1;                                            // number of narrow folds
   double crease_width_min = 0.003, crease_width_max = 0.008;  // metres
   double crease_angle_min = 30, crease_angle_max = 120;       // degrees
-  bool curl = false;            // one extra wide bend
+  bool curl = false;                                          // one extra wide bend
   double curl_width_min = 0.04, curl_width_max = 0.09;        // metres
   double curl_angle_min = 30, curl_angle_max = 70;            // degrees
-  double max_total_angle = 125; // |sum of signed angles| on any path, degrees
+  double max_total_angle = 125;  // |sum of signed angles| on any path, degrees
 };
 
 // Random non-crossing folds for a sheet; deterministic for the generator's

@@ -5,10 +5,9 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <sstream>
-
 #include <opencv2/freetype.hpp>
 #include <opencv2/imgproc.hpp>
+#include <sstream>
 
 #include "common/errors.h"
 
@@ -50,8 +49,8 @@ const std::map<std::string, std::vector<std::string>> kFonts = {
 
 // Running text: paragraphs of the licence texts every Debian system has.
 std::vector<std::string> Paragraphs(std::mt19937* rng) {
-  const std::vector<std::string> files = {"GPL-3", "Apache-2.0", "MPL-2.0", "GFDL-1.3",
-                                          "LGPL-2.1", "Artistic"};
+  const std::vector<std::string> files = {"GPL-3",    "Apache-2.0", "MPL-2.0",
+                                          "GFDL-1.3", "LGPL-2.1",   "Artistic"};
   std::vector<std::string> available;
   for (const std::string& f : files)
     if (fs::exists("/usr/share/common-licenses/" + f)) available.push_back(f);
@@ -132,12 +131,12 @@ class Typesetter {
   // Draws `text` with its baseline starting at (u, v); records it as a text
   // line of the page (one line of text.txt unless `same_line`), and its
   // baseline as a true straight line.
-  void Text(const std::string& style, double size_pt, const std::string& text, double u,
-            double v, const cv::Scalar& colour, bool same_line = false) {
+  void Text(const std::string& style, double size_pt, const std::string& text, double u, double v,
+            const cv::Scalar& colour, bool same_line = false) {
     if (text.find_first_not_of(' ') == std::string::npos) return;
     const int h = std::max(1, Px(size_pt * kMetresPerPoint));
-    Font(style)->putText(page_->image, text, cv::Point(Px(u), Px(v)), h, colour, -1,
-                         cv::LINE_AA, true);
+    Font(style)->putText(page_->image, text, cv::Point(Px(u), Px(v)), h, colour, -1, cv::LINE_AA,
+                         true);
     const double w = Width(style, size_pt, text);
     // The baseline runs under the inked characters, not the leading spaces.
     const size_t first = text.find_first_not_of(' ');
@@ -218,8 +217,7 @@ void DrawTextPage(Typesetter& ts, Page& page, std::mt19937* rng) {
     if (v > page.height_m - margin - 0.01) break;
   }
   const std::string number = "- " + std::to_string(1 + (*rng)() % 40) + " -";
-  ts.Text("serif", size * 0.9, number,
-          page.width_m / 2 - ts.Width("serif", size * 0.9, number) / 2,
+  ts.Text("serif", size * 0.9, number, page.width_m / 2 - ts.Width("serif", size * 0.9, number) / 2,
           page.height_m - margin * 0.55, ink);
 }
 
@@ -232,18 +230,18 @@ void DrawTablePage(Typesetter& ts, Page& page, std::mt19937* rng) {
   double v = margin + 0.012;
   ts.Text("sans-bold", size * 1.8, "ACCOUNT STATEMENT", margin, v, ink);
   v += line_h * 2;
-  const std::vector<std::string> names = {"Alex Morgan", "Sam Taylor", "Jordan Lee",
+  const std::vector<std::string> names = {"Alex Morgan", "Sam Taylor",   "Jordan Lee",
                                           "Casey Brown", "Robin Clarke", "Maria Rossi"};
-  const std::vector<std::string> streets = {"Mill Lane", "Harbour Road", "Station Street",
+  const std::vector<std::string> streets = {"Mill Lane",   "Harbour Road", "Station Street",
                                             "Church Walk", "Kings Avenue", "Elm Grove"};
   ts.Text("sans", size, Pick(names, rng), margin, v, ink);
   v += line_h;
   ts.Text("sans", size, std::to_string(3 + (*rng)() % 90) + " " + Pick(streets, rng), margin, v,
           ink);
   v += line_h;
-  ts.Text("sans", size, "Account " + std::to_string(10000000 + (*rng)() % 89999999) +
-                            "   Sort code 20-" + std::to_string(10 + (*rng)() % 89) + "-" +
-                            std::to_string(10 + (*rng)() % 89),
+  ts.Text("sans", size,
+          "Account " + std::to_string(10000000 + (*rng)() % 89999999) + "   Sort code 20-" +
+              std::to_string(10 + (*rng)() % 89) + "-" + std::to_string(10 + (*rng)() % 89),
           margin, v, ink);
   v += line_h * 1.8;
 
@@ -261,13 +259,12 @@ void DrawTablePage(Typesetter& ts, Page& page, std::mt19937* rng) {
   const double top = v;
   ts.Fill(margin, top, right, top + row_h, cv::Scalar(222, 222, 222));
   for (size_t c = 0; c < headers.size(); ++c)
-    ts.Text("sans-bold", size, headers[c], col_u[c] + 0.0015, top + row_h * 0.72, ink,
-            c > 0);
-  const std::vector<std::string> what = {"Card payment", "Direct debit", "Transfer to",
+    ts.Text("sans-bold", size, headers[c], col_u[c] + 0.0015, top + row_h * 0.72, ink, c > 0);
+  const std::vector<std::string> what = {"Card payment", "Direct debit",   "Transfer to",
                                          "Cash machine", "Standing order", "Interest",
-                                         "Salary", "Refund from"};
-  const std::vector<std::string> who = {"GROCER", "RAILWAYS", "ENERGY CO", "BOOKSHOP",
-                                        "PHARMACY", "CAFE", "COUNCIL TAX", "GARAGE"};
+                                         "Salary",       "Refund from"};
+  const std::vector<std::string> who = {"GROCER",   "RAILWAYS", "ENERGY CO",   "BOOKSHOP",
+                                        "PHARMACY", "CAFE",     "COUNCIL TAX", "GARAGE"};
   const int rows = int(std::floor((page.height_m - margin - 0.05 - (top + row_h)) / row_h));
   double balance = Uniform(rng, 200, 3000);
   int day = 1 + (*rng)() % 5;
@@ -322,15 +319,16 @@ void DrawReceipt(Typesetter& ts, Page& page, std::mt19937* rng) {
   ts.Text("mono-bold", size * 1.3, shop,
           (page.width_m - ts.Width("mono-bold", size * 1.3, shop)) / 2, v, ink);
   v += line_h * 1.4;
-  ts.Text("mono", size, "Store " + std::to_string(1 + (*rng)() % 99) + "  Till " +
-                            std::to_string(1 + (*rng)() % 9),
-          margin, v, ink);
+  ts.Text(
+      "mono", size,
+      "Store " + std::to_string(1 + (*rng)() % 99) + "  Till " + std::to_string(1 + (*rng)() % 9),
+      margin, v, ink);
   v += line_h;
   ts.Text("mono", size, std::string(columns, '-'), margin, v, ink);
   v += line_h;
-  const std::vector<std::string> items = {"Bread", "Milk 1L", "Apples", "Cheese", "Coffee",
+  const std::vector<std::string> items = {"Bread", "Milk 1L",  "Apples",   "Cheese", "Coffee",
                                           "Pasta", "Tomatoes", "Rice 2kg", "Butter", "Soap",
-                                          "Tea", "Eggs x6", "Onions", "Yoghurt"};
+                                          "Tea",   "Eggs x6",  "Onions",   "Yoghurt"};
   double total = 0;
   while (v < page.height_m - margin - line_h * 5) {
     const std::string item = Pick(items, rng);
@@ -382,12 +380,12 @@ void DrawPoster(Typesetter& ts, Page& page, std::mt19937* rng) {
     ts.Rule(right, bottom, margin, bottom, thickness, ink);
     ts.Rule(margin, bottom, margin, top, thickness, ink);
     double tv = top + 0.011;
-    ts.Text("sans-bold", size * 1.25, std::to_string(9 + b * 2) + ":00  Session " +
-                                          std::to_string(b + 1),
-            margin + 0.006, tv, ink);
+    ts.Text("sans-bold", size * 1.25,
+            std::to_string(9 + b * 2) + ":00  Session " + std::to_string(b + 1), margin + 0.006, tv,
+            ink);
     tv += line_h * 1.5;
-    for (const std::string& line : ts.Wrap("sans", size, paragraphs[b % paragraphs.size()],
-                                           right - margin - 0.012)) {
+    for (const std::string& line :
+         ts.Wrap("sans", size, paragraphs[b % paragraphs.size()], right - margin - 0.012)) {
       if (tv > bottom - 0.006) break;
       ts.Text("sans", size, line, margin + 0.006, tv, ink);
       tv += line_h;
@@ -408,10 +406,14 @@ PageKind ParsePageKind(const std::string& name) {
 
 std::string PageKindName(PageKind kind) {
   switch (kind) {
-    case PageKind::kText: return "text";
-    case PageKind::kTable: return "table";
-    case PageKind::kReceipt: return "receipt";
-    case PageKind::kPoster: return "poster";
+    case PageKind::kText:
+      return "text";
+    case PageKind::kTable:
+      return "table";
+    case PageKind::kReceipt:
+      return "receipt";
+    case PageKind::kPoster:
+      return "poster";
   }
   return "text";
 }
@@ -431,10 +433,18 @@ Page MakePage(PageKind kind, cv::Size2d size_m, double dpi, std::mt19937* rng) {
                        cv::Scalar(paper - Uniform(rng, 0, 8), paper - Uniform(rng, 0, 3), paper));
   Typesetter ts(&page, rng);
   switch (kind) {
-    case PageKind::kText: DrawTextPage(ts, page, rng); break;
-    case PageKind::kTable: DrawTablePage(ts, page, rng); break;
-    case PageKind::kReceipt: DrawReceipt(ts, page, rng); break;
-    case PageKind::kPoster: DrawPoster(ts, page, rng); break;
+    case PageKind::kText:
+      DrawTextPage(ts, page, rng);
+      break;
+    case PageKind::kTable:
+      DrawTablePage(ts, page, rng);
+      break;
+    case PageKind::kReceipt:
+      DrawReceipt(ts, page, rng);
+      break;
+    case PageKind::kPoster:
+      DrawPoster(ts, page, rng);
+      break;
   }
   const double W = page.width_m, H = page.height_m;
   page.lines.push_back({"border", {{0, 0}, {W, 0}}});

@@ -2,12 +2,11 @@
 // true straight lines (text baselines, table rules, page edges).
 #pragma once
 
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
 #include <random>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
-#include <opencv2/core.hpp>
 
 namespace docunfold::synth {
 
@@ -23,7 +22,7 @@ struct PageLine {
 
 struct Page {
   double width_m = 0.21, height_m = 0.297;
-  cv::Mat image;                  // 8-bit BGR, `pixels_per_m` resolution
+  cv::Mat image;  // 8-bit BGR, `pixels_per_m` resolution
   double pixels_per_m = 0;
   std::vector<std::string> text;  // one entry per text line, reading order
   std::vector<PageLine> lines;

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-
 #include <opencv2/imgproc.hpp>
 
 #include "common/errors.h"
@@ -66,10 +65,15 @@ Extent Measure(const PageSurface& page, const PinholeCamera& cam) {
   const double mx = 0.03 * cam.width, my = 0.03 * cam.height;
   for (const Eigen::Vector3d& v : page.vertices) {
     const Eigen::Vector3d xc = cam.CamFromWorld(v);
-    if (xc.z() <= 0) { margin_ok = false; continue; }
+    if (xc.z() <= 0) {
+      margin_ok = false;
+      continue;
+    }
     const Eigen::Vector2d p = cam.ProjectCam(xc);
-    x0 = std::min(x0, p.x()); x1 = std::max(x1, p.x());
-    y0 = std::min(y0, p.y()); y1 = std::max(y1, p.y());
+    x0 = std::min(x0, p.x());
+    x1 = std::max(x1, p.x());
+    y0 = std::min(y0, p.y());
+    y1 = std::max(y1, p.y());
     if (p.x() >= 0 && p.y() >= 0 && p.x() <= cam.width - 1 && p.y() <= cam.height - 1) ++inside;
     if (p.x() < mx || p.y() < my || p.x() > cam.width - 1 - mx || p.y() > cam.height - 1 - my)
       margin_ok = false;
@@ -90,10 +94,14 @@ Background ParseBackground(const std::string& name) {
 
 std::string BackgroundName(Background b) {
   switch (b) {
-    case Background::kPlain: return "plain";
-    case Background::kWood: return "wood";
-    case Background::kCloth: return "cloth";
-    case Background::kGranite: return "granite";
+    case Background::kPlain:
+      return "plain";
+    case Background::kWood:
+      return "wood";
+    case Background::kCloth:
+      return "cloth";
+    case Background::kGranite:
+      return "granite";
   }
   return "plain";
 }
@@ -106,7 +114,10 @@ std::vector<PinholeCamera> MakeCameras(const PageSurface& page, const CameraOpti
   K << f, 0, (options.width - 1) / 2.0, 0, f, (options.height - 1) / 2.0, 0, 0, 1;
 
   Eigen::Vector3d lo = page.vertices[0], hi = lo;
-  for (const auto& v : page.vertices) { lo = lo.cwiseMin(v); hi = hi.cwiseMax(v); }
+  for (const auto& v : page.vertices) {
+    lo = lo.cwiseMin(v);
+    hi = hi.cwiseMax(v);
+  }
   const Eigen::Vector3d centre = (lo + hi) / 2;
   const double diag = (hi - lo).head<2>().norm();
   // For a cut-off page every view aims beyond one side of the page.
@@ -133,8 +144,8 @@ std::vector<PinholeCamera> MakeCameras(const PageSurface& page, const CameraOpti
     double distance = diag / (2 * std::tan(hfov / 2) * fill);
     PinholeCamera cam;
     for (int it = 0; it < 6; ++it) {
-      cam = LookAt(target + distance * dir, target, up_hint, roll, K, options.width,
-                   options.height);
+      cam =
+          LookAt(target + distance * dir, target, up_hint, roll, K, options.width, options.height);
       distance *= Measure(page, cam).ratio / fill;
     }
     cam = LookAt(target + distance * dir, target, up_hint, roll, K, options.width, options.height);
@@ -144,8 +155,8 @@ std::vector<PinholeCamera> MakeCameras(const PageSurface& page, const CameraOpti
                                       : e.all_inside_margin;
       if (ok) break;
       distance *= (options.cut_off && e.inside_fraction >= 0.93) ? 0.96 : 1.05;
-      cam = LookAt(target + distance * dir, target, up_hint, roll, K, options.width,
-                   options.height);
+      cam =
+          LookAt(target + distance * dir, target, up_hint, roll, K, options.width, options.height);
     }
     cam.image = "view_" + std::string(i < 10 ? "0" : "") + std::to_string(i) + ".jpg";
     cameras.push_back(cam);
@@ -208,7 +219,8 @@ Table MakeTable(Background background, std::mt19937* rng) {
       const double weave = Uniform(rng, 0.8, 1.6);  // pixels = millimetres here
       for (int y = 0; y < n; ++y)
         for (int x = 0; x < n; ++x) {
-          const float w = float(0.06 * std::sin(2 * kPi * x / weave) * std::sin(2 * kPi * y / weave));
+          const float w =
+              float(0.06 * std::sin(2 * kPi * x / weave) * std::sin(2 * kPi * y / weave));
           img(y, x) = base * (1 + w + 0.07f * low(y, x)) + cv::Vec3f::all(6 * fine(y, x));
         }
       break;
@@ -219,8 +231,8 @@ Table MakeTable(Background background, std::mt19937* rng) {
       cv::GaussianBlur(speckle, speckle, cv::Size(0, 0), 1.2);
       for (int y = 0; y < n; ++y)
         for (int x = 0; x < n; ++x)
-          img(y, x) = cv::Vec3f::all(v * (1 + 0.05f * low(y, x)) + 90 * speckle(y, x)) +
-                      cv::Vec3f(0, 2, 6);
+          img(y, x) =
+              cv::Vec3f::all(v * (1 + 0.05f * low(y, x)) + 90 * speckle(y, x)) + cv::Vec3f(0, 2, 6);
       break;
     }
   }

@@ -3,12 +3,11 @@
 // noise and JPEG compression.
 #pragma once
 
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
 #include <random>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
-#include <opencv2/core.hpp>
 
 #include "common/camera.h"
 #include "common/raster.h"
@@ -31,8 +30,8 @@ std::string BackgroundName(Background b);
 
 struct CameraOptions {
   int views = 5;
-  int width = 1600, height = 1200;   // pixels
-  double hfov_min_deg = 65, hfov_max_deg = 75;        // one phone camera for all views
+  int width = 1600, height = 1200;              // pixels
+  double hfov_min_deg = 65, hfov_max_deg = 75;  // one phone camera for all views
   double elevation_min_deg = 55, elevation_max_deg = 88;
   double fill_min = 0.6, fill_max = 0.82;  // page extent / image extent
   // Frame every view so that part of the page is outside the image.
@@ -48,7 +47,7 @@ struct RenderOptions {
   Background background = Background::kPlain;
   double noise_sigma = 2.0;  // grey levels, Gaussian, per channel
   int jpeg_quality = 90;
-  double blur_sigma = 0.6;   // pixels, lens softness
+  double blur_sigma = 0.6;  // pixels, lens softness
 };
 
 struct Lighting {

@@ -1,9 +1,9 @@
 #include "stages/synth/synth.h"
 
-#include <chrono>
-#include <cmath>
 #include <unistd.h>
 
+#include <chrono>
+#include <cmath>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -42,7 +42,8 @@ PageSurface PlaceOnTable(const FoldedSheet& sheet, double spacing, std::mt19937*
       Eigen::Quaterniond::FromTwoVectors(mean_normal.normalized(), Eigen::Vector3d::UnitZ())
           .toRotationMatrix();
   const double yaw = std::uniform_real_distribution<double>(0, 2 * 3.14159265358979)(*rng);
-  const Eigen::Matrix3d R = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix() * up;
+  const Eigen::Matrix3d R =
+      Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix() * up;
   Eigen::Vector3d lo(1e9, 1e9, 1e9), hi(-1e9, -1e9, -1e9);
   for (Eigen::Vector3d& v : s.vertices) {
     v = R * v;
@@ -114,8 +115,8 @@ SynthResult Run(const SynthOptions& o) {
 
   // Everything goes to a temporary folder first, renamed at the end.
   const fs::path out = fs::absolute(o.out);
-  const fs::path tmp = out.parent_path() / ("." + out.filename().string() + ".tmp." +
-                                            std::to_string(::getpid()));
+  const fs::path tmp =
+      out.parent_path() / ("." + out.filename().string() + ".tmp." + std::to_string(::getpid()));
   struct Cleanup {
     fs::path dir;
     ~Cleanup() {
@@ -168,7 +169,10 @@ SynthResult Run(const SynthOptions& o) {
                    "made by docunfold synth seed " + std::to_string(o.seed)};
   mesh.vertices = surface.vertices;
   std::vector<double> s, t;
-  for (const auto& st : surface.st) { s.push_back(st.x()); t.push_back(st.y()); }
+  for (const auto& st : surface.st) {
+    s.push_back(st.x());
+    t.push_back(st.y());
+  }
   mesh.SetProperty("s", s);
   mesh.SetProperty("t", t);
   mesh.faces = surface.quads;
@@ -201,7 +205,8 @@ SynthResult Run(const SynthOptions& o) {
 
   if (fs::exists(out, ec)) fs::remove_all(out, ec);
   fs::rename(tmp, out, ec);
-  if (ec) throw OutputError(out.string() + ": cannot move the data set into place: " + ec.message());
+  if (ec)
+    throw OutputError(out.string() + ": cannot move the data set into place: " + ec.message());
   cleanup.dir.clear();
 
   SynthResult r;

@@ -16,19 +16,19 @@ namespace docunfold::synth {
 namespace fs = std::filesystem;
 
 struct SynthOptions {
-  fs::path out;                  // data-set folder to create
-  bool force = false;            // replace an existing folder
-  uint32_t seed = 1;             // everything random derives from it
+  fs::path out;        // data-set folder to create
+  bool force = false;  // replace an existing folder
+  uint32_t seed = 1;   // everything random derives from it
   PageKind kind = PageKind::kText;
-  double page_width_m = 0;       // 0: the kind's default (A4; 80 x 200 mm receipt)
+  double page_width_m = 0;  // 0: the kind's default (A4; 80 x 200 mm receipt)
   double page_height_m = 0;
-  FoldOptions folds;             // creases, curl, widths and angles
-  CameraOptions cameras;         // views, image size, field of view, elevation, cut-off
-  RenderOptions render;          // background, noise, JPEG quality
-  double flat_dpi = 150;         // resolution of ground_truth/flat.png
-  double texture_dpi = 300;      // resolution the page is printed at for rendering
-  double mesh_spacing_m = 0.002; // vertex spacing of ground_truth/mesh.ply
-  std::string command_line;      // recorded in COMMAND beside the data
+  FoldOptions folds;              // creases, curl, widths and angles
+  CameraOptions cameras;          // views, image size, field of view, elevation, cut-off
+  RenderOptions render;           // background, noise, JPEG quality
+  double flat_dpi = 150;          // resolution of ground_truth/flat.png
+  double texture_dpi = 300;       // resolution the page is printed at for rendering
+  double mesh_spacing_m = 0.002;  // vertex spacing of ground_truth/mesh.ply
+  std::string command_line;       // recorded in COMMAND beside the data
 };
 
 struct SynthResult {

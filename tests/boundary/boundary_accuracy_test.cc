@@ -3,10 +3,10 @@
 // the sides (a real side lies on the true page edge; a page cut by the image
 // border has its cut sides marked not real), in every view and in crops of
 // the most frontal view that cut the page off.
+#include <gtest/gtest.h>
+
 #include <cstdio>
 #include <cstdlib>
-
-#include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -56,8 +56,10 @@ void ExpectGood(const ViewFigures& v, const std::string& what, bool check_corner
   EXPECT_TRUE(f.SidesHold()) << what << ": a real side leaves the true page edge ("
                              << f.real_off_edge_px << " px, max " << f.real_off_edge_max_px
                              << ") or misses it (covers " << f.edge_recall << ")";
-  if (f.page_cut) EXPECT_GE(f.sides_not_real, 1) << what << ": cut page, no cut side";
-  else EXPECT_EQ(f.sides_not_real, 0) << what << ": whole page, side marked cut";
+  if (f.page_cut)
+    EXPECT_GE(f.sides_not_real, 1) << what << ": cut page, no cut side";
+  else
+    EXPECT_EQ(f.sides_not_real, 0) << what << ": whole page, side marked cut";
   if (v.orientation_method == "text") {
     EXPECT_TRUE(f.corners_in_order) << what << ": orientation read from the text is wrong";
   }
@@ -83,13 +85,13 @@ void MaybeWriteDebug(const GroundTruth& gt, const PinholeCamera& cam, const cv::
 
 void Print(const std::string& what, const ViewFigures& v) {
   const BoundaryFigures& f = v.f;
-  std::printf("%-36s IoU %.4f  corner%s %5.2f px (%.2f%% diag)  real-off-edge %5.2f (max %5.2f) px  "
-              "edge-recall %.3f  not real %d%s  top %s (%d votes, %.2f) %s\n",
-              what.c_str(), f.iou, f.corner_hidden ? "(hidden)" : "", f.worst_corner_px,
-              100 * f.WorstCornerFraction(), f.real_off_edge_px, f.real_off_edge_max_px,
-              f.edge_recall, f.sides_not_real, f.page_cut ? " (cut)" : "",
-              v.orientation_method.c_str(), v.votes, v.confidence,
-              f.corners_in_order ? "ok" : "differs");
+  std::printf(
+      "%-36s IoU %.4f  corner%s %5.2f px (%.2f%% diag)  real-off-edge %5.2f (max %5.2f) px  "
+      "edge-recall %.3f  not real %d%s  top %s (%d votes, %.2f) %s\n",
+      what.c_str(), f.iou, f.corner_hidden ? "(hidden)" : "", f.worst_corner_px,
+      100 * f.WorstCornerFraction(), f.real_off_edge_px, f.real_off_edge_max_px, f.edge_recall,
+      f.sides_not_real, f.page_cut ? " (cut)" : "", v.orientation_method.c_str(), v.votes,
+      v.confidence, f.corners_in_order ? "ok" : "differs");
 }
 
 class BoundaryOnDataSet : public ::testing::TestWithParam<fs::path> {};
@@ -109,8 +111,8 @@ TEST_P(BoundaryOnDataSet, EveryViewMatchesTheTruth) {
     ASSERT_FALSE(image.empty()) << cam.image;
     const BoundaryResult r = boundary::SegmentBoundary(image, {});
     const ViewFigures f = Measure(*gt, cam, r);
-    const std::string what = DataSetName(GetParam()) + "/" + cam.image +
-                             (int(v) == frontal ? " (frontal)" : "");
+    const std::string what =
+        DataSetName(GetParam()) + "/" + cam.image + (int(v) == frontal ? " (frontal)" : "");
     Print(what, f);
     MaybeWriteDebug(*gt, cam, image, r, what);
     if (int(v) == frontal) ExpectGood(f, what);
@@ -119,10 +121,11 @@ TEST_P(BoundaryOnDataSet, EveryViewMatchesTheTruth) {
     text_orientations += f.orientation_method == "text";
     right_orientations += f.orientation_method == "text" && f.f.corners_in_order;
   }
-  std::printf("%s: %d of %zu views pass every check; mean IoU %.4f; orientation read from "
-              "text in %d views, right in %d\n",
-              DataSetName(GetParam()).c_str(), all_good, gt->cameras.views.size(), mean_iou,
-              text_orientations, right_orientations);
+  std::printf(
+      "%s: %d of %zu views pass every check; mean IoU %.4f; orientation read from "
+      "text in %d views, right in %d\n",
+      DataSetName(GetParam()).c_str(), all_good, gt->cameras.views.size(), mean_iou,
+      text_orientations, right_orientations);
 }
 
 // Crops of the most frontal view that cut the page: off its bottom, off one
@@ -142,8 +145,8 @@ TEST_P(BoundaryOnDataSet, CutOffPagesKeepTheirRealSides) {
       {"corner", cv::Rect(page.x + int(0.25 * page.width), page.y + int(0.2 * page.height),
                           cam.width - page.x - int(0.25 * page.width),
                           cam.height - page.y - int(0.2 * page.height))},
-      {"two-sides", cv::Rect(0, page.y + int(0.15 * page.height), cam.width,
-                             int(0.7 * page.height))},
+      {"two-sides",
+       cv::Rect(0, page.y + int(0.15 * page.height), cam.width, int(0.7 * page.height))},
   };
   for (const auto& [name, rect] : crops) {
     const PinholeCamera crop_cam = CropCamera(cam, rect);

@@ -1,12 +1,12 @@
 // The segment-boundary command line: outputs and their formats, --verbose,
 // and bad input (missing or unreadable image, an image without a document)
 // failing with exit 3, a message naming the file, and no output at all.
-#include <fstream>
-#include <random>
-
 #include <gtest/gtest.h>
+
+#include <fstream>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <random>
 
 #include "tests/support/test_support.h"
 
@@ -41,8 +41,8 @@ bool Empty(const fs::path& dir) {
 TEST(SegmentBoundaryCli, WritesMaskBoundaryAndOverlay) {
   TempDir dir;
   const fs::path image = WriteScene(dir, true);
-  const CommandResult r = RunCommand(Binary() + " --image " + Quote(image.string()) +
-                                     " --out " + Quote((dir / "out").string()) + " --verbose");
+  const CommandResult r = RunCommand(Binary() + " --image " + Quote(image.string()) + " --out " +
+                                     Quote((dir / "out").string()) + " --verbose");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("4 of 4 sides real"), std::string::npos) << r.output;
   const cv::Mat mask = cv::imread((dir / "out" / "mask.png").string(), cv::IMREAD_UNCHANGED);
@@ -50,9 +50,9 @@ TEST(SegmentBoundaryCli, WritesMaskBoundaryAndOverlay) {
   EXPECT_EQ(mask.type(), CV_8UC1);
   EXPECT_EQ(mask.size(), cv::Size(800, 600));
   EXPECT_FALSE(cv::imread((dir / "out" / "overlay.png").string()).empty());
-  const CommandResult valid = RunCommand(
-      Quote((SourceDir() / "scripts" / "validate-json").string()) + " " +
-      Quote((dir / "out" / "boundary.json").string()));
+  const CommandResult valid =
+      RunCommand(Quote((SourceDir() / "scripts" / "validate-json").string()) + " " +
+                 Quote((dir / "out" / "boundary.json").string()));
   EXPECT_EQ(valid.exit_code, 0) << valid.output;
 }
 
@@ -117,16 +117,16 @@ TEST(SegmentBoundaryCli, OtherViewsGetTheirOwnPageMasks) {
   WriteScene(dir, false);
   fs::copy_file(dir / "page.png", dir / "again.png");
   const fs::path cameras = WriteCameras(dir, {"page.png", "again.png", "table.png"}, 800);
-  const std::string base = Binary() + " --image " + Quote((dir / "page.png").string()) +
-                           " --out " + Quote((dir / "out").string());
+  const std::string base = Binary() + " --image " + Quote((dir / "page.png").string()) + " --out " +
+                           Quote((dir / "out").string());
   const CommandResult r = RunCommand(base + " --views " + Quote(dir.path().string()) +
                                      " --cameras " + Quote(cameras.string()));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   // The reference's own outputs as always; a view without a page is left out.
   EXPECT_TRUE(fs::is_regular_file(dir / "out" / "mask.png"));
   EXPECT_FALSE(fs::exists(dir / "out" / "views" / "page"));
-  const cv::Mat mask = cv::imread((dir / "out" / "views" / "again" / "mask.png").string(),
-                                  cv::IMREAD_UNCHANGED);
+  const cv::Mat mask =
+      cv::imread((dir / "out" / "views" / "again" / "mask.png").string(), cv::IMREAD_UNCHANGED);
   ASSERT_FALSE(mask.empty());
   EXPECT_EQ(mask.size(), cv::Size(800, 600));
   EXPECT_GT(cv::countNonZero(mask), 0.15 * mask.total());

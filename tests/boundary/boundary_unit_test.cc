@@ -1,10 +1,10 @@
 // segment-boundary on drawn scenes whose truth is known exactly: a page on a
 // plain and on a textured table, a page cut off by the image border, an empty
 // table; and the corner and orientation helpers.
-#include <random>
-
 #include <gtest/gtest.h>
+
 #include <opencv2/imgproc.hpp>
+#include <random>
 
 #include "common/errors.h"
 #include "stages/segment-boundary/segment_boundary.h"
@@ -14,13 +14,14 @@ namespace {
 
 struct Scene {
   cv::Mat3b image;
-  cv::Mat1b mask;                     // true page region
-  std::vector<cv::Point2d> corners;   // true corners, clockwise
+  cv::Mat1b mask;                    // true page region
+  std::vector<cv::Point2d> corners;  // true corners, clockwise
 };
 
 // A table (plain green with noise, or a blotchy texture) with a white page
 // (quadrilateral `corners`) carrying lines of dark "text" blocks.
-Scene DrawScene(const std::vector<cv::Point2d>& corners, bool textured, cv::Size size = {1200, 900}) {
+Scene DrawScene(const std::vector<cv::Point2d>& corners, bool textured,
+                cv::Size size = {1200, 900}) {
   Scene s;
   std::mt19937 rng(7);
   std::normal_distribution<float> noise(0, 3);
@@ -29,8 +30,8 @@ Scene DrawScene(const std::vector<cv::Point2d>& corners, bool textured, cv::Size
     std::uniform_int_distribution<int> x(0, size.width), y(0, size.height), r(3, 12), c(-35, 35);
     for (int i = 0; i < 6000; ++i) {
       const int d = c(rng);
-      cv::circle(s.image, {x(rng), y(rng)}, r(rng),
-                 cv::Scalar(70 + d, 110 + d, 60 + d), cv::FILLED, cv::LINE_AA);
+      cv::circle(s.image, {x(rng), y(rng)}, r(rng), cv::Scalar(70 + d, 110 + d, 60 + d), cv::FILLED,
+                 cv::LINE_AA);
     }
   }
   std::vector<cv::Point> poly;

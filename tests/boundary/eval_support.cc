@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-
 #include <opencv2/imgcodecs.hpp>
 
 #include "tests/support/test_support.h"
@@ -46,7 +45,10 @@ int MostFrontalView(const GroundTruth& gt) {
       all_in = all_in && c.x() >= 0 && c.y() >= 0 && c.x() < cam.width && c.y() < cam.height;
     const double score =
         std::abs(normal.dot((centre - cam.Center()).normalized())) + (all_in ? 1.0 : 0.0);
-    if (score > best_score) { best_score = score; best = int(i); }
+    if (score > best_score) {
+      best_score = score;
+      best = int(i);
+    }
   }
   return best;
 }

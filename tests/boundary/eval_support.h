@@ -3,12 +3,11 @@
 // figures themselves are evaluate's (stages/evaluate/front_end.h).
 #pragma once
 
+#include <Eigen/Core>
 #include <filesystem>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
-#include <opencv2/core.hpp>
 
 #include "common/camera.h"
 #include "tests/support/ground_truth.h"

@@ -1,7 +1,8 @@
 #include "common/atomic_file.h"
 
-#include <fstream>
 #include <gtest/gtest.h>
+
+#include <fstream>
 
 #include "common/errors.h"
 #include "tests/support/test_support.h"

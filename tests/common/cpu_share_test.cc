@@ -16,8 +16,8 @@ using Clock = std::chrono::steady_clock;
 
 CpuSample Sample(double wall_seconds, double busy, double self) {
   CpuSample s;
-  s.wall = Clock::time_point(std::chrono::duration_cast<Clock::duration>(
-      std::chrono::duration<double>(wall_seconds)));
+  s.wall = Clock::time_point(
+      std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(wall_seconds)));
   s.busy_seconds = busy;
   s.self_seconds = self;
   s.valid = true;
@@ -46,8 +46,7 @@ TEST(CpuShare, OthersAreTheBusyTimeNotSpentByThisProcess) {
   // core.
   EXPECT_DOUBLE_EQ(OthersCores(Sample(10, 100, 5), Sample(12, 103, 6)), 1.0);
   // Counters are coarser than this process's own clock: never below 0.
-  EXPECT_DOUBLE_EQ(OthersCores(Sample(10, 100, 5), Sample(11, 100.5, 5.9)),
-                   0.0);
+  EXPECT_DOUBLE_EQ(OthersCores(Sample(10, 100, 5), Sample(11, 100.5, 5.9)), 0.0);
   // Unreadable /proc/stat, or no time passed: nothing known.
   CpuSample invalid = Sample(12, 103, 6);
   invalid.valid = false;
@@ -81,8 +80,7 @@ TEST(CpuShare, SeesAnotherProcessLoad) {
   int status = 0;
   rusage child_usage{};
   ASSERT_EQ(wait4(child, &status, 0, &child_usage), child);
-  const double wall =
-      std::chrono::duration<double>(Clock::now() - start).count();
+  const double wall = std::chrono::duration<double>(Clock::now() - start).count();
   const double child_cores =
       (child_usage.ru_utime.tv_sec + child_usage.ru_stime.tv_sec +
        1e-6 * (child_usage.ru_utime.tv_usec + child_usage.ru_stime.tv_usec)) /

@@ -18,26 +18,20 @@ struct Points {
   }
 };
 
-double PlaneDepth(double u, double v) {
-  return 1 / (0.5 + 0.001 * u - 0.0005 * v);
-}
+double PlaneDepth(double u, double v) { return 1 / (0.5 + 0.001 * u - 0.0005 * v); }
 
 TEST(DepthField, PlanarFitIsExactOnAPlaneWithOrWithoutTheGuard) {
   Points p;
   for (int i = 0; i < 12; ++i)
     for (int j = 0; j < 12; ++j) {
-      const double u = 20 * i + 3 * std::sin(i * 7 + j),
-                   v = 20 * j + 3 * std::cos(i + 5 * j);
+      const double u = 20 * i + 3 * std::sin(i * 7 + j), v = 20 * j + 3 * std::cos(i + 5 * j);
       p.Add(u, v, PlaneDepth(u, v));
     }
   for (double guard : {0.0, 0.01}) {
-    const DepthField field(p.pixels, p.depths, 3, 10, DepthModel::kPlanar, 16,
-                           guard);
+    const DepthField field(p.pixels, p.depths, 3, 10, DepthModel::kPlanar, 16, guard);
     for (const Eigen::Vector2d& px :
-         {Eigen::Vector2d(55, 71), Eigen::Vector2d(130, 12),
-          Eigen::Vector2d(201, 199)})
-      EXPECT_NEAR(field.At(px), PlaneDepth(px.x(), px.y()), 1e-9)
-          << "guard " << guard;
+         {Eigen::Vector2d(55, 71), Eigen::Vector2d(130, 12), Eigen::Vector2d(201, 199)})
+      EXPECT_NEAR(field.At(px), PlaneDepth(px.x(), px.y()), 1e-9) << "guard " << guard;
   }
 }
 
@@ -60,8 +54,7 @@ TEST(DepthField, TheGuardTakesTheWiderFitWhereAFewClustersTiltTheNarrowOne) {
   }
   const Eigen::Vector2d px(20, 0);
   const DepthField narrow(p.pixels, p.depths, 3, 2, DepthModel::kPlanar, 16, 0);
-  const DepthField guarded(p.pixels, p.depths, 3, 2, DepthModel::kPlanar, 16,
-                           0.01);
+  const DepthField guarded(p.pixels, p.depths, 3, 2, DepthModel::kPlanar, 16, 0.01);
   EXPECT_GT(narrow.At(px), 1.03);
   EXPECT_LT(guarded.At(px), 1.02);
 }

@@ -1,8 +1,8 @@
 #include "common/gltf.h"
 
-#include <fstream>
 #include <gtest/gtest.h>
 
+#include <fstream>
 #include <nlohmann/json.hpp>
 
 #include "tests/support/test_support.h"

@@ -1,7 +1,8 @@
 #include "common/json_io.h"
 
-#include <fstream>
 #include <gtest/gtest.h>
+
+#include <fstream>
 
 #include "common/camera.h"
 #include "common/errors.h"
@@ -23,7 +24,9 @@ TEST(JsonIo, ReportsFileAndPointer) {
   testing::TempDir dir;
   Json doc = MakeHeader("docunfold.cameras", 1, "test");
   doc["reference"] = "a.jpg";
-  doc["views"] = Json::array({{{"image", "a.jpg"}, {"width", 10}, {"height", 10},
+  doc["views"] = Json::array({{{"image", "a.jpg"},
+                               {"width", 10},
+                               {"height", 10},
                                {"K", {{1, 0, 5}, {0, 1, 5}, {0, 0, 1}}},
                                {"R", {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}},
                                {"t", {0, 0, "x"}}}});

@@ -1,7 +1,8 @@
 #include "common/page_files.h"
 
-#include <fstream>
 #include <gtest/gtest.h>
+
+#include <fstream>
 
 #include "common/errors.h"
 #include "tests/support/test_support.h"
@@ -44,8 +45,7 @@ TEST(PageFiles, ProblemsNameFileAndPointer) {
   std::ofstream(dir / "b.json") << broken;
   EXPECT_NE(ErrorOf([&] { ReadBoundary(dir / "b.json"); }).find("b.json:/sides/bottom/real: "),
             std::string::npos);
-  std::ofstream(dir / "f.json")
-      << R"({"format": "docunfold.features", "version": 1, "segments": [
+  std::ofstream(dir / "f.json") << R"({"format": "docunfold.features", "version": 1, "segments": [
             {"kind": "text", "points": [[1, 2], [3, 4]]}, {"kind": "curve", "points": [[1, 2], [3, 4]]}]})";
   EXPECT_NE(ErrorOf([&] { ReadFeatures(dir / "f.json"); }).find("f.json:/segments/1/kind: "),
             std::string::npos);
@@ -53,7 +53,8 @@ TEST(PageFiles, ProblemsNameFileAndPointer) {
       << R"({"format": "docunfold.features", "version": 1, "segments": [{"kind": "edge", "points": [[1, 2]]}]})";
   EXPECT_NE(ErrorOf([&] { ReadFeatures(dir / "g.json"); }).find("g.json:/segments/0/points: "),
             std::string::npos);
-  std::ofstream(dir / "h.json") << R"({"format": "docunfold.features", "version": 1, "segments": []})";
+  std::ofstream(dir / "h.json")
+      << R"({"format": "docunfold.features", "version": 1, "segments": []})";
   EXPECT_TRUE(ReadFeatures(dir / "h.json").segments.empty());
 }
 

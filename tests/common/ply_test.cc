@@ -1,7 +1,8 @@
 #include "common/ply.h"
 
-#include <fstream>
 #include <gtest/gtest.h>
+
+#include <fstream>
 
 #include "common/errors.h"
 #include "tests/support/test_support.h"
@@ -15,7 +16,10 @@ PlyData MakeGrid() {
     for (int x = 0; x < 4; ++x) ply.vertices.push_back({x * 0.5, y * 0.25, 0.1 * x * y});
   std::vector<double> s, t;
   for (int y = 0; y < 3; ++y)
-    for (int x = 0; x < 4; ++x) { s.push_back(x / 3.0); t.push_back(y / 2.0); }
+    for (int x = 0; x < 4; ++x) {
+      s.push_back(x / 3.0);
+      t.push_back(y / 2.0);
+    }
   ply.SetProperty("s", s);
   ply.SetProperty("t", t);
   ply.SetProperty("track_length", std::vector<double>(12, 7), PlyScalar::kInt32);
@@ -86,15 +90,18 @@ TEST(PlyRead, RejectsAwkwardFiles) {
 
 TEST(PlyRead, ReadsDoubleAndBigEndianFromOtherTools) {
   testing::TempDir dir;
-  std::string body = "ply\nformat binary_big_endian 1.0\nelement vertex 1\n"
-                     "property double x\nproperty double y\nproperty double z\n"
-                     "end_header\n";
+  std::string body =
+      "ply\nformat binary_big_endian 1.0\nelement vertex 1\n"
+      "property double x\nproperty double y\nproperty double z\n"
+      "end_header\n";
   auto put_be = [&body](double d) {
     unsigned char b[8];
     std::memcpy(b, &d, 8);
     for (int i = 7; i >= 0; --i) body.push_back(char(b[i]));
   };
-  put_be(1.5); put_be(-2.0); put_be(3.25);
+  put_be(1.5);
+  put_be(-2.0);
+  put_be(3.25);
   WriteFile(dir / "be.ply", body);
   PlyData p = ReadPly(dir / "be.ply");
   ASSERT_EQ(p.vertices.size(), 1u);

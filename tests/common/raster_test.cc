@@ -11,8 +11,8 @@ TEST(Raster, PerspectiveCorrectAttributesOnATiltedPlane) {
   cam.height = 200;
   cam.K << 150, 0, 99.5, 0, 150, 99.5, 0, 0, 1;
   // A unit square tilted away from the camera; attribute = world x, y.
-  std::vector<Eigen::Vector3d> v = {{-0.5, -0.5, 1.0}, {0.5, -0.5, 1.0},
-                                    {0.5, 0.5, 2.0}, {-0.5, 0.5, 2.0}};
+  std::vector<Eigen::Vector3d> v = {
+      {-0.5, -0.5, 1.0}, {0.5, -0.5, 1.0}, {0.5, 0.5, 2.0}, {-0.5, 0.5, 2.0}};
   std::vector<Triangle> tris = Triangulate({{0, 1, 2, 3}});
   RasterResult r = RasterizeMesh(cam, v, tris);
   Eigen::MatrixXf attr(4, 3);

@@ -34,8 +34,7 @@ Page MakePage() {
   for (int y = 220; y < 950; y += 24)
     for (int x = 40; x < kWidth - 60; x += 11)
       if ((x / 11 + y / 24) % 7 != 0)
-        cv::putText(p.text, "a", cv::Point(x, y), cv::FONT_HERSHEY_SIMPLEX, 0.5,
-                    255, 1);
+        cv::putText(p.text, "a", cv::Point(x, y), cv::FONT_HERSHEY_SIMPLEX, 0.5, 255, 1);
   albedo.setTo(cv::Vec3f(30, 30, 30), p.text);
   // Light: a fold at y = 600 below which the panel gets 0.65 of it, a soft
   // diagonal shadow (0.8 at its middle), and a gentle falloff to the right.
@@ -50,8 +49,7 @@ Page MakePage() {
     }
   p.image = cv::Mat3b(kHeight, kWidth);
   for (int y = 0; y < kHeight; ++y)
-    for (int x = 0; x < kWidth; ++x)
-      p.image(y, x) = albedo(y, x) * p.light(y, x);
+    for (int x = 0; x < kWidth; ++x) p.image(y, x) = albedo(y, x) * p.light(y, x);
   cv::Mat1b near_text;
   cv::dilate(p.text, near_text, cv::Mat::ones(9, 9, CV_8U));
   p.paper = (near_text == 0) & (p.banner == 0);
@@ -77,13 +75,11 @@ TEST(RemoveShading, PaperBecomesEvenAndPrintKeepsItsContrastAndColour) {
   ASSERT_EQ(r.image.size(), page.image.size());
   ASSERT_EQ(r.image.type(), CV_8UC3);
   EXPECT_LE(PaperSpread(r.image, page.paper), 10);
-  std::printf("paper spread %.0f -> %.0f grey levels\n",
-              PaperSpread(page.image, page.paper),
+  std::printf("paper spread %.0f -> %.0f grey levels\n", PaperSpread(page.image, page.paper),
               PaperSpread(r.image, page.paper));
   // Paper maps to the well-lit paper's colour.
   const cv::Scalar paper_mean = cv::mean(r.image, page.paper);
-  for (int c = 0; c < 3; ++c)
-    EXPECT_NEAR(paper_mean[c], kPaper[c] * 0.95, 15) << c;
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(paper_mean[c], kPaper[c] * 0.95, 15) << c;
   // Text stays dark next to the paper on the dark panel as on the bright one.
   cv::Mat1b text_top = page.text.clone(), text_bottom = page.text.clone();
   text_top.rowRange(600, kHeight).setTo(0);
@@ -104,8 +100,8 @@ TEST(RemoveShading, PaperBecomesEvenAndPrintKeepsItsContrastAndColour) {
   std::printf(
       "text %.0f / %.0f on paper %.0f; banner (%.0f %.0f %.0f) was (%.0f %.0f "
       "%.0f)\n",
-      top, bottom, paper_mean[1], banner[0], banner[1], banner[2],
-      banner_before[0], banner_before[1], banner_before[2]);
+      top, bottom, paper_mean[1], banner[0], banner[1], banner[2], banner_before[0],
+      banner_before[1], banner_before[2]);
 }
 
 TEST(RemoveShading, EmptyGreyAndEvenImagesAreHandled) {
@@ -115,9 +111,7 @@ TEST(RemoveShading, EmptyGreyAndEvenImagesAreHandled) {
   grey.colRange(150, 300).setTo(120);  // a shaded half
   const ShadingRemoval g = RemoveShading(grey);
   ASSERT_EQ(g.image.type(), CV_8UC1);
-  EXPECT_LE(std::abs(int(g.image.at<uchar>(100, 50)) -
-                     int(g.image.at<uchar>(100, 250))),
-            4);
+  EXPECT_LE(std::abs(int(g.image.at<uchar>(100, 50)) - int(g.image.at<uchar>(100, 250))), 4);
   // Evenly lit paper stays as it is.
   const cv::Mat3b even(120, 90, cv::Vec3b(210, 220, 225));
   const ShadingRemoval e = RemoveShading(even);

@@ -60,8 +60,8 @@ TEST_F(DensifyCli, WritesItsFilesAndKeepsSfmPointsFirstAndUnchanged) {
   for (const char* p : {"track_length", "reprojection_error", "source"})
     EXPECT_NE(all.FindProperty(p), nullptr) << p;
   EXPECT_TRUE(fs::is_regular_file(dir_ / "25_points/overlay.png"));
-  const CommandResult v = RunCommand(Quote((SourceDir() / "scripts/validate-json").string()) +
-                                     " " + Quote((dir_ / "25_points/points.json").string()));
+  const CommandResult v = RunCommand(Quote((SourceDir() / "scripts/validate-json").string()) + " " +
+                                     Quote((dir_ / "25_points/points.json").string()));
   EXPECT_EQ(v.exit_code, 0) << v.output;
   const Json report = ReadJsonFile(dir_ / "25_points/points.json");
   EXPECT_TRUE(report["points"].contains("steps")) << report.dump();
@@ -81,12 +81,12 @@ TEST_F(DensifyCli, SurfacePrewarpIsASecondPassCountedApart) {
   EXPECT_NE(r.output.find("through the points' surface"), std::string::npos) << r.output;
   const Json after = ReadJsonFile(dir_ / "25_points/points.json");
   // The first pass is the same; the second only adds.
-  EXPECT_EQ(after["points"]["texture"].get<int>() -
-                after["points"]["texture_surface_prewarp"].get<int>(),
-            before["points"]["texture"].get<int>());
+  EXPECT_EQ(
+      after["points"]["texture"].get<int>() - after["points"]["texture_surface_prewarp"].get<int>(),
+      before["points"]["texture"].get<int>());
   EXPECT_TRUE(after["producer"]["options"]["texture"]["surface_prewarp"].get<bool>());
-  const CommandResult v = RunCommand(Quote((SourceDir() / "scripts/validate-json").string()) +
-                                     " " + Quote((dir_ / "25_points/points.json").string()));
+  const CommandResult v = RunCommand(Quote((SourceDir() / "scripts/validate-json").string()) + " " +
+                                     Quote((dir_ / "25_points/points.json").string()));
   EXPECT_EQ(v.exit_code, 0) << v.output;
 }
 

@@ -58,15 +58,15 @@ TEST(DensifyOnTruth, PointsLieOnTheTrueSurface) {
     const Json boundary = ReadJsonFile(dir / "20_boundary/boundary.json");
     bool whole_page = true;
     for (const auto& side : boundary["sides"]) whole_page = whole_page && side["real"].get<bool>();
-    std::printf("[densify] %-6s ref %-11s texture %5zu median %.3f%% p90 %.3f%% | outline %4zu "
-                "of %4d samples median %.3f%% p90 %.3f%% | steps %4zu median %.3f%% p90 %.3f%% "
-                "max %.3f%% of the diagonal, %.2f s\n",
-                set.filename().c_str(), reference.c_str(), texture.size(),
-                100 * Quantile(texture, 0.5), 100 * Quantile(texture, 0.9), outline.size(),
-                report["outline"]["samples"].get<int>(), 100 * Quantile(outline, 0.5),
-                100 * Quantile(outline, 0.9), steps.size(), 100 * Quantile(steps, 0.5),
-                100 * Quantile(steps, 0.9), 100 * Quantile(steps, 1.0),
-                report["seconds"]["total"].get<double>());
+    std::printf(
+        "[densify] %-6s ref %-11s texture %5zu median %.3f%% p90 %.3f%% | outline %4zu "
+        "of %4d samples median %.3f%% p90 %.3f%% | steps %4zu median %.3f%% p90 %.3f%% "
+        "max %.3f%% of the diagonal, %.2f s\n",
+        set.filename().c_str(), reference.c_str(), texture.size(), 100 * Quantile(texture, 0.5),
+        100 * Quantile(texture, 0.9), outline.size(), report["outline"]["samples"].get<int>(),
+        100 * Quantile(outline, 0.5), 100 * Quantile(outline, 0.9), steps.size(),
+        100 * Quantile(steps, 0.5), 100 * Quantile(steps, 0.9), 100 * Quantile(steps, 1.0),
+        report["seconds"]["total"].get<double>());
     // Measured (true cameras and outline; 300 true points, 3000 before
     // 2026-11-25): texture median <= 0.022 %, p90 <= 0.122 % (0.114 %);
     // outline on whole pages median <= 0.055 %, p90 <= 0.15 %

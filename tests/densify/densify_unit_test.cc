@@ -2,13 +2,12 @@
 // with rows of "words" on a darker table, seen by four cameras.
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cstdio>
 #include <functional>
-#include <random>
-
-#include <Eigen/Geometry>
 #include <opencv2/imgproc.hpp>
+#include <random>
 
 #include "stages/densify/densify.h"
 
@@ -74,8 +73,8 @@ TEST(Densify, PointsOfAnotherColourThanTheReferenceShowsAreHidden) {
   std::uniform_int_distribution<int> col(210, 590), row(110, 490), gap(0, 14);
   // Paper between the text lines (10 px from them).
   for (int i = 0; i < 60; ++i) add(col(rng), 160 + 20 * gap(rng), {245, 245, 245}, false);
-  for (int y = 150; y < 450; y += 60) add(400, y + 1, {20, 20, 20}, false);       // on the text
-  for (int i = 0; i < 15; ++i) add(col(rng), row(rng), {150, 90, 40}, true);    // table behind
+  for (int y = 150; y < 450; y += 60) add(400, y + 1, {20, 20, 20}, false);   // on the text
+  for (int i = 0; i < 15; ++i) add(col(rng), row(rng), {150, 90, 40}, true);  // table behind
   add(100, 300, {150, 90, 40}, false);  // table where the reference shows table
   std::vector<int> indices(points.size());
   for (size_t i = 0; i < indices.size(); ++i) indices[i] = int(i);
@@ -84,14 +83,14 @@ TEST(Densify, PointsOfAnotherColourThanTheReferenceShowsAreHidden) {
   indices.push_back(int(points.size()) - 1);
   expected.push_back(false);
 
-  const std::vector<bool> hidden = densify::HiddenInReference(
-      points, colours, indices, camera, reference, densify::HiddenOptions{});
+  const std::vector<bool> hidden = densify::HiddenInReference(points, colours, indices, camera,
+                                                              reference, densify::HiddenOptions{});
   ASSERT_EQ(hidden.size(), expected.size());
   for (size_t i = 0; i < expected.size(); ++i) EXPECT_EQ(hidden[i], expected[i]) << i;
 
   // Without colours, or with one colour for all, nothing is judged.
-  const std::vector<bool> none = densify::HiddenInReference(points, {}, indices, camera, reference,
-                                                            densify::HiddenOptions{});
+  const std::vector<bool> none =
+      densify::HiddenInReference(points, {}, indices, camera, reference, densify::HiddenOptions{});
   EXPECT_EQ(std::count(none.begin(), none.end(), true), 0);
   const std::vector<std::array<uint8_t, 3>> grey(points.size(), {128, 128, 128});
   const std::vector<bool> same = densify::HiddenInReference(points, grey, indices, camera,
@@ -206,8 +205,8 @@ DensifyInputs InputsOf(const Scene& s, int sfm_points) {
     // top TL->TR, right TR->BR, bottom BL->BR, left TL->BL
     const int a = i == 2 ? 3 : i == 3 ? 0 : i, b = i == 2 ? 2 : i == 3 ? 3 : i + 1;
     for (int k = 0; k <= 20; ++k)
-      in.boundary.sides[i].points.push_back(in.boundary.corners[a] +
-                                            (in.boundary.corners[b] - in.boundary.corners[a]) * k / 20.0);
+      in.boundary.sides[i].points.push_back(
+          in.boundary.corners[a] + (in.boundary.corners[b] - in.boundary.corners[a]) * k / 20.0);
   }
   in.region = ContourRegion(in.boundary, 0);
   std::mt19937 rng(3);
@@ -243,7 +242,8 @@ TEST(Densify, PointsLieOnTheRenderedPageAndItsOutline) {
   EXPECT_EQ(r.sfm_points, 150);
   std::vector<double> on_page, on_outline;
   for (size_t i = 0; i < r.points.vertices.size(); ++i) {
-    if (source[i] == densify::kTexture) on_page.push_back(DistanceToPage(scene, r.points.vertices[i]));
+    if (source[i] == densify::kTexture)
+      on_page.push_back(DistanceToPage(scene, r.points.vertices[i]));
     if (source[i] == densify::kOutline)
       on_outline.push_back(DistanceToOutline(scene, r.points.vertices[i]));
   }
@@ -253,13 +253,13 @@ TEST(Densify, PointsLieOnTheRenderedPageAndItsOutline) {
     std::sort(v.begin(), v.end());
     return v.empty() ? NAN : v[size_t(q * (v.size() - 1))];
   };
-  std::printf("[densify] rendered page: %d texture points (median %.3f %%, p95 %.3f %% of the "
-              "diagonal off the page), %d of %d outline samples (median %.3f %%, p95 %.3f %% off "
-              "the outline)\n",
-              r.texture_points, 100 * quantile(on_page, 0.5) / diagonal,
-              100 * quantile(on_page, 0.95) / diagonal, r.outline.points, r.outline.samples,
-              100 * quantile(on_outline, 0.5) / diagonal,
-              100 * quantile(on_outline, 0.95) / diagonal);
+  std::printf(
+      "[densify] rendered page: %d texture points (median %.3f %%, p95 %.3f %% of the "
+      "diagonal off the page), %d of %d outline samples (median %.3f %%, p95 %.3f %% off "
+      "the outline)\n",
+      r.texture_points, 100 * quantile(on_page, 0.5) / diagonal,
+      100 * quantile(on_page, 0.95) / diagonal, r.outline.points, r.outline.samples,
+      100 * quantile(on_outline, 0.5) / diagonal, 100 * quantile(on_outline, 0.95) / diagonal);
   EXPECT_GT(r.texture_points, 2000);
   EXPECT_LT(quantile(on_page, 0.5), 0.0005 * diagonal);
   EXPECT_LT(quantile(on_page, 0.95), 0.002 * diagonal);
@@ -374,12 +374,12 @@ TEST(Densify, TheFarSideOfAFoldGetsPointsThroughTheSurfaceOfTheFirst) {
   const int far_both = far_side(both, &errors);
   std::sort(errors.begin(), errors.end());
   const double diagonal = 0.5;
-  std::printf("[densify] folded page: %d texture points past the fold with the page's "
-              "homography, %d with the second pass (%d points in all; median %.3f %%, p95 "
-              "%.3f %% of the diagonal off the page)\n",
-              far_first, far_both, both.texture_points,
-              100 * errors[errors.size() / 2] / diagonal,
-              100 * errors[errors.size() * 95 / 100] / diagonal);
+  std::printf(
+      "[densify] folded page: %d texture points past the fold with the page's "
+      "homography, %d with the second pass (%d points in all; median %.3f %%, p95 "
+      "%.3f %% of the diagonal off the page)\n",
+      far_first, far_both, both.texture_points, 100 * errors[errors.size() / 2] / diagonal,
+      100 * errors[errors.size() * 95 / 100] / diagonal);
   EXPECT_EQ(first.texture_points_surface, 0);
   EXPECT_EQ(both.texture_points_surface, both.texture_points - first.texture_points);
   EXPECT_GT(far_both, far_first + 500);
@@ -408,7 +408,7 @@ TEST(Densify, ShadingStepsOfBlankPaperGetPointsOnThePage) {
   const DensifyResult r = densify::Run(in, o);
   ASSERT_GT(r.steps.samples, 0);
   ASSERT_GT(r.steps.points, 5) << r.steps.samples << " samples, " << r.steps.unmatched
-                              << " unmatched, " << r.steps.off_surface << " off the surface";
+                               << " unmatched, " << r.steps.off_surface << " off the surface";
   const std::vector<double>& source = r.points.properties[2].values;
   const Eigen::Vector3d n = scene.along.cross(scene.down).normalized();
   for (size_t i = 0; i < r.points.vertices.size(); ++i) {

@@ -3,13 +3,14 @@
 // (true surface and camera) must clearly beat the scanner-app homography on
 // folded pages, and reach a high MS-SSIM itself. Also the geometry metrics
 // of evaluate on the true meshes and on a distorted copy.
+#include "stages/baseline/baseline.h"
+
 #include <gtest/gtest.h>
 
 #include <fstream>
 
 #include "common/atomic_file.h"
 #include "common/json_io.h"
-#include "stages/baseline/baseline.h"
 #include "stages/evaluate/evaluate.h"
 #include "stages/evaluate/image_metrics.h"
 #include "tests/evaluate/truth_frontend.h"
@@ -75,8 +76,8 @@ TEST_P(Baselines, OracleClearlyBeatsHomographyOnFoldedPages) {
 
   const double h = MsSsimOf(data, homography.image), o = MsSsimOf(data, oracle.image);
   const int folds = FoldCount(data);
-  std::cout << data.filename().string() << " (reference " << reference << ", folds "
-            << folds << "): MS-SSIM homography " << h << ", oracle " << o << "\n";
+  std::cout << data.filename().string() << " (reference " << reference << ", folds " << folds
+            << "): MS-SSIM homography " << h << ", oracle " << o << "\n";
   // Where the page leaves the reference photo (cut-off sets) no single-view
   // method can know it; elsewhere the oracle must be close to the truth.
   const PinholeCamera* camera = gt->cameras.Find(reference);
@@ -103,8 +104,8 @@ TEST_P(Baselines, OracleClearlyBeatsHomographyOnFoldedPages) {
 INSTANTIATE_TEST_SUITE_P(DataSets, Baselines, ::testing::ValuesIn(DataSetsWithGroundTruth()),
                          [](const auto& info) {
                            const fs::path p(info.param);
-                           std::string n = p.parent_path().filename().string() + "_" +
-                                           p.filename().string();
+                           std::string n =
+                               p.parent_path().filename().string() + "_" + p.filename().string();
                            for (char& c : n)
                              if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
                            return n;
@@ -231,8 +232,7 @@ TEST(EvaluateGeometry, TrueMeshesAreOnTheSurfaceAndIsometric) {
 
   // Every vertex moved 1% of the page diagonal along the reference camera's
   // optical axis (z of the sfm frame, whose unit is the median depth).
-  const double diagonal_in_sfm =
-      ReferenceFrame(*gt, reference).scale * gt->Diagonal();
+  const double diagonal_in_sfm = ReferenceFrame(*gt, reference).scale * gt->Diagonal();
   for (auto& v : meshes.mesh3d.vertices) v.z() += 0.01 * diagonal_in_sfm;
   EnsureDirectory(work / "50_optimize");
   WritePly(work / "50_optimize" / "mesh3d.ply", meshes.mesh3d);
@@ -241,7 +241,7 @@ TEST(EvaluateGeometry, TrueMeshesAreOnTheSurfaceAndIsometric) {
   EXPECT_EQ(r.document["geometry"]["mesh_dir"], (work / "50_optimize").string());
   EXPECT_GT(r.metrics.surface_mean_pct, 0.3) << r.document["geometry"].dump();
   EXPECT_LT(r.metrics.surface_max_pct, 1.0 + 1e-3);  // float32 PLY coordinates
-  EXPECT_LT(r.metrics.isometry_mean, 0.005);  // a translation keeps lengths
+  EXPECT_LT(r.metrics.isometry_mean, 0.005);         // a translation keeps lengths
 }
 
 }  // namespace

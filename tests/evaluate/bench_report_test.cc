@@ -4,11 +4,10 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <opencv2/imgcodecs.hpp>
 #include <sstream>
 #include <utility>
 #include <vector>
-
-#include <opencv2/imgcodecs.hpp>
 
 #include "common/json_io.h"
 #include "tests/support/test_support.h"
@@ -35,18 +34,30 @@ TEST(BenchReport, WritesValidJsonAndAReadableTable) {
   fs::create_directories(work / "bench");
   fs::create_directories(work / "70_eval");
   std::ofstream(work / "timings.jsonl")
-      << R"({"stage": "truth-frontend", "seconds": 1.50, "max_rss_mb": 200.0, "exit": 0})" "\n"
-      << R"({"stage": "init-mesh", "seconds": 3.25, "max_rss_mb": 100.5, "exit": 0})" "\n"
-      << R"({"stage": "render", "seconds": 2.00, "max_rss_mb": 90.0, "exit": 1})" "\n";
+      << R"({"stage": "truth-frontend", "seconds": 1.50, "max_rss_mb": 200.0, "exit": 0})"
+         "\n"
+      << R"({"stage": "init-mesh", "seconds": 3.25, "max_rss_mb": 100.5, "exit": 0})"
+         "\n"
+      << R"({"stage": "render", "seconds": 2.00, "max_rss_mb": 90.0, "exit": 1})"
+         "\n";
   std::ofstream(work / "bench" / "timings.jsonl")
-      << R"({"stage": "make:homography", "seconds": 0.50, "max_rss_mb": 60.0, "exit": 0})" "\n"
-      << R"({"stage": "evaluate:homography", "seconds": 7.00, "max_rss_mb": 130.0, "exit": 0})" "\n"
-      << R"({"stage": "make:oracle", "seconds": 0.70, "max_rss_mb": 110.0, "exit": 0})" "\n"
-      << R"({"stage": "evaluate:oracle", "seconds": 6.00, "max_rss_mb": 120.0, "exit": 0})" "\n";
+      << R"({"stage": "make:homography", "seconds": 0.50, "max_rss_mb": 60.0, "exit": 0})"
+         "\n"
+      << R"({"stage": "evaluate:homography", "seconds": 7.00, "max_rss_mb": 130.0, "exit": 0})"
+         "\n"
+      << R"({"stage": "make:oracle", "seconds": 0.70, "max_rss_mb": 110.0, "exit": 0})"
+         "\n"
+      << R"({"stage": "evaluate:oracle", "seconds": 6.00, "max_rss_mb": 120.0, "exit": 0})"
+         "\n";
   std::ofstream(work / "bench" / "pipeline.exit") << "2\n";
   Json metrics = {{"format", "docunfold.metrics"},
-                  {"metrics", {{"ms_ssim", 0.5}, {"ld", 10.0}, {"li_d", 2.0}, {"cer", 0.25},
-                               {"wer", nullptr}, {"surface_mean_pct", nullptr}}}};
+                  {"metrics",
+                   {{"ms_ssim", 0.5},
+                    {"ld", 10.0},
+                    {"li_d", 2.0},
+                    {"cer", 0.25},
+                    {"wer", nullptr},
+                    {"surface_mean_pct", nullptr}}}};
   std::ofstream(work / "70_eval" / "metrics-homography.json") << metrics.dump();
   metrics["metrics"]["ms_ssim"] = 0.9;
   metrics["metrics"]["cer"] = 0.05;
@@ -65,9 +76,9 @@ TEST(BenchReport, WritesValidJsonAndAReadableTable) {
     Json its = Json::array();
     for (const auto& [t, f] : last) its.push_back({{"seconds", t}, {"F", f}});
     return Json{{"seconds", seconds},
-                {"rounds", {{{"iterations", {{{"seconds", 0.5}, {"F", 9.0}}}},
-                             {"solver", {{"method", "x"}}}},
-                            {{"iterations", its}, {"solver", {{"method", "y"}}}}}}};
+                {"rounds",
+                 {{{"iterations", {{{"seconds", 0.5}, {"F", 9.0}}}}, {"solver", {{"method", "x"}}}},
+                  {{"iterations", its}, {"solver", {{"method", "y"}}}}}}};
   };
   fs::create_directories(work / "bench" / "solver_gn");
   fs::create_directories(work / "bench" / "solver_lbfgs");
@@ -80,12 +91,13 @@ TEST(BenchReport, WritesValidJsonAndAReadableTable) {
   CommandResult r = RunCommand(
       "/usr/bin/python3 " + Quote((SourceDir() / "scripts" / "bench_report.py").string()) +
       " --root " + Quote(SourceDir().string()) + " --work " + Quote((dir / "work").string()) +
-      " --out " + Quote(out.string()) + " --frontend truth --eval-flags=--ocr-at-truth-size --solver-set setA setA=" +
+      " --out " + Quote(out.string()) +
+      " --frontend truth --eval-flags=--ocr-at-truth-size --solver-set setA setA=" +
       Quote(data.string()));
   ASSERT_EQ(r.exit_code, 0) << r.output;
 
-  CommandResult v = RunCommand(Quote((SourceDir() / "scripts" / "validate-json").string()) +
-                               " " + Quote((out / "results.json").string()));
+  CommandResult v = RunCommand(Quote((SourceDir() / "scripts" / "validate-json").string()) + " " +
+                               Quote((out / "results.json").string()));
   EXPECT_EQ(v.exit_code, 0) << v.output;
   const Json j = Json::parse(ReadAll(out / "results.json"));
   ASSERT_EQ(j["sets"].size(), 1u);
@@ -100,12 +112,14 @@ TEST(BenchReport, WritesValidJsonAndAReadableTable) {
 
   const std::string md = ReadAll(out / "results.md");
   EXPECT_NE(md.find("| setA | homography | 0.5000 | 10.00 | 2.00 | 0.2500 | – |"),
-            std::string::npos) << md;
+            std::string::npos)
+      << md;
   EXPECT_NE(md.find("| setA | docunfold | failed: evaluate failed: boom |"), std::string::npos)
       << md;
   EXPECT_NE(md.find("| truth-frontend | init-mesh | render |"), std::string::npos) << md;
   EXPECT_NE(md.find("| setA | 2 × 64x48 | 1.5 / 200 | 3.2 / 100 | 2.0 / 90 (exit 1) | 6.8 |"),
-            std::string::npos) << md;
+            std::string::npos)
+      << md;
   EXPECT_NE(md.find("Summary: homography MS-SSIM 0.5000"), std::string::npos) << md;
   EXPECT_NE(md.find("docunfold-init: no render binary (setA)"), std::string::npos) << md;
   EXPECT_NE(md.find("Front end: **ground truth**"), std::string::npos) << md;

@@ -3,7 +3,6 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
-
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -24,8 +23,8 @@ fs::path MakeDataSet(const fs::path& root) {
   cv::Mat3b page(680, 880, cv::Vec3b(245, 245, 240));
   std::ofstream text(root / "ground_truth" / "text.txt");
   for (int i = 0; i < 4; ++i) {
-    cv::putText(page, kLines[i], cv::Point(40, 110 + 140 * i), cv::FONT_HERSHEY_SIMPLEX,
-                1.4, cv::Scalar(20, 20, 20), 3, cv::LINE_AA);
+    cv::putText(page, kLines[i], cv::Point(40, 110 + 140 * i), cv::FONT_HERSHEY_SIMPLEX, 1.4,
+                cv::Scalar(20, 20, 20), 3, cv::LINE_AA);
     text << kLines[i] << "\n";
   }
   // Some texture so that the flow has something to hold on to everywhere.
@@ -79,8 +78,8 @@ TEST_F(EvaluateCli, IdenticalImageScoresPerfectlyAndValidates) {
   EXPECT_EQ(m["ocr"]["reference_from_cache"], false);
   EXPECT_NE(r.output.find("MS-SSIM 1.0000"), std::string::npos) << r.output;
 
-  CommandResult v = RunCommand(Quote((SourceDir() / "scripts" / "validate-json").string()) +
-                               " " + Quote(out.string()));
+  CommandResult v = RunCommand(Quote((SourceDir() / "scripts" / "validate-json").string()) + " " +
+                               Quote(out.string()));
   EXPECT_EQ(v.exit_code, 0) << v.output;
 
   // A second row of the same data set reads the ground truth's OCR text from
@@ -168,8 +167,8 @@ TEST_F(EvaluateCli, BadUsageAndMissingFolders) {
                           Quote(out.string())));
   EXPECT_EQ(r.exit_code, 3) << r.output;
   EXPECT_NE(r.output.find("absent: no such data set folder"), std::string::npos) << r.output;
-  r = RunCommand(Evaluate(Args(flat, "--no-ocr --no-flow --mesh-dir " +
-                                         Quote((dir / "no-meshes").string()))));
+  r = RunCommand(
+      Evaluate(Args(flat, "--no-ocr --no-flow --mesh-dir " + Quote((dir / "no-meshes").string()))));
   EXPECT_EQ(r.exit_code, 3) << r.output;
   EXPECT_NE(r.output.find("mesh3d.ply: no such file"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(out));
@@ -196,8 +195,8 @@ TEST(BaselineCli, MissingInputsNameTheFile) {
                              Quote((dir / "out.png").string());
   CommandResult r = RunCommand(Baseline("--method homography" + common));
   EXPECT_EQ(r.exit_code, 3) << r.output;
-  EXPECT_NE(r.output.find("10_sfm/cameras.json: no such file (run sfm first)"),
-            std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("10_sfm/cameras.json: no such file (run sfm first)"), std::string::npos)
+      << r.output;
 
   // A minimal sfm output, but no boundary: homography needs it.
   fs::create_directories(dir / "work" / "10_sfm");

@@ -33,10 +33,10 @@ PlyData Grid(int nx, int ny, double spacing) {
 
 TEST(PointTriangleDistance, RegionsOfTheTriangle) {
   const Eigen::Vector3d a(0, 0, 0), b(1, 0, 0), c(0, 1, 0);
-  EXPECT_NEAR(PointTriangleDistance({0.2, 0.2, 0.5}, a, b, c), 0.5, 1e-12);   // face
+  EXPECT_NEAR(PointTriangleDistance({0.2, 0.2, 0.5}, a, b, c), 0.5, 1e-12);         // face
   EXPECT_NEAR(PointTriangleDistance({-1, -1, 0}, a, b, c), std::sqrt(2.0), 1e-12);  // vertex
-  EXPECT_NEAR(PointTriangleDistance({0.5, -2, 0}, a, b, c), 2.0, 1e-12);      // edge ab
-  EXPECT_NEAR(PointTriangleDistance({1, 1, 0}, a, b, c), std::sqrt(0.5), 1e-12);  // edge bc
+  EXPECT_NEAR(PointTriangleDistance({0.5, -2, 0}, a, b, c), 2.0, 1e-12);            // edge ab
+  EXPECT_NEAR(PointTriangleDistance({1, 1, 0}, a, b, c), std::sqrt(0.5), 1e-12);    // edge bc
 }
 
 TEST(AlignCameras, RecoversAKnownSimilarity) {
@@ -83,8 +83,8 @@ TEST(SurfaceDistance, PointsAboveAFlatGrid) {
   EXPECT_NEAR(distance({0.512, 0.377, 0.03}), 0.03, 1e-12);
   EXPECT_NEAR(distance({0.5, 0.5, -0.2}), 0.2, 1e-12);
   EXPECT_NEAR(distance({1.1, 0.5, 0}), 0.1, 1e-12);  // beyond the edge
-  const DistanceStats s = MeshToSurface({{0.3, 0.3, 0.01}, {0.6, 0.6, 0.03}},
-                                        Similarity{}, distance);
+  const DistanceStats s =
+      MeshToSurface({{0.3, 0.3, 0.01}, {0.6, 0.6, 0.03}}, Similarity{}, distance);
   EXPECT_NEAR(s.mean, 0.02, 1e-12);
   EXPECT_NEAR(s.max, 0.03, 1e-12);
   EXPECT_EQ(s.samples, 2u);

@@ -37,16 +37,16 @@ cv::Mat1b Shift(const cv::Mat1b& image, double dx, double dy) {
 TEST(EvaluationSize, MatchesMatlabImresizeCeil) {
   EXPECT_EQ(EvaluationSize({1240, 1753}), cv::Size(651, 920));
   EXPECT_EQ(EvaluationSize({472, 1181}), cv::Size(490, 1224));  // upscaled
-  EXPECT_EQ(EvaluationSize({880, 680}), cv::Size(880, 680));     // exactly the area
-  EXPECT_EQ(EvaluationSize({1760, 1360}), cv::Size(880, 680));   // exactly half
+  EXPECT_EQ(EvaluationSize({880, 680}), cv::Size(880, 680));    // exactly the area
+  EXPECT_EQ(EvaluationSize({1760, 1360}), cv::Size(880, 680));  // exactly half
 }
 
 TEST(MatlabGrey, UsesRgb2grayWeightsAndRounds) {
   cv::Mat3b bgr(1, 4);
-  bgr(0, 0) = {0, 0, 255};      // red
-  bgr(0, 1) = {0, 255, 0};      // green
-  bgr(0, 2) = {255, 0, 0};      // blue
-  bgr(0, 3) = {77, 77, 77};     // grey stays grey
+  bgr(0, 0) = {0, 0, 255};   // red
+  bgr(0, 1) = {0, 255, 0};   // green
+  bgr(0, 2) = {255, 0, 0};   // blue
+  bgr(0, 3) = {77, 77, 77};  // grey stays grey
   const cv::Mat1b g = MatlabGrey(bgr);
   EXPECT_EQ(g(0, 0), 76);   // 0.298936 * 255 = 76.23
   EXPECT_EQ(g(0, 1), 150);  // 0.587043 * 255 = 149.70

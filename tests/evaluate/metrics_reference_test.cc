@@ -45,9 +45,9 @@ TEST_P(MetricsReference, ReproducesMsSsimAndCer) {
   TempDir dir;
   const fs::path out = dir / "metrics.json";
   CommandResult r = RunCommand(
-      Quote(StageBinary("evaluate").string()) + " --data " + Quote(data.string()) +
-      " --result " + Quote((pair / expected["result"].get<std::string>()).string()) +
-      " --out " + Quote(out.string()) + " --no-flow --no-geometry --method " + GetParam());
+      Quote(StageBinary("evaluate").string()) + " --data " + Quote(data.string()) + " --result " +
+      Quote((pair / expected["result"].get<std::string>()).string()) + " --out " +
+      Quote(out.string()) + " --no-flow --no-geometry --method " + GetParam());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const Json m = ReadJson(out)["metrics"];
   const double ms_ssim = m["ms_ssim"].get<double>(), cer = m["cer"].get<double>();
@@ -67,7 +67,9 @@ INSTANTIATE_TEST_SUITE_P(Pairs, MetricsReference, ::testing::ValuesIn(ReferenceP
 GTEST_ALLOW_UNINSTANTIATED_PARAMETERIZED_TEST(MetricsReference);
 
 TEST(MetricsReferenceData, PresentOrSkipped) {
-  if (ReferencePairs().empty()) GTEST_SKIP() << SharedDir() / "metrics-reference" << " is absent";
+  if (ReferencePairs().empty())
+    GTEST_SKIP() << SharedDir() / "metrics-reference"
+                 << " is absent";
   EXPECT_GE(ReferencePairs().size(), 2u);
 }
 

@@ -1,8 +1,8 @@
 #include "stages/evaluate/text_metrics.h"
 
-#include <cmath>
-
 #include <gtest/gtest.h>
+
+#include <cmath>
 
 namespace docunfold::evaluate {
 namespace {
@@ -16,12 +16,17 @@ TEST(EditDistance, ClassicCases) {
 }
 
 TEST(Utf8ToCodePoints, CountsCodePointsNotBytes) {
-  EXPECT_EQ(Utf8ToCodePoints("na\xC3\xAFve").size(), 5u);       // naïve
-  EXPECT_EQ(Utf8ToCodePoints("\xE2\x82\xAC" "5").size(), 2u);    // €5
-  EXPECT_EQ(Utf8ToCodePoints("\xF0\x9F\x93\x84").size(), 1u);    // U+1F4C4
+  EXPECT_EQ(Utf8ToCodePoints("na\xC3\xAFve").size(), 5u);  // naïve
+  EXPECT_EQ(Utf8ToCodePoints("\xE2\x82\xAC"
+                             "5")
+                .size(),
+            2u);                                               // €5
+  EXPECT_EQ(Utf8ToCodePoints("\xF0\x9F\x93\x84").size(), 1u);  // U+1F4C4
   EXPECT_EQ(EditDistance(Utf8ToCodePoints("na\xC3\xAFve"), Utf8ToCodePoints("naive")), 1u);
   // A stray continuation byte or a cut-off sequence is one replacement char.
-  EXPECT_EQ(Utf8ToCodePoints("a\x80" "b"), std::u32string(U"a\uFFFDb"));
+  EXPECT_EQ(Utf8ToCodePoints("a\x80"
+                             "b"),
+            std::u32string(U"a\uFFFDb"));
   EXPECT_EQ(Utf8ToCodePoints("a\xE2\x82"), std::u32string(U"a\uFFFD\uFFFD"));
   EXPECT_EQ(CodePointsToUtf8(Utf8ToCodePoints("na\xC3\xAFve \xE2\x82\xAC")),
             "na\xC3\xAFve \xE2\x82\xAC");

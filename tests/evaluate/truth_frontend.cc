@@ -1,10 +1,9 @@
 #include "tests/evaluate/truth_frontend.h"
 
 #include <algorithm>
-#include <stdexcept>
-
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <stdexcept>
 
 #include "common/atomic_file.h"
 #include "common/json_io.h"
@@ -35,8 +34,7 @@ std::string ChooseTrueReference(const GroundTruth& gt) {
       best = camera.image;
     }
   }
-  if (best.empty() || best_score.second <= 0)
-    throw std::runtime_error("no view sees the page");
+  if (best.empty() || best_score.second <= 0) throw std::runtime_error("no view sees the page");
   return best;
 }
 
@@ -111,8 +109,7 @@ void WriteBoundaryFromTruth(const GroundTruth& gt, const std::string& reference,
   WriteJsonAtomic(out_dir / "boundary.json", doc);
 }
 
-std::string WriteTruthFrontEnd(const GroundTruth& gt, const fs::path& work,
-                               std::string reference) {
+std::string WriteTruthFrontEnd(const GroundTruth& gt, const fs::path& work, std::string reference) {
   if (reference.empty()) reference = ChooseTrueReference(gt);
   WriteSfmFromTruth(gt, reference, work / "10_sfm");
   WriteBoundaryFromTruth(gt, reference, work / "20_boundary");

@@ -18,8 +18,10 @@ int main(int argc, char** argv) {
   std::vector<std::string> args;
   bool meshes = false;
   for (int i = 1; i < argc; ++i) {
-    if (std::string(argv[i]) == "--meshes") meshes = true;
-    else args.push_back(argv[i]);
+    if (std::string(argv[i]) == "--meshes")
+      meshes = true;
+    else
+      args.push_back(argv[i]);
   }
   if (args.size() < 2 || args.size() > 3) {
     std::cerr << "usage: truth-frontend DATA WORK [REFERENCE] [--meshes]\n";

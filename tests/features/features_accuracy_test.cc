@@ -7,10 +7,10 @@
 // they are read off flat.png, see LinesFromFlatScan), so both are compared
 // directly. The figures are evaluate's (stages/evaluate/front_end.h), the
 // same that `evaluate --front-end` gives the benchmark for a pipeline run.
+#include <gtest/gtest.h>
+
 #include <cstdio>
 #include <cstdlib>
-
-#include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -29,10 +29,11 @@ using evaluate::LineFigures;
 using evaluate::SegmentIndex;
 
 void Print(const std::string& what, const LineFigures& f) {
-  std::printf("%-36s precision %.3f (text %.3f, edge %.3f)  recall %.3f (text %.3f, rules %.3f)  "
-              "segments %d text, %d edge\n",
-              what.c_str(), f.precision, f.precision_text, f.precision_edge, f.recall,
-              f.recall_text, f.recall_rule, f.text_segments, f.edge_segments);
+  std::printf(
+      "%-36s precision %.3f (text %.3f, edge %.3f)  recall %.3f (text %.3f, rules %.3f)  "
+      "segments %d text, %d edge\n",
+      what.c_str(), f.precision, f.precision_text, f.precision_edge, f.recall, f.recall_text,
+      f.recall_rule, f.text_segments, f.edge_segments);
 }
 
 std::vector<FeatureSegment> Segments(const FeaturesResult& r) {
@@ -53,8 +54,8 @@ void MaybeWriteDebug(const GroundTruth& gt, const PinholeCamera& cam, const cv::
   for (const TrueLine& l : evaluate::SeeTruth(gt, cam).lines)
     for (size_t k = 0; k + 1 < l.points.size(); ++k)
       cv::line(out, cv::Point(int(l.points[k].x()), int(l.points[k].y())),
-               cv::Point(int(l.points[k + 1].x()), int(l.points[k + 1].y())),
-               cv::Scalar(0, 200, 0), 1);
+               cv::Point(int(l.points[k + 1].x()), int(l.points[k + 1].y())), cv::Scalar(0, 200, 0),
+               1);
   std::string name = what;
   for (char& c : name)
     if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
@@ -79,8 +80,8 @@ TEST_P(FeaturesOnDataSet, SegmentsLieOnTrueLines) {
     const evaluate::TruthInView truth = evaluate::SeeTruth(*gt, cam);
     const FeaturesResult r = features::DetectFeatures(image, truth.page, {});
     const LineFigures f = evaluate::MeasureLines(truth, Segments(r));
-    const std::string what = DataSetName(GetParam()) + "/" + cam.image +
-                             (int(v) == frontal ? " (frontal)" : "");
+    const std::string what =
+        DataSetName(GetParam()) + "/" + cam.image + (int(v) == frontal ? " (frontal)" : "");
     Print(what, f);
     MaybeWriteDebug(*gt, cam, image, truth.page, r, what);
     length += f.detected_length;
@@ -107,8 +108,7 @@ TEST_P(FeaturesOnDataSet, FlatScanLinesAgreeWithSynth) {
   ASSERT_TRUE(gt);
   if (gt->lines.empty()) GTEST_SKIP() << "no features.json to compare with";
   SegmentIndex synth_index(16), flat_index(16);
-  for (const TrueLine& l : gt->lines)
-    synth_index.AddPolyline(l.points);
+  for (const TrueLine& l : gt->lines) synth_index.AddPolyline(l.points);
   double length = 0, good = 0;
   for (const TrueLine& l : LinesFromFlatScan(*gt)) {
     const Eigen::Vector2d a = l.points.front(), b = l.points.back();
@@ -116,7 +116,9 @@ TEST_P(FeaturesOnDataSet, FlatScanLinesAgreeWithSynth) {
     const int steps = std::max(1, int((b - a).norm()));
     for (int j = 0; j < steps; ++j) {
       length += (b - a).norm() / steps;
-      good += synth_index.Distance(a + (b - a) * ((j + 0.5) / steps)) <= 1.0 ? (b - a).norm() / steps : 0;
+      good += synth_index.Distance(a + (b - a) * ((j + 0.5) / steps)) <= 1.0
+                  ? (b - a).norm() / steps
+                  : 0;
     }
   }
   double synth_text = 0, covered = 0;
@@ -127,14 +129,17 @@ TEST_P(FeaturesOnDataSet, FlatScanLinesAgreeWithSynth) {
       const int steps = std::max(1, int((b - a).norm()));
       for (int j = 0; j < steps; ++j) {
         synth_text += (b - a).norm() / steps;
-        covered += flat_index.Distance(a + (b - a) * ((j + 0.5) / steps)) <= 1.0 ? (b - a).norm() / steps : 0;
+        covered += flat_index.Distance(a + (b - a) * ((j + 0.5) / steps)) <= 1.0
+                       ? (b - a).norm() / steps
+                       : 0;
       }
     }
   }
-  std::printf("%s: %.3f of the flat-scan lines within 1 px of synth's; they cover %.3f of "
-              "synth's text lines\n",
-              DataSetName(GetParam()).c_str(), length > 0 ? good / length : 0.0,
-              synth_text > 0 ? covered / synth_text : 0.0);
+  std::printf(
+      "%s: %.3f of the flat-scan lines within 1 px of synth's; they cover %.3f of "
+      "synth's text lines\n",
+      DataSetName(GetParam()).c_str(), length > 0 ? good / length : 0.0,
+      synth_text > 0 ? covered / synth_text : 0.0);
   EXPECT_GE(good, 0.9 * length);
   if (evaluate::LineRecallRequired(*gt)) {
     EXPECT_GE(covered, 0.8 * synth_text);

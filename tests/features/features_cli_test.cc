@@ -1,9 +1,9 @@
 // The detect-features command line: outputs and their format, and bad input
 // (missing or unreadable image or mask, a mask of the wrong size, an empty
 // mask) failing with exit 3, a message naming the file and no output.
-#include <fstream>
-
 #include <gtest/gtest.h>
+
+#include <fstream>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -24,8 +24,8 @@ Inputs WriteInputs(const TempDir& dir) {
   mask(cv::Rect(100, 60, 600, 480)).setTo(255);
   image.setTo(cv::Scalar(240, 240, 240), mask);
   for (int y = 120; y < 400; y += 28)
-    cv::putText(image, "Dolphins keep the happy fjord quality", {140, y},
-                cv::FONT_HERSHEY_COMPLEX, 0.6, cv::Scalar(20, 20, 20), 1, cv::LINE_AA);
+    cv::putText(image, "Dolphins keep the happy fjord quality", {140, y}, cv::FONT_HERSHEY_COMPLEX,
+                0.6, cv::Scalar(20, 20, 20), 1, cv::LINE_AA);
   cv::rectangle(image, cv::Rect(140, 460, 500, 2), cv::Scalar(30, 30, 30), cv::FILLED);
   Inputs in{dir / "reference.png", dir / "mask.png"};
   cv::imwrite(in.image.string(), image);

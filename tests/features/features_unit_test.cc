@@ -2,6 +2,7 @@
 // (upright, upside down, and bent at a crease), table rules, the page outline
 // kept out; bad masks; and the geometric helpers.
 #include <gtest/gtest.h>
+
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -92,8 +93,7 @@ TEST(DetectFeatures, AThinColumnRuleCutByRowRulesComesOutWhole) {
   Page p = DrawPage();
   p.image(cv::Rect(150, 580, 900, 260)).setTo(cv::Scalar(240, 240, 240));
   for (int y = 600; y <= 820; y += 20)
-    cv::rectangle(p.image, cv::Rect(200, y - 1, 800, 2), cv::Scalar(30, 30, 30),
-                  cv::FILLED);
+    cv::rectangle(p.image, cv::Rect(200, y - 1, 800, 2), cv::Scalar(30, 30, 30), cv::FILLED);
   const cv::Point2d top(400, 590), bottom(412, 830);
   cv::line(p.image, top, bottom, cv::Scalar(120, 120, 120), 1, cv::LINE_AA);
   auto longest_along_column = [&](const FeaturesOptions& options) {
@@ -104,9 +104,7 @@ TEST(DetectFeatures, AThinColumnRuleCutByRowRulesComesOutWhole) {
       double worst = 0;
       for (const cv::Point2d& q : {s.points.front(), s.points.back()})
         worst = std::max(worst, std::abs((q - top).cross(dir)));
-      if (worst <= 1.0)
-        longest =
-            std::max(longest, cv::norm(s.points.back() - s.points.front()));
+      if (worst <= 1.0) longest = std::max(longest, cv::norm(s.points.back() - s.points.front()));
     }
     return longest;
   };
@@ -153,7 +151,8 @@ TEST(DetectFeatures, TextLinesAreCutAtACrease) {
     }
   cv::Mat3b bent;
   cv::Mat1b bent_mask;
-  cv::remap(p.image, bent, map_x, map_y, cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar(90, 90, 90));
+  cv::remap(p.image, bent, map_x, map_y, cv::INTER_LINEAR, cv::BORDER_CONSTANT,
+            cv::Scalar(90, 90, 90));
   cv::remap(p.mask, bent_mask, map_x, map_y, cv::INTER_NEAREST);
   const FeaturesResult r = DetectFeatures(bent, bent_mask, {});
   ASSERT_GT(r.text_segments, 10);
@@ -237,7 +236,8 @@ TEST(FeatureHelpers, SplitWhereBentCutsAtTheKink) {
   const auto pieces = detail::SplitWhereBent(pts, 1.0);
   ASSERT_EQ(pieces.size(), 2u);
   EXPECT_NEAR(pieces[0].second, 100, 6);
-  const auto straight = detail::SplitWhereBent(std::vector<cv::Point2d>(pts.begin(), pts.begin() + 101), 1.0);
+  const auto straight =
+      detail::SplitWhereBent(std::vector<cv::Point2d>(pts.begin(), pts.begin() + 101), 1.0);
   EXPECT_EQ(straight.size(), 1u);
 }
 

@@ -3,6 +3,7 @@
 #include "tests/support/ground_truth.h"
 
 #include <gtest/gtest.h>
+
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -150,10 +151,13 @@ TEST(TruthFrame, ReferenceCameraIsTheOriginAndMeshesAreIsometric) {
   TrueMeshes m = TrueMeshesInReferenceFrame(*gt, true_ref.image);
   // Same pixels in the reference view; same picture in every other view.
   for (size_t i = 0; i < m.mesh3d.vertices.size(); i += 97) {
-    EXPECT_LT((ref->Project(m.mesh3d.vertices[i]) - true_ref.Project(gt->mesh.vertices[i])).norm(), 1e-3);
+    EXPECT_LT((ref->Project(m.mesh3d.vertices[i]) - true_ref.Project(gt->mesh.vertices[i])).norm(),
+              1e-3);
     for (size_t v = 1; v < cams.views.size(); ++v)
       EXPECT_LT((cams.views[v].Project(m.mesh3d.vertices[i]) -
-                 gt->cameras.views[v].Project(gt->mesh.vertices[i])).norm(), 1e-3);
+                 gt->cameras.views[v].Project(gt->mesh.vertices[i]))
+                    .norm(),
+                1e-3);
   }
   std::vector<double> depths;
   for (const auto& v : m.mesh3d.vertices) depths.push_back(v.z());

@@ -3,14 +3,13 @@
 // the page, an unusable boundary.
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+#include <Eigen/SVD>
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <memory>
 #include <regex>
-
-#include <Eigen/Geometry>
-#include <Eigen/SVD>
 
 #include "common/camera.h"
 #include "common/grid_mesh.h"
@@ -51,15 +50,16 @@ TEST(InitMeshCli, BlankMarginsContinueTheirPanels) {
   WriteFoldedPageWithMarginsWork(paper.path(), 40, 30, 0.15);
   const CommandResult a = RunCommand(InitMeshCommand(ours.path()));
   ASSERT_EQ(a.exit_code, 0) << a.output;
-  const CommandResult b = RunCommand(InitMeshCommand(
-      paper.path(), "--depth-model average --unsupported-fairness 1"));
+  const CommandResult b =
+      RunCommand(InitMeshCommand(paper.path(), "--depth-model average --unsupported-fairness 1"));
   ASSERT_EQ(b.exit_code, 0) << b.output;
   const double size = isometry::ModelSize(truth);
   const auto with = SurfaceDistance(ReadMeshPair(ours / "40_init"), truth);
   const auto without = SurfaceDistance(ReadMeshPair(paper / "40_init"), truth);
-  std::printf("[init] blank margins: mean distance %.3f %% of the model size (paper's settings "
-              "%.3f %%)\n",
-              100 * with.mean / size, 100 * without.mean / size);
+  std::printf(
+      "[init] blank margins: mean distance %.3f %% of the model size (paper's settings "
+      "%.3f %%)\n",
+      100 * with.mean / size, 100 * without.mean / size);
   EXPECT_LT(with.mean, 0.002 * size);
   EXPECT_LT(isometry::IsometryEdgeError(ReadMeshPair(ours / "40_init")).mean, 0.005);
 }
@@ -80,9 +80,10 @@ TEST(InitMeshCli, TheOutlineShapesBlankPaperBetweenFolds) {
   const double size = isometry::ModelSize(truth);
   const auto prior = SurfaceDistance(ReadMeshPair(with / "40_init"), truth);
   const auto points = SurfaceDistance(ReadMeshPair(without / "40_init"), truth);
-  std::printf("[init] zig-zag, blank band: mean distance of the lifted grid %.3f %% of the model "
-              "size with the outline prior, %.3f %% from the points alone\n",
-              100 * prior.mean / size, 100 * points.mean / size);
+  std::printf(
+      "[init] zig-zag, blank band: mean distance of the lifted grid %.3f %% of the model "
+      "size with the outline prior, %.3f %% from the points alone\n",
+      100 * prior.mean / size, 100 * points.mean / size);
   EXPECT_LT(prior.mean, 0.5 * points.mean);
   EXPECT_LT(prior.mean, 0.003 * size);
   const Json report = ReadJsonFile(with / "40_init/init.json");
@@ -126,7 +127,8 @@ TEST(InitMeshCli, OutlineHoldKeepsTheBorderOnTheOutline) {
   TempDir held, free;
   const MeshPair truth = WriteFoldedPageWithMarginsWork(held.path(), 40, 30, 0.15);
   WriteFoldedPageWithMarginsWork(free.path(), 40, 30, 0.15);
-  const CommandResult a = RunCommand(InitMeshCommand(held.path(), "--outline-hold 1 --outline-hold-support 1"));
+  const CommandResult a =
+      RunCommand(InitMeshCommand(held.path(), "--outline-hold 1 --outline-hold-support 1"));
   ASSERT_EQ(a.exit_code, 0) << a.output;
   const CommandResult b = RunCommand(InitMeshCommand(free.path()));
   ASSERT_EQ(b.exit_code, 0) << b.output;

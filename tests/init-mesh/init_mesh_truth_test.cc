@@ -3,13 +3,12 @@
 // boundary. One run of the stage per data set is shared by the checks.
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+#include <Eigen/SVD>
 #include <chrono>
 #include <cstdio>
 #include <memory>
 #include <regex>
-
-#include <Eigen/Geometry>
-#include <Eigen/SVD>
 
 #include "common/grid_mesh.h"
 #include "common/isometry/metrics.h"
@@ -141,8 +140,8 @@ void CheckPlysOpenInAssimp(const TruthCase& c) {
 
 void CheckInitJson(const TruthCase& c) {
   const fs::path json = c.dir->path() / "40_init/init.json";
-  const CommandResult v = RunCommand(Quote((SourceDir() / "scripts/validate-json").string()) +
-                                     " " + Quote(json.string()) + " 2>&1");
+  const CommandResult v = RunCommand(Quote((SourceDir() / "scripts/validate-json").string()) + " " +
+                                     Quote(json.string()) + " 2>&1");
   EXPECT_EQ(v.exit_code, 0) << c.set << "\n" << v.output;
   const Json doc = ReadJsonFile(json);
   EXPECT_EQ(doc["grid"]["source"], "coons") << c.set;

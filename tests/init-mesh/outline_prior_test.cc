@@ -1,9 +1,9 @@
 // OutlinePriorDepths on a flat page square to the camera: with outline
 // points on three of its sides, the fourth (straight between its corners)
 // completes the border whichever side it is, a grid row or a grid column.
-#include <gtest/gtest.h>
-
 #include "stages/init-mesh/outline_prior.h"
+
+#include <gtest/gtest.h>
 
 namespace docunfold::init_mesh {
 namespace {
@@ -67,10 +67,9 @@ TEST(OutlinePrior, TwoMeasuredSidesAreNotEnough) {
   }
   const std::vector<double> depths(two.size(), kDepth);
   const std::vector<double> grid_depths(page.grid_pixels.size(), kDepth);
-  const OutlinePriorResult none =
-      OutlinePriorDepths(page.grid, page.grid_pixels, grid_depths, page.sides,
-                         {true, true, true, true}, page.camera, two, depths, page.grid_pixels,
-                         grid_depths, {});
+  const OutlinePriorResult none = OutlinePriorDepths(
+      page.grid, page.grid_pixels, grid_depths, page.sides, {true, true, true, true}, page.camera,
+      two, depths, page.grid_pixels, grid_depths, {});
   EXPECT_FALSE(none.used);
   EXPECT_EQ(none.measured_sides, 2);
 }

@@ -4,14 +4,13 @@
 // sheet in front of a camera (no data needed).
 #pragma once
 
+#include <Eigen/Geometry>
 #include <algorithm>
-#include <cmath>
 #include <array>
+#include <cmath>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <Eigen/Geometry>
-#include <opencv2/core.hpp>
 
 #include "common/atomic_file.h"
 #include "common/camera.h"
@@ -62,7 +61,7 @@ inline void WriteBoundary(const fs::path& dir, const std::string& image, int wid
 // 0 or 1, projected; sides top (t = 0, s up), right (s = 1, t up), bottom
 // (t = 1, s up), left (s = 0, t up), as boundary.json orders them.
 inline std::array<std::vector<Eigen::Vector2d>, 4> TrueSides(const GroundTruth& gt,
-                                                            const PinholeCamera& cam) {
+                                                             const PinholeCamera& cam) {
   const auto& s = gt.mesh.FindProperty("s")->values;
   const auto& t = gt.mesh.FindProperty("t")->values;
   std::array<std::vector<std::pair<double, Eigen::Vector2d>>, 4> raw;
@@ -95,8 +94,8 @@ inline void WriteWorkFromTruth(const GroundTruth& gt, const std::string& referen
                                const fs::path& work, const SfmFromTruthOptions& sfm) {
   WriteSfmFromTruth(gt, reference, work / "10_sfm", sfm);
   const PinholeCamera& cam = *gt.cameras.Find(reference);
-  WriteBoundary(work / "20_boundary", "reference.png", cam.width, cam.height,
-                TrueSides(gt, cam), TruePageMask(gt, cam));
+  WriteBoundary(work / "20_boundary", "reference.png", cam.width, cam.height, TrueSides(gt, cam),
+                TruePageMask(gt, cam));
 }
 
 // An analytic scene: a curled sheet (0.21 x 0.297, curl radius 0.2) seen by
@@ -142,8 +141,8 @@ MeshPair WriteSheetWork(const fs::path& work, MeshPair sheet, int points, const 
   doc["reference"] = cam.image;
   doc["views"] = Json::array({CameraToJson(cam)});
   WriteJsonAtomic(work / "10_sfm/cameras.json", doc);
-  WriteImageAtomic(work / "10_sfm/reference.png", cv::Mat(cam.height, cam.width, CV_8UC3,
-                                                          cv::Scalar(90, 120, 90)));
+  WriteImageAtomic(work / "10_sfm/reference.png",
+                   cv::Mat(cam.height, cam.width, CV_8UC3, cv::Scalar(90, 120, 90)));
   // Sides from the border of the grid: top = row 0 (flat y = 0), etc.
   std::array<std::vector<Eigen::Vector2d>, 4> sides;
   const QuadGrid& g = sheet.grid;
@@ -161,10 +160,9 @@ MeshPair WriteSheetWork(const fs::path& work, MeshPair sheet, int points, const 
 
 inline MeshPair WriteSyntheticWork(const fs::path& work, int points = 1500,
                                    double keep_left_fraction = 1.0) {
-  return WriteSheetWork(work, CurledSheet(22, 30, 0.21, 0.297, 0.2), points,
-                        [&](const Eigen::Vector2d& flat) {
-                          return flat.x() <= keep_left_fraction * 0.21;
-                        });
+  return WriteSheetWork(
+      work, CurledSheet(22, 30, 0.21, 0.297, 0.2), points,
+      [&](const Eigen::Vector2d& flat) { return flat.x() <= keep_left_fraction * 0.21; });
 }
 
 // A page folded by `fold_deg` down its middle and tilted by `tilt_deg` about
@@ -174,9 +172,8 @@ inline MeshPair WriteFoldedPageWithMarginsWork(const fs::path& work, double fold
                                                double tilt_deg, double margin) {
   const int nx = 22, ny = 30;
   const double w = 0.21, h = 0.297;
-  MeshPair sheet = ProfileSheet(nx, ny, w, h, [&](int c) {
-    return c == nx / 2 - 1 ? fold_deg * M_PI / 180 : 0.0;
-  });
+  MeshPair sheet = ProfileSheet(
+      nx, ny, w, h, [&](int c) { return c == nx / 2 - 1 ? fold_deg * M_PI / 180 : 0.0; });
   const Eigen::Matrix3d tilt =
       Eigen::AngleAxisd(tilt_deg * M_PI / 180, Eigen::Vector3d::UnitX()).toRotationMatrix();
   const Eigen::Vector3d centre(0, 0, 1);

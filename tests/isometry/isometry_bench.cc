@@ -5,8 +5,8 @@
 //   isometry_bench <data set> [--method gn|lbfgs] [--solver auto|direct|cg]
 //                  [--rounds 4] [--points 6000] [--flatten 0.5]
 #include <chrono>
-#include <ctime>
 #include <cstring>
+#include <ctime>
 #include <iostream>
 #include <string>
 
@@ -29,7 +29,8 @@ int main(int argc, char** argv) {
   double flatten = 0.5;
   for (int i = 2; i + 1 < argc; i += 2) {
     const std::string k = argv[i], v = argv[i + 1];
-    if (k == "--method") o.method = v == "lbfgs" ? isometry::Method::kLbfgs : isometry::Method::kGaussNewton;
+    if (k == "--method")
+      o.method = v == "lbfgs" ? isometry::Method::kLbfgs : isometry::Method::kGaussNewton;
     if (k == "--solver")
       o.linear_solver = v == "direct" ? isometry::LinearSolver::kDirect
                         : v == "cg"   ? isometry::LinearSolver::kConjugateGradient
@@ -39,7 +40,9 @@ int main(int argc, char** argv) {
     if (k == "--flatten") flatten = std::stod(v);
     if (k == "--max-outer") o.max_outer_iterations = std::stoi(v);
     if (k == "--cg-iterations") o.cg_max_iterations = std::stoi(v);
-    if (k == "--iso") o.iso_normalization = v == "raw" ? isometry::IsoNormalization::kRaw : isometry::IsoNormalization::kStrain;
+    if (k == "--iso")
+      o.iso_normalization =
+          v == "raw" ? isometry::IsoNormalization::kRaw : isometry::IsoNormalization::kStrain;
     if (k == "--verbose") verbose = std::stoi(v);
     if (k == "--cg-tol") o.cg_tolerance = std::stod(v);
     if (k == "--fair2d") o.weights.fair2d = std::stod(v);
@@ -67,7 +70,9 @@ int main(int argc, char** argv) {
     for (auto& v : p.meshes.mesh3d) v.z() -= flatten * (v.z() - mean);
   }
   std::printf("%s: %zu points, reference %s\n", argv[1], p.points.size(), ref.c_str());
-  std::printf("round grid       iters  total_s  per_iter_s  footpt_s  step_s  lin_its  dist%%  iso_err%%  method\n");
+  std::printf(
+      "round grid       iters  total_s  per_iter_s  footpt_s  step_s  lin_its  dist%%  iso_err%%  "
+      "method\n");
   double total = 0, total_cpu = 0;
   for (int round = 0; round < rounds; ++round) {
     if (round > 0) p.meshes = isometry::SubdivideCatmullClark(p.meshes);
@@ -78,9 +83,11 @@ int main(int argc, char** argv) {
     p.meshes = r.meshes;
     if (verbose)
       for (const auto& it : r.report.iterations)
-        std::printf("   it %2d F %.6e iso %.3e dist %.3e f3 %.3e f2 %.3e in %d lin %d mu %.2e acc %d step %.3f\n",
-                    it.iteration, it.F, it.terms.iso, it.terms.dist, it.terms.fair3d, it.terms.fair2d,
-                    it.inliers, it.linear_iterations, it.damping, int(it.step_accepted), it.step_seconds);
+        std::printf(
+            "   it %2d F %.6e iso %.3e dist %.3e f3 %.3e f2 %.3e in %d lin %d mu %.2e acc %d step "
+            "%.3f\n",
+            it.iteration, it.F, it.terms.iso, it.terms.dist, it.terms.fair3d, it.terms.fair2d,
+            it.inliers, it.linear_iterations, it.damping, int(it.step_accepted), it.step_seconds);
     double foot = 0, step = 0;
     int lin = 0;
     for (const auto& it : r.report.iterations) {
@@ -91,11 +98,11 @@ int main(int argc, char** argv) {
     const int steps = std::max<int>(1, r.report.iterations.size() - 1);
     total += r.report.seconds;
     const auto d = testing::SurfaceDistance(p.meshes, fine);
-    std::printf("%5d %4dx%-4d %5zu  %7.3f  %10.4f  %8.4f  %6.3f  %7d  %5.3f  %8.4f  %6.3f  %s\n", round,
-                p.meshes.grid.nx, p.meshes.grid.ny, r.report.iterations.size(), r.report.seconds,
-                r.report.seconds / steps, foot / r.report.iterations.size(), step / steps, lin,
-                d.mean / diag * 100, isometry::IsometryEdgeError(p.meshes).mean * 100, cpu,
-                r.report.method.c_str());
+    std::printf("%5d %4dx%-4d %5zu  %7.3f  %10.4f  %8.4f  %6.3f  %7d  %5.3f  %8.4f  %6.3f  %s\n",
+                round, p.meshes.grid.nx, p.meshes.grid.ny, r.report.iterations.size(),
+                r.report.seconds, r.report.seconds / steps, foot / r.report.iterations.size(),
+                step / steps, lin, d.mean / diag * 100,
+                isometry::IsometryEdgeError(p.meshes).mean * 100, cpu, r.report.method.c_str());
   }
   std::printf("total %.3f s wall, %.3f s cpu\n", total, total_cpu);
   return 0;

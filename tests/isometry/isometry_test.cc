@@ -4,10 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
 #include <cmath>
 #include <random>
-
-#include <Eigen/Eigenvalues>
 
 #include "common/isometry/block_matrix.h"
 #include "common/isometry/mesh_index.h"
@@ -218,7 +217,9 @@ TEST_P(BlockMatrix, MatchesDenseJtJ) {
   Eigen::MatrixXd dense = Eigen::MatrixXd::Zero(n, n);
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> uni(-1, 1);
-  auto random5 = [&] { return isometry::internal::Vec5d(uni(rng), uni(rng), uni(rng), uni(rng), uni(rng)); };
+  auto random5 = [&] {
+    return isometry::internal::Vec5d(uni(rng), uni(rng), uni(rng), uni(rng), uni(rng));
+  };
   for (int q = 0; q < g.NumQuads(); ++q) {
     const auto c = g.Quad(q);
     std::array<isometry::internal::Vec5d, 4> d;
@@ -424,9 +425,10 @@ TEST(Isometry, StifferFairnessAwayFromPointsStraightensBlankParts) {
   isometry::SolveOptions stiff = paper;
   stiff.unsupported_fairness = 100;
   const double straightened = right_error(isometry::Solve(p, stiff).meshes);
-  std::printf("[isometry] blank half: off the plane by %.2f %% of the size with the paper's "
-              "fairness, %.2f %% with it stiffened away from points\n",
-              100 * bent / size, 100 * straightened / size);
+  std::printf(
+      "[isometry] blank half: off the plane by %.2f %% of the size with the paper's "
+      "fairness, %.2f %% with it stiffened away from points\n",
+      100 * bent / size, 100 * straightened / size);
   EXPECT_GT(bent, 0.03 * size);  // the case is real: nothing else undoes the hinge quickly
   EXPECT_LT(straightened, 0.2 * bent);
 }
@@ -476,8 +478,8 @@ TEST(Isometry, MarkersStraightenLinesAndFollowTheirRays) {
   p.lines = {{M_PI / 2, 0}, {0, 0}};
   for (int k = 0; k <= 40; ++k) {
     for (int line = 0; line < 2; ++line) {
-      const Eigen::Vector2d flat = line == 0 ? Eigen::Vector2d(0.02 * k, 0.3)
-                                             : Eigen::Vector2d(0.4, 0.015 * k);
+      const Eigen::Vector2d flat =
+          line == 0 ? Eigen::Vector2d(0.02 * k, 0.3) : Eigen::Vector2d(0.4, 0.015 * k);
       auto where = locator.Locate(flat);
       ASSERT_TRUE(where);
       isometry::Marker m;
@@ -539,9 +541,7 @@ TEST(Isometry, SolveIsTheSameForAnyNumberOfThreads) {
   const MeshPair truth = CurledSheet(61, 41, 0.8, 0.6, 0.45);
   Problem p;
   p.meshes = Flattened(truth, 0.6);
-  p.points =
-      SampleSurface(truth, 5000, 0.002 * isometry::ModelSize(truth), 0.02, 5)
-          .points;
+  p.points = SampleSurface(truth, 5000, 0.002 * isometry::ModelSize(truth), 0.02, 5).points;
   SolveOptions o;
   o.max_outer_iterations = 4;
   o.num_threads = 1;
@@ -551,8 +551,7 @@ TEST(Isometry, SolveIsTheSameForAnyNumberOfThreads) {
   EXPECT_EQ(one.report.method, "gauss-newton/cg");
   ASSERT_EQ(one.report.iterations.size(), two.report.iterations.size());
   for (size_t i = 0; i < one.report.iterations.size(); ++i)
-    EXPECT_EQ(one.report.iterations[i].F, two.report.iterations[i].F)
-        << "iteration " << i;
+    EXPECT_EQ(one.report.iterations[i].F, two.report.iterations[i].F) << "iteration " << i;
   EXPECT_TRUE(one.meshes.mesh3d == two.meshes.mesh3d);
   EXPECT_TRUE(one.meshes.mesh2d == two.meshes.mesh2d);
 }
@@ -572,8 +571,7 @@ Problem ThreeTextRows(const std::vector<double>& rows, bool text) {
     line.text_row = text;
     p.lines.push_back(line);
     for (int k = 0; k <= 30; ++k) {
-      const auto where =
-          locator.Locate(Eigen::Vector2d(0.1 + 0.02 * k, rows[l]));
+      const auto where = locator.Locate(Eigen::Vector2d(0.1 + 0.02 * k, rows[l]));
       if (!where) continue;
       isometry::Marker m;
       m.where = *where;
@@ -602,14 +600,11 @@ TEST(Isometry, TextRowsMoveTowardTheMiddleOfTheirNeighbours) {
   // Off, not text, or gaps too different (0.07 and 0.13: a paragraph
   // break): the rows stay where the rays hold them.
   o.line_spacing = 0;
-  EXPECT_NEAR(
-      isometry::Solve(ThreeTextRows({0.1, 0.19, 0.3}, true), o).lines[1].offset,
-      0.19, 0.001);
+  EXPECT_NEAR(isometry::Solve(ThreeTextRows({0.1, 0.19, 0.3}, true), o).lines[1].offset, 0.19,
+              0.001);
   o.line_spacing = 1;
-  EXPECT_NEAR(isometry::Solve(ThreeTextRows({0.1, 0.19, 0.3}, false), o)
-                  .lines[1]
-                  .offset,
-              0.19, 0.001);
+  EXPECT_NEAR(isometry::Solve(ThreeTextRows({0.1, 0.19, 0.3}, false), o).lines[1].offset, 0.19,
+              0.001);
   const auto uneven = isometry::Solve(ThreeTextRows({0.1, 0.17, 0.3}, true), o);
   EXPECT_EQ(uneven.report.iterations.front().spaced_rows, 0);
   EXPECT_NEAR(uneven.lines[1].offset, 0.17, 0.001);
@@ -735,12 +730,13 @@ TEST(Isometry, SubdivisionKeepsTheTruePairIsometric) {
     // A coarse sub-grid of the truth, subdivided twice.
     const MeshPair coarse = testing::SubGrid(truth, 8);
     const double coarse_before = isometry::IsometryEdgeError(coarse).mean;
-    const double coarse_after = isometry::IsometryEdgeError(
-        isometry::SubdivideCatmullClark(isometry::SubdivideCatmullClark(coarse))).mean;
+    const double coarse_after =
+        isometry::IsometryEdgeError(
+            isometry::SubdivideCatmullClark(isometry::SubdivideCatmullClark(coarse)))
+            .mean;
     EXPECT_LT(coarse_after, 3 * coarse_before + 0.002) << set;
-    std::cout << set.filename() << ": edge error " << before << " -> " << after
-              << " (full truth), " << coarse_before << " -> " << coarse_after
-              << " (every 8th line, subdivided twice)\n";
+    std::cout << set.filename() << ": edge error " << before << " -> " << after << " (full truth), "
+              << coarse_before << " -> " << coarse_after << " (every 8th line, subdivided twice)\n";
   }
 }
 
@@ -790,8 +786,8 @@ TEST(Isometry, ClosestPointIsExact) {
     double best = 1e9;
     for (const Triangle& t : tris)
       best = std::min(best, isometry::ClosestPointOnTriangle(p, sheet.mesh3d[t[0]],
-                                                             sheet.mesh3d[t[1]],
-                                                             sheet.mesh3d[t[2]]).distance);
+                                                             sheet.mesh3d[t[1]], sheet.mesh3d[t[2]])
+                                .distance);
     const auto c = index.Closest(p);
     ASSERT_TRUE(c);
     EXPECT_NEAR(c->distance, best, 1e-12);

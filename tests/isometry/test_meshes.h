@@ -3,17 +3,15 @@
 // on a coarser sub-grid), plus distances to a true surface.
 #pragma once
 
+#include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
+#include <opencv2/core.hpp>
 #include <random>
 #include <vector>
 
-#include <Eigen/Core>
-
 #include "common/grid_mesh.h"
 #include "common/isometry/mesh_index.h"
-#include <opencv2/core.hpp>
-
 #include "tests/support/ground_truth.h"
 #include "tests/support/test_support.h"
 #include "tests/support/truth_frame.h"
@@ -95,8 +93,10 @@ inline MeshPair Resample(const MeshPair& m, int nx, int ny) {
       const int c0 = std::min(int(u), m.grid.nx - 2), r0 = std::min(int(v), m.grid.ny - 2);
       const double fu = u - c0, fv = v - r0;
       auto mix = [&](const auto& field) {
-        return (1 - fv) * ((1 - fu) * field[m.grid.Index(r0, c0)] + fu * field[m.grid.Index(r0, c0 + 1)]) +
-               fv * ((1 - fu) * field[m.grid.Index(r0 + 1, c0)] + fu * field[m.grid.Index(r0 + 1, c0 + 1)]);
+        return (1 - fv) *
+                   ((1 - fu) * field[m.grid.Index(r0, c0)] + fu * field[m.grid.Index(r0, c0 + 1)]) +
+               fv * ((1 - fu) * field[m.grid.Index(r0 + 1, c0)] +
+                     fu * field[m.grid.Index(r0 + 1, c0 + 1)]);
       };
       s.mesh3d.push_back(mix(m.mesh3d));
       s.mesh2d.push_back(mix(m.mesh2d));
@@ -150,8 +150,8 @@ inline std::string ChooseReferenceView(const GroundTruth& gt) {
   for (const PinholeCamera& cam : gt.cameras.views) {
     bool inside = true;
     for (const Eigen::Vector2d& c : TrueCorners(gt, cam))
-      inside = inside && c.x() >= 2 && c.y() >= 2 && c.x() <= cam.width - 3 &&
-               c.y() <= cam.height - 3;
+      inside =
+          inside && c.x() >= 2 && c.y() >= 2 && c.x() <= cam.width - 3 && c.y() <= cam.height - 3;
     const double area = cv::countNonZero(TruePageMask(gt, cam)) * (inside ? 1.0 : 1e-3);
     if (area > best_area) {
       best_area = area;
@@ -188,16 +188,17 @@ inline SampledPoints SampleSurface(const MeshPair& m, int count, double sigma,
   }
   for (int i = 0; i < count; ++i) {
     const double pick = uni(rng) * total;
-    const size_t t = std::min(tris.size() - 1, size_t(std::lower_bound(cumulative.begin(),
-                                                                       cumulative.end(), pick) -
-                                                      cumulative.begin()));
+    const size_t t = std::min(
+        tris.size() - 1,
+        size_t(std::lower_bound(cumulative.begin(), cumulative.end(), pick) - cumulative.begin()));
     double a = uni(rng), b = uni(rng);
     if (a + b > 1) {
       a = 1 - a;
       b = 1 - b;
     }
     const Triangle& tri = tris[t];
-    Eigen::Vector3d p = (1 - a - b) * m.mesh3d[tri[0]] + a * m.mesh3d[tri[1]] + b * m.mesh3d[tri[2]];
+    Eigen::Vector3d p =
+        (1 - a - b) * m.mesh3d[tri[0]] + a * m.mesh3d[tri[1]] + b * m.mesh3d[tri[2]];
     p += sigma * Eigen::Vector3d(gauss(rng), gauss(rng), gauss(rng));
     s.points.push_back(p);
     s.outlier.push_back(false);

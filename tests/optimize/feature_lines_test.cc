@@ -2,9 +2,9 @@
 // a real page side that lie off M's image go on M's border (so the ray term
 // can pull the border to the outline); other segments' samples off M, and
 // every sample without it, are dropped.
-#include <gtest/gtest.h>
-
 #include "stages/optimize/feature_lines.h"
+
+#include <gtest/gtest.h>
 
 namespace docunfold::optimize {
 namespace {
@@ -56,15 +56,13 @@ TEST(CastMarkers, PageSideSamplesOffTheMeshGoOnItsBorder) {
     const Eigen::Vector2d flat = PointOnMesh2d(scene.meshes, set.markers[i].where);
     EXPECT_NEAR(flat.x(), -0.5, 1e-9) << i;
     EXPECT_NEAR(flat.y(), (set.pixel[i].y() - 400) / 800 * 4, 1e-9) << i;
-    EXPECT_GT(set.markers[i].ray_direction.dot(
-                  scene.camera.RayDirection(set.pixel[i])), 1 - 1e-12);
+    EXPECT_GT(set.markers[i].ray_direction.dot(scene.camera.RayDirection(set.pixel[i])), 1 - 1e-12);
   }
   // Beyond the radius, or by default (off): none.
   EXPECT_EQ(CastMarkers(scene.meshes, scene.camera, {LeftOf("boundary", 30)}, Snapping())
                 .markers_of_segment[0],
             0);
-  EXPECT_EQ(CastMarkers(scene.meshes, scene.camera, {LeftOf("boundary", 12)})
-                .markers_of_segment[0],
+  EXPECT_EQ(CastMarkers(scene.meshes, scene.camera, {LeftOf("boundary", 12)}).markers_of_segment[0],
             0);
 }
 
@@ -167,14 +165,12 @@ TEST(CornerMarkers, HoldTheGridCornersToTheRaysOfRealCornersNearThem) {
     const isometry::Marker& m = markers[k];
     EXPECT_EQ(m.line, -1);
     EXPECT_TRUE(m.across.isZero());
-    EXPECT_LT((PointOnMesh3d(scene.meshes, m.where) - scene.meshes.mesh3d[corner_vertex[k]])
-                  .norm(),
+    EXPECT_LT((PointOnMesh3d(scene.meshes, m.where) - scene.meshes.mesh3d[corner_vertex[k]]).norm(),
               1e-12)
         << k;
     EXPECT_GT(m.ray_direction.dot(scene.camera.RayDirection(boundary.corners[k])), 1 - 1e-12);
   }
-  EXPECT_EQ(CornerMarkers(scene.meshes, boundary, scene.camera, {false, true, false, false})
-                .size(),
+  EXPECT_EQ(CornerMarkers(scene.meshes, boundary, scene.camera, {false, true, false, false}).size(),
             1u);
 }
 

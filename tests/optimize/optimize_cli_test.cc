@@ -15,8 +15,8 @@ std::string OptimizeCommand(const fs::path& work, const fs::path& points, const 
   return Quote(StageBinary("optimize").string()) + " --sfm " + Quote((work / "10_sfm").string()) +
          " --boundary " + Quote((work / "20_boundary").string()) + " --features " +
          Quote((work / "features.json").string()) + " --init " +
-         Quote((work / "40_init").string()) + " --points " + Quote(points.string()) +
-         " --out " + Quote(out.string()) + " --rounds 2 --no-scene 2>&1";
+         Quote((work / "40_init").string()) + " --points " + Quote(points.string()) + " --out " +
+         Quote(out.string()) + " --rounds 2 --no-scene 2>&1";
 }
 
 TEST(OptimizeCli, PointsOutsideTheDocumentRegionAreNotFitted) {
@@ -46,11 +46,11 @@ TEST(OptimizeCli, PointsOutsideTheDocumentRegionAreNotFitted) {
   WritePly(dir / "with_table.ply", cloud);
   ASSERT_GT(table, 1000);
 
-  const CommandResult page = RunCommand(
-      OptimizeCommand(dir.path(), dir / "10_sfm/points.ply", dir / "page"));
+  const CommandResult page =
+      RunCommand(OptimizeCommand(dir.path(), dir / "10_sfm/points.ply", dir / "page"));
   ASSERT_EQ(page.exit_code, 0) << page.output;
-  const CommandResult both = RunCommand(
-      OptimizeCommand(dir.path(), dir / "with_table.ply", dir / "both"));
+  const CommandResult both =
+      RunCommand(OptimizeCommand(dir.path(), dir / "with_table.ply", dir / "both"));
   ASSERT_EQ(both.exit_code, 0) << both.output;
   EXPECT_EQ(ReadJsonFile(dir / "both/log.json")["points_in_region"].get<size_t>(), page_points);
   const MeshPair a = ReadMeshPair(dir / "page"), b = ReadMeshPair(dir / "both");
@@ -88,9 +88,9 @@ TEST(OptimizeCli, TextRowsTurnAnOffUprightFlatMesh) {
   ASSERT_GE(segments.size(), 40u);
   // The reader's down: the sheet's rows run along flat x, so down is flat +y,
   // seen in the image between two rows.
-  const Eigen::Vector2d down_px =
-      (cam.Project(truth.mesh3d[truth.grid.Index(16, 10)]) -
-       cam.Project(truth.mesh3d[truth.grid.Index(14, 10)])).normalized();
+  const Eigen::Vector2d down_px = (cam.Project(truth.mesh3d[truth.grid.Index(16, 10)]) -
+                                   cam.Project(truth.mesh3d[truth.grid.Index(14, 10)]))
+                                      .normalized();
   WriteJsonAtomic(dir / "features.json", {{"format", "docunfold.features"},
                                           {"version", 1},
                                           {"text_down", {down_px.x(), down_px.y()}},
@@ -129,8 +129,8 @@ TEST(OptimizeCli, TextRowsTurnAnOffUprightFlatMesh) {
   // By default every line runs exactly along an axis of M'; --axis-lines
   // features holds the text lines only, the page sides only straight;
   // --axis-lines none (the paper) holds neither.
-  const CommandResult features = RunCommand(
-      OptimizeCommand(dir.path(), points, dir / "features") + " --axis-lines features");
+  const CommandResult features =
+      RunCommand(OptimizeCommand(dir.path(), points, dir / "features") + " --axis-lines features");
   ASSERT_EQ(features.exit_code, 0) << features.output;
   const CommandResult none =
       RunCommand(OptimizeCommand(dir.path(), points, dir / "none") + " --axis-lines none");
@@ -146,7 +146,8 @@ TEST(OptimizeCli, TextRowsTurnAnOffUprightFlatMesh) {
     return off;
   };
   auto largest = [](const std::vector<double>& v) { return *std::max_element(v.begin(), v.end()); };
-  const auto all_text = slants(dir / "turned", "text"), all_sides = slants(dir / "turned", "boundary");
+  const auto all_text = slants(dir / "turned", "text"),
+             all_sides = slants(dir / "turned", "boundary");
   ASSERT_GE(all_text.size(), 10u);
   ASSERT_EQ(all_sides.size(), 4u);
   EXPECT_LT(largest(all_text), 1e-12);

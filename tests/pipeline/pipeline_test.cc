@@ -20,11 +20,10 @@ class Pipeline : public ::testing::Test {
  protected:
   fs::path Work() const { return dir_.path() / "work"; }
   CommandResult Make(const std::string& args) const {
-    return RunCommand("make --no-print-directory -f " +
-                      Quote((SourceDir() / "pipeline.mk").string()) + " DATA=" + kSample +
-                      " WORK=" + Quote(Work().string()) + " NO_BUILD=1" +
-                      " BUILD=" + Quote(fs::path(DOCUNFOLD_BIN_DIR).parent_path().string()) +
-                      " " + args);
+    return RunCommand(
+        "make --no-print-directory -f " + Quote((SourceDir() / "pipeline.mk").string()) +
+        " DATA=" + kSample + " WORK=" + Quote(Work().string()) + " NO_BUILD=1" +
+        " BUILD=" + Quote(fs::path(DOCUNFOLD_BIN_DIR).parent_path().string()) + " " + args);
   }
   fs::file_time_type MTime(const std::string& rel) const {
     return fs::last_write_time(Work() / rel);
@@ -48,13 +47,13 @@ TEST_F(Pipeline, WritesEveryStageOutputAndTheyValidate) {
   for (const char* stage : {"bin/sfm", "bin/segment-boundary", "bin/densify", "bin/detect-features",
                             "bin/init-mesh", "bin/optimize", "bin/render"})
     EXPECT_EQ(first_.output.find(stage), std::string::npos) << first_.output;
-  for (const char* f : {"10_sfm/cameras.json", "10_sfm/points.ply", "10_sfm/reference.png",
-                        "20_boundary/boundary.json", "20_boundary/mask.png",
-                        "20_boundary/overlay.png", "25_points/points.ply",
-                        "25_points/points.json", "25_points/overlay.png", "30_features/features.json",
-                        "30_features/overlay.png", "40_init/mesh3d.ply",
-                        "50_optimize/log.json", "50_optimize/scene.glb", "60_render/rectified.png",
-                        "70_eval/metrics.json", "report.html"})
+  for (const char* f :
+       {"10_sfm/cameras.json", "10_sfm/points.ply", "10_sfm/reference.png",
+        "20_boundary/boundary.json", "20_boundary/mask.png", "20_boundary/overlay.png",
+        "25_points/points.ply", "25_points/points.json", "25_points/overlay.png",
+        "30_features/features.json", "30_features/overlay.png", "40_init/mesh3d.ply",
+        "50_optimize/log.json", "50_optimize/scene.glb", "60_render/rectified.png",
+        "70_eval/metrics.json", "report.html"})
     EXPECT_TRUE(fs::is_regular_file(Work() / f)) << f;
   for (const auto& e : fs::recursive_directory_iterator(Work())) {
     if (e.path().extension() != ".json" || e.path().string().find("/colmap/") != std::string::npos)
@@ -96,11 +95,13 @@ TEST_F(Pipeline, SecondRunDoesNothingAndFlagsRerunOnlyDownstream) {
   ASSERT_EQ(sparse.exit_code, 0) << sparse.output;
   EXPECT_EQ(sparse.output.find("bin/densify"), std::string::npos) << sparse.output;
   EXPECT_NE(sparse.output.find("--points " + (Work() / "10_sfm/points.ply").string()),
-            std::string::npos) << sparse.output;
+            std::string::npos)
+      << sparse.output;
   CommandResult dense = Make("all EVAL_FLAGS=--no-ocr");
   ASSERT_EQ(dense.exit_code, 0) << dense.output;
   EXPECT_NE(dense.output.find("--points " + (Work() / "25_points/points.ply").string()),
-            std::string::npos) << dense.output;
+            std::string::npos)
+      << dense.output;
 }
 
 TEST_F(Pipeline, FeaturesFromAnotherDetectorAreValidatedAndUsed) {
@@ -142,9 +143,9 @@ TEST_F(Pipeline, FeaturesFromAnotherDetectorAreValidatedAndUsed) {
 }
 
 TEST(PipelineInput, UnknownDataSetIsReported) {
-  CommandResult r = RunCommand("make --no-print-directory -f " +
-                               Quote((SourceDir() / "pipeline.mk").string()) +
-                               " DATA=no-such-set WORK=/tmp/docunfold-none sfm");
+  CommandResult r =
+      RunCommand("make --no-print-directory -f " + Quote((SourceDir() / "pipeline.mk").string()) +
+                 " DATA=no-such-set WORK=/tmp/docunfold-none sfm");
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.output.find("DATA=no-such-set: no data set"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists("/tmp/docunfold-none/10_sfm/cameras.json"));

@@ -27,19 +27,17 @@ class RenderCli : public ::testing::Test {
 
   // A private copy of the scene for a test that changes it.
   fs::path CopyScene() {
-    fs::copy(scene_dir_->path(), dir_.path() / "work",
-             fs::copy_options::recursive);
+    fs::copy(scene_dir_->path(), dir_.path() / "work", fs::copy_options::recursive);
     return dir_.path() / "work";
   }
 
   static CommandResult Render(const fs::path& work, const fs::path& out,
                               const std::string& flags = "",
                               const std::string& meshes = "40_init") {
-    return RunCommand(Quote(StageBinary("render").string()) + " --sfm " +
-                      Quote((work / "10_sfm").string()) + " --boundary " +
-                      Quote((work / "20_boundary").string()) + " --meshes " +
-                      Quote((work / meshes).string()) + " --out " +
-                      Quote(out.string()) + " " + flags);
+    return RunCommand(
+        Quote(StageBinary("render").string()) + " --sfm " + Quote((work / "10_sfm").string()) +
+        " --boundary " + Quote((work / "20_boundary").string()) + " --meshes " +
+        Quote((work / meshes).string()) + " --out " + Quote(out.string()) + " " + flags);
   }
 
   // The run failed cleanly: the exit code, a message naming `names`, and
@@ -78,9 +76,8 @@ TEST_F(RenderCli, WritesTheImagesAndAValidReport) {
   EXPECT_EQ(report["crop"]["rule"], "boundary-lines");
   EXPECT_EQ(report["size_rule"], "reference-density");
   EXPECT_TRUE(report["timing_s"].contains("read"));
-  const CommandResult v =
-      RunCommand(Quote((SourceDir() / "scripts/validate-json").string()) + " " +
-                 Quote((out / "render.json").string()));
+  const CommandResult v = RunCommand(Quote((SourceDir() / "scripts/validate-json").string()) + " " +
+                                     Quote((out / "render.json").string()));
   EXPECT_EQ(v.exit_code, 0) << v.output;
   // Nothing but the three outputs (no temporary files left behind).
   int files = 0;
@@ -93,8 +90,7 @@ TEST_F(RenderCli, WritesTheImagesAndAValidReport) {
 
 TEST_F(RenderCli, WidthFlagSetsTheOutputWidth) {
   const fs::path out = dir_ / "out";
-  const CommandResult r =
-      Render(scene(), out, "--width 150 --fill white --no-deskew");
+  const CommandResult r = Render(scene(), out, "--width 150 --fill white --no-deskew");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const cv::Mat image = cv::imread((out / "rectified.png").string());
   EXPECT_EQ(image.cols, 150);
@@ -195,16 +191,16 @@ TEST_F(RenderCli, DeskewFollowsTheLinesOfLinesJson) {
                                {"segments", segments},
                                {"text_down", {down, 0.0}}});
     const std::string name = "features" + std::to_string(turns);
-    ASSERT_EQ(Render(work, dir_ / name, "--width 100 --features " + Quote(features.string()))
-                  .exit_code,
-              0);
+    ASSERT_EQ(
+        Render(work, dir_ / name, "--width 100 --features " + Quote(features.string())).exit_code,
+        0);
     const Json o = ReadJsonFile(dir_ / name / "render.json")["orientation"];
     EXPECT_EQ(o["quarter_turns_clockwise"], turns) << o.dump();
     EXPECT_NE(o.value("note", "").find("features.json"), std::string::npos) << o.dump();
   }
-  ExpectFailure(Render(work, dir_ / "nofeatures", "--features " +
-                                                    Quote((work / "none.json").string())),
-                3, "none.json", dir_ / "nofeatures");
+  ExpectFailure(
+      Render(work, dir_ / "nofeatures", "--features " + Quote((work / "none.json").string())), 3,
+      "none.json", dir_ / "nofeatures");
   WriteTextAtomic(work / "40_init/lines.json", "{\"lines\": [{\"normal\": [0, 1]}]}");
   ExpectFailure(Render(work, dir_ / "broken"), 3, "lines.json:/lines/0", dir_ / "broken");
   WriteTextAtomic(work / "40_init/lines.json",
@@ -214,8 +210,7 @@ TEST_F(RenderCli, DeskewFollowsTheLinesOfLinesJson) {
 
 TEST_F(RenderCli, ContradictoryFlagsAreUsageErrors) {
   const fs::path out = dir_ / "out";
-  ExpectFailure(Render(scene(), out, "--width 100 --dpi 300"), 2, "excludes",
-                out);
+  ExpectFailure(Render(scene(), out, "--width 100 --dpi 300"), 2, "excludes", out);
   ExpectFailure(Render(scene(), out, "--dpi 300"), 2, "--page-width-mm", out);
   ExpectFailure(Render(scene(), out, "--fill purple"), 2, "--fill", out);
   ExpectFailure(Render(scene(), out, "--width 100000"), 2, "--max-pixels", out);
@@ -284,8 +279,7 @@ TEST_F(RenderCli, BoundaryOfAnotherImageIsBadInput) {
   b["height"] = 1200;
   WriteJsonAtomic(work / "20_boundary" / "boundary.json", b);
   const fs::path out = dir_ / "out";
-  ExpectFailure(Render(work, out), 3,
-                "boundary.json: made for a 1600x1200 image", out);
+  ExpectFailure(Render(work, out), 3, "boundary.json: made for a 1600x1200 image", out);
   fs::remove(work / "20_boundary" / "boundary.json");
   ExpectFailure(Render(work, out), 3, "boundary.json", out);
 }

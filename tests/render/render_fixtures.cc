@@ -28,9 +28,8 @@ Json Points(const std::vector<Eigen::Vector2d>& pts) {
 // The part of a projected border inside the image. It is a real side when
 // most of it is inside (the page edge is seen, only its end is cut off);
 // otherwise the image border stands in for it, not real.
-std::vector<Eigen::Vector2d> ClipToImage(
-    const std::vector<Eigen::Vector2d>& pts, int width, int height,
-    bool* real) {
+std::vector<Eigen::Vector2d> ClipToImage(const std::vector<Eigen::Vector2d>& pts, int width,
+                                         int height, bool* real) {
   std::vector<Eigen::Vector2d> out;
   for (const auto& p : pts)
     if (Inside(p, width, height)) out.push_back(p);
@@ -38,8 +37,7 @@ std::vector<Eigen::Vector2d> ClipToImage(
   if (!*real) {
     out.clear();
     for (const auto& p : pts)
-      out.emplace_back(std::clamp(p.x(), 0.0, width - 1.0),
-                       std::clamp(p.y(), 0.0, height - 1.0));
+      out.emplace_back(std::clamp(p.x(), 0.0, width - 1.0), std::clamp(p.y(), 0.0, height - 1.0));
   }
   return out;
 }
@@ -70,13 +68,10 @@ void WriteBoundaryJson(const fs::path& file, int width, int height,
   std::vector<Eigen::Vector2d> contour;
   for (const auto& p : sides[0]) contour.push_back(p);
   for (const auto& p : sides[1]) contour.push_back(p);
-  for (auto it = sides[2].rbegin(); it != sides[2].rend(); ++it)
-    contour.push_back(*it);
-  for (auto it = sides[3].rbegin(); it != sides[3].rend(); ++it)
-    contour.push_back(*it);
+  for (auto it = sides[2].rbegin(); it != sides[2].rend(); ++it) contour.push_back(*it);
+  for (auto it = sides[3].rbegin(); it != sides[3].rend(); ++it) contour.push_back(*it);
   doc["contour"] = Points(contour);
-  doc["corners"] = Points(
-      {sides[0].front(), sides[0].back(), sides[2].back(), sides[2].front()});
+  doc["corners"] = Points({sides[0].front(), sides[0].back(), sides[2].back(), sides[2].front()});
   const char* names[4] = {"top", "right", "bottom", "left"};
   doc["sides"] = Json::object();
   for (int i = 0; i < 4; ++i)
@@ -92,13 +87,10 @@ TruthInputs MakeTruthInputs(const GroundTruth& gt) {
   out.photo = ReadImage(gt.root / "images" / reference);
   const TrueMeshes truth = TrueMeshesInReferenceFrame(gt, reference);
   const auto grid = truth.mesh3d.GridSize();
-  if (!grid)
-    throw std::runtime_error(gt.root.string() +
-                             ": true mesh has no grid comment");
+  if (!grid) throw std::runtime_error(gt.root.string() + ": true mesh has no grid comment");
   out.meshes.grid = {(*grid)[0], (*grid)[1]};
   out.meshes.mesh3d = truth.mesh3d.vertices;
-  for (const auto& v : truth.mesh2d.vertices)
-    out.meshes.mesh2d.push_back(v.head<2>());
+  for (const auto& v : truth.mesh2d.vertices) out.meshes.mesh2d.push_back(v.head<2>());
   // Page outline: border vertices of the true grid ordered along each side.
   const auto& s = gt.mesh.FindProperty("s")->values;
   const auto& t = gt.mesh.FindProperty("t")->values;
@@ -124,10 +116,10 @@ TruthInputs MakeTruthInputs(const GroundTruth& gt) {
 
 namespace {
 
-render::RenderInputs Inputs(
-    const PinholeCamera& camera, const cv::Mat3b& photo, const MeshPair& meshes,
-    const std::array<std::vector<Eigen::Vector2d>, 4>& sides,
-    const std::array<bool, 4>& real) {
+render::RenderInputs Inputs(const PinholeCamera& camera, const cv::Mat3b& photo,
+                            const MeshPair& meshes,
+                            const std::array<std::vector<Eigen::Vector2d>, 4>& sides,
+                            const std::array<bool, 4>& real) {
   render::RenderInputs in;
   in.camera = camera;
   in.reference = photo;
@@ -171,16 +163,14 @@ cv::Mat3b MakeTexture(int width, int height) {
   for (int y = line_h * 3; y < height * 2 / 3; y += line_h) {
     std::string line;
     for (int w = 0; w < 12; ++w) line += std::string(words[rng() % 10]) + " ";
-    cv::putText(tex, line, cv::Point(width / 20, y), cv::FONT_HERSHEY_SIMPLEX,
-                font, cv::Scalar(30, 30, 30), std::max(1, int(font * 2)),
-                cv::LINE_AA);
+    cv::putText(tex, line, cv::Point(width / 20, y), cv::FONT_HERSHEY_SIMPLEX, font,
+                cv::Scalar(30, 30, 30), std::max(1, int(font * 2)), cv::LINE_AA);
   }
   // Table rules and a frame.
   for (int y = height * 2 / 3 + 10; y < height - 20; y += line_h)
-    cv::line(tex, cv::Point(width / 20, y), cv::Point(width * 19 / 20, y),
-             cv::Scalar(60, 40, 20), 2);
-  cv::rectangle(tex, cv::Rect(4, 4, width - 8, height - 8),
-                cv::Scalar(90, 60, 30), 3);
+    cv::line(tex, cv::Point(width / 20, y), cv::Point(width * 19 / 20, y), cv::Scalar(60, 40, 20),
+             2);
+  cv::rectangle(tex, cv::Rect(4, 4, width - 8, height - 8), cv::Scalar(90, 60, 30), 3);
   // Fine stripes (period 3 texture pixels) in a corner patch.
   for (int y = height - 120; y < height - 30; ++y)
     for (int x = width * 2 / 3; x < width - 30; ++x)
@@ -196,13 +186,12 @@ SyntheticScene MakeScene(const SceneOptions& o) {
   s.camera.image = "view_00.png";
   s.camera.width = o.image_width;
   s.camera.height = o.image_height;
-  s.camera.K << o.focal, 0, (o.image_width - 1) / 2.0, 0, o.focal,
-      (o.image_height - 1) / 2.0, 0, 0, 1;
+  s.camera.K << o.focal, 0, (o.image_width - 1) / 2.0, 0, o.focal, (o.image_height - 1) / 2.0, 0, 0,
+      1;
   const int nx = 43, ny = 57;
   s.meshes.grid = {nx, ny};
   const Eigen::Matrix3d tilt =
-      Eigen::AngleAxisd(o.tilt_deg * M_PI / 180, Eigen::Vector3d::UnitX())
-          .toRotationMatrix();
+      Eigen::AngleAxisd(o.tilt_deg * M_PI / 180, Eigen::Vector3d::UnitX()).toRotationMatrix();
   for (int r = 0; r < ny; ++r)
     for (int c = 0; c < nx; ++c) {
       const double a = o.page_w * c / (nx - 1), b = o.page_h * r / (ny - 1);
@@ -210,8 +199,7 @@ SyntheticScene MakeScene(const SceneOptions& o) {
       const double half = o.page_w / 2;
       if (o.radius > 0 && a > half) {
         const double theta = (a - half) / o.radius;
-        local = {half + o.radius * std::sin(theta), b,
-                 -o.radius * (1 - std::cos(theta))};
+        local = {half + o.radius * std::sin(theta), b, -o.radius * (1 - std::cos(theta))};
       }
       s.meshes.mesh3d.push_back(o.page_origin + tilt * local);
       s.meshes.mesh2d.emplace_back(a, b);
@@ -219,33 +207,26 @@ SyntheticScene MakeScene(const SceneOptions& o) {
   // The photo: 3x3 supersampled texture lookup over a plain table.
   const double ss = 3;
   const auto tris = s.meshes.grid.Triangles();
-  const RasterResult raster =
-      RasterizeMesh(s.camera, s.meshes.mesh3d, tris, ss);
+  const RasterResult raster = RasterizeMesh(s.camera, s.meshes.mesh3d, tris, ss);
   Eigen::MatrixXf uv(s.meshes.mesh2d.size(), 2);
   for (size_t i = 0; i < s.meshes.mesh2d.size(); ++i) {
     uv(i, 0) = float(s.meshes.mesh2d[i].x() / o.page_w * o.texture_width - 0.5);
-    uv(i, 1) =
-        float(s.meshes.mesh2d[i].y() / o.page_h * o.texture_height - 0.5);
+    uv(i, 1) = float(s.meshes.mesh2d[i].y() / o.page_h * o.texture_height - 0.5);
   }
   cv::Mat map = InterpolateAttributes(raster, tris, uv);
   cv::Mat3b big;
-  cv::remap(s.texture, big, map, cv::noArray(), cv::INTER_LINEAR,
-            cv::BORDER_CONSTANT, cv::Scalar(70, 110, 60));
-  cv::resize(big, s.photo, cv::Size(o.image_width, o.image_height), 0, 0,
-             cv::INTER_AREA);
+  cv::remap(s.texture, big, map, cv::noArray(), cv::INTER_LINEAR, cv::BORDER_CONSTANT,
+            cv::Scalar(70, 110, 60));
+  cv::resize(big, s.photo, cv::Size(o.image_width, o.image_height), 0, 0, cv::INTER_AREA);
   // Sides: the projected border of the grid.
   std::array<std::vector<Eigen::Vector2d>, 4> border;
   for (int c = 0; c < nx; ++c) {
-    border[0].push_back(
-        s.camera.Project(s.meshes.mesh3d[s.meshes.grid.Index(0, c)]));
-    border[2].push_back(
-        s.camera.Project(s.meshes.mesh3d[s.meshes.grid.Index(ny - 1, c)]));
+    border[0].push_back(s.camera.Project(s.meshes.mesh3d[s.meshes.grid.Index(0, c)]));
+    border[2].push_back(s.camera.Project(s.meshes.mesh3d[s.meshes.grid.Index(ny - 1, c)]));
   }
   for (int r = 0; r < ny; ++r) {
-    border[1].push_back(
-        s.camera.Project(s.meshes.mesh3d[s.meshes.grid.Index(r, nx - 1)]));
-    border[3].push_back(
-        s.camera.Project(s.meshes.mesh3d[s.meshes.grid.Index(r, 0)]));
+    border[1].push_back(s.camera.Project(s.meshes.mesh3d[s.meshes.grid.Index(r, nx - 1)]));
+    border[3].push_back(s.camera.Project(s.meshes.mesh3d[s.meshes.grid.Index(r, 0)]));
   }
   for (int k = 0; k < 4; ++k) {
     bool real = false;
@@ -266,8 +247,8 @@ void WriteScene(const SyntheticScene& scene, const fs::path& work) {
   WriteJsonAtomic(work / "10_sfm" / "cameras.json", doc);
   WriteImageAtomic(work / "10_sfm" / "reference.png", scene.photo);
   EnsureDirectory(work / "20_boundary");
-  WriteBoundaryJson(work / "20_boundary" / "boundary.json", scene.camera.width,
-                    scene.camera.height, scene.sides, scene.real);
+  WriteBoundaryJson(work / "20_boundary" / "boundary.json", scene.camera.width, scene.camera.height,
+                    scene.sides, scene.real);
   EnsureDirectory(work / "40_init");
   WriteMeshPair(work / "40_init", scene.meshes);
 }
@@ -284,8 +265,7 @@ cv::Mat1f Detail(const cv::Mat& image) {
   return f / (low + 10.0f) - 1.0f;
 }
 
-double Correlation(const cv::Mat1f& a, const cv::Mat1f& b,
-                   const cv::Mat1b& mask) {
+double Correlation(const cv::Mat1f& a, const cv::Mat1f& b, const cv::Mat1b& mask) {
   cv::Scalar ma, sa, mb, sb;
   cv::meanStdDev(a, ma, sa, mask);
   cv::meanStdDev(b, mb, sb, mask);
@@ -293,16 +273,14 @@ double Correlation(const cv::Mat1f& a, const cv::Mat1f& b,
   return cv::mean(prod, mask)[0] / (sa[0] * sb[0] + 1e-12);
 }
 
-TileOffsets FindTileOffsets(const cv::Mat1f& ref, const cv::Mat1f& moved,
-                            const cv::Mat1b& mask, int tile, int radius) {
+TileOffsets FindTileOffsets(const cv::Mat1f& ref, const cv::Mat1f& moved, const cv::Mat1b& mask,
+                            int tile, int radius) {
   TileOffsets out;
   std::vector<double> offsets;
   for (int y = radius; y + tile + radius <= ref.rows; y += tile)
     for (int x = radius; x + tile + radius <= ref.cols; x += tile) {
-      const cv::Rect window(x - radius, y - radius, tile + 2 * radius,
-                            tile + 2 * radius);
-      if (!mask.empty() && cv::countNonZero(mask(window)) < window.area())
-        continue;
+      const cv::Rect window(x - radius, y - radius, tile + 2 * radius, tile + 2 * radius);
+      if (!mask.empty() && cv::countNonZero(mask(window)) < window.area()) continue;
       const cv::Rect r(x, y, tile, tile);
       cv::Scalar mean, sd;
       cv::meanStdDev(ref(r), mean, sd);

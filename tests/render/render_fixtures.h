@@ -56,10 +56,9 @@ struct SyntheticScene {
 struct SceneOptions {
   int image_width = 640, image_height = 480;
   double focal = 700;
-  Eigen::Vector3d page_origin{-0.22, -0.3,
-                              1.0};  // top-left corner, camera frame
-  double radius = 0.25;              // of the bend (0 = flat)
-  double tilt_deg = 20;              // page turned about the camera's x axis
+  Eigen::Vector3d page_origin{-0.22, -0.3, 1.0};  // top-left corner, camera frame
+  double radius = 0.25;                           // of the bend (0 = flat)
+  double tilt_deg = 20;                           // page turned about the camera's x axis
   int texture_width = 480, texture_height = 640;
   double page_w = 0.42, page_h = 0.56;
 };
@@ -80,8 +79,7 @@ render::RenderInputs InputsOf(const TruthInputs& truth);
 cv::Mat1f Detail(const cv::Mat& image);
 // Normalised cross-correlation of two equally sized images over `mask`
 // (all pixels when empty).
-double Correlation(const cv::Mat1f& a, const cv::Mat1f& b,
-                   const cv::Mat1b& mask = {});
+double Correlation(const cv::Mat1f& a, const cv::Mat1f& b, const cv::Mat1b& mask = {});
 
 // Where the content of `ref` is found in `moved`: tiles of `tile` pixels of
 // `ref` with enough texture are searched for in `moved` within +-`radius`
@@ -96,7 +94,7 @@ struct TileOffsets {
   double p90 = 0;
   double max = 0;
 };
-TileOffsets FindTileOffsets(const cv::Mat1f& ref, const cv::Mat1f& moved,
-                            const cv::Mat1b& mask, int tile, int radius);
+TileOffsets FindTileOffsets(const cv::Mat1f& ref, const cv::Mat1f& moved, const cv::Mat1b& mask,
+                            int tile, int radius);
 
 }  // namespace docunfold::testing

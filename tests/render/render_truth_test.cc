@@ -21,24 +21,19 @@ class RenderTruth : public ::testing::TestWithParam<fs::path> {};
 // flat.png scaled by `units_per_flat_px`.
 cv::Mat FlatInRenderFrame(const cv::Mat& flat, double units_per_flat_px,
                           const render::RenderResult& r) {
-  const double f =
-      r.pixels_per_unit * units_per_flat_px;  // render px per flat px
+  const double f = r.pixels_per_unit * units_per_flat_px;  // render px per flat px
   cv::Mat small;
-  cv::resize(flat, small, cv::Size(), f, f,
-             f < 1 ? cv::INTER_AREA : cv::INTER_CUBIC);
+  cv::resize(flat, small, cv::Size(), f, f, f < 1 ? cv::INTER_AREA : cv::INTER_CUBIC);
   // Pixel k of `small` is centred on flat coordinate (k + 0.5) / sx - 0.5
   // (resize's convention), i.e. on M' x = (k + 0.5) / sx * units_per_flat_px;
   // render pixel i on x0 + (i + 0.5) / s. Solved for k:
-  const double sx = double(small.cols) / flat.cols,
-               sy = double(small.rows) / flat.rows;
+  const double sx = double(small.cols) / flat.cols, sy = double(small.rows) / flat.rows;
   const double ax = sx / f, ay = sy / f;
-  const cv::Matx23d render_to_small(
-      ax, 0, 0.5 * ax - 0.5 + ax * r.pixels_per_unit * r.crop_x0, 0, ay,
-      0.5 * ay - 0.5 + ay * r.pixels_per_unit * r.crop_y0);
+  const cv::Matx23d render_to_small(ax, 0, 0.5 * ax - 0.5 + ax * r.pixels_per_unit * r.crop_x0, 0,
+                                    ay, 0.5 * ay - 0.5 + ay * r.pixels_per_unit * r.crop_y0);
   cv::Mat out;
   cv::warpAffine(small, out, render_to_small, r.rectified.size(),
-                 cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_CONSTANT,
-                 cv::Scalar::all(0));
+                 cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_CONSTANT, cv::Scalar::all(0));
   return out;
 }
 
@@ -58,18 +53,15 @@ TEST_P(RenderTruth, TrueMeshesReproduceFlatPng) {
   }
   const double diag = std::hypot(page_w, page_h);
   EXPECT_NEAR(page_w / page_h, gt->width_m / gt->height_m, 1e-3);
-  const double true_edge[4] = {0, page_w, page_h,
-                               0};  // top y, right x, bottom y, left x
+  const double true_edge[4] = {0, page_w, page_h, 0};  // top y, right x, bottom y, left x
   const double crop_edge[4] = {r.crop_y0, r.crop_x1, r.crop_y1, r.crop_x0};
   int real = 0;
   for (int i = 0; i < 4; ++i) {
     real += r.sides[i].real;
-    EXPECT_EQ(r.sides[i].used, r.sides[i].real)
-        << kSideNames[i] << " " << r.sides[i].note;
+    EXPECT_EQ(r.sides[i].used, r.sides[i].real) << kSideNames[i] << " " << r.sides[i].note;
     // A real side bounds the crop where the page edge is (to a pixel).
     if (r.sides[i].used) {
-      EXPECT_LT(std::abs(crop_edge[i] - true_edge[i]), 1.5 / r.pixels_per_unit)
-          << kSideNames[i];
+      EXPECT_LT(std::abs(crop_edge[i] - true_edge[i]), 1.5 / r.pixels_per_unit) << kSideNames[i];
     }
   }
   const double aspect = double(r.rectified.cols) / r.rectified.rows;
@@ -89,9 +81,8 @@ TEST_P(RenderTruth, TrueMeshesReproduceFlatPng) {
   ASSERT_FALSE(flat.empty());
   const cv::Mat expected = FlatInRenderFrame(flat, page_w / flat.cols, r);
   cv::Mat1b inside;
-  cv::threshold(
-      FlatInRenderFrame(cv::Mat1b(flat.size(), 255), page_w / flat.cols, r),
-      inside, 254, 255, cv::THRESH_BINARY);
+  cv::threshold(FlatInRenderFrame(cv::Mat1b(flat.size(), 255), page_w / flat.cols, r), inside, 254,
+                255, cv::THRESH_BINARY);
   cv::Mat1b mask = r.page_mask & inside;
   cv::erode(mask, mask, cv::Mat(), cv::Point(-1, -1), 3);
   ASSERT_GT(cv::countNonZero(mask), 0.2 * mask.total());
@@ -107,15 +98,13 @@ TEST_P(RenderTruth, TrueMeshesReproduceFlatPng) {
       "(shifted 3px %.3f) | tiles %d matched %d offset median %.2f p90 %.2f "
       "max %.2f px "
       "| hidden %.3f | %.2f s\n",
-      set.filename().c_str(), r.rectified.cols, r.rectified.rows,
-      r.pixels_per_unit, r.reference_pixels_per_unit, aspect,
-      gt->width_m / gt->height_m, r.crop_rule.c_str(), ncc, ncc_shifted,
-      off.tiles, off.matched, off.median, off.p90, off.max, r.hidden_fraction,
+      set.filename().c_str(), r.rectified.cols, r.rectified.rows, r.pixels_per_unit,
+      r.reference_pixels_per_unit, aspect, gt->width_m / gt->height_m, r.crop_rule.c_str(), ncc,
+      ncc_shifted, off.tiles, off.matched, off.median, off.p90, off.max, r.hidden_fraction,
       r.report["timing_s"]["total"].get<double>());
   if (std::getenv("DOCUNFOLD_KEEP_TEST_DIRS")) {
     cv::imwrite("/tmp/render-" + set.filename().string() + ".png", r.rectified);
-    cv::imwrite("/tmp/render-expected-" + set.filename().string() + ".png",
-                expected);
+    cv::imwrite("/tmp/render-expected-" + set.filename().string() + ".png", expected);
   }
   EXPECT_GT(ncc, 0.5);
   EXPECT_GT(ncc, ncc_shifted + 0.25);
@@ -132,8 +121,7 @@ std::string SetName(const ::testing::TestParamInfo<fs::path>& info) {
   return name;
 }
 
-INSTANTIATE_TEST_SUITE_P(DataSets, RenderTruth,
-                         ::testing::ValuesIn(RenderDataSets()), SetName);
+INSTANTIATE_TEST_SUITE_P(DataSets, RenderTruth, ::testing::ValuesIn(RenderDataSets()), SetName);
 GTEST_ALLOW_UNINSTANTIATED_PARAMETERIZED_TEST(RenderTruth);
 
 }  // namespace

@@ -30,16 +30,15 @@ cv::Mat ExpectedImage(const SyntheticScene& s, const render::RenderResult& r) {
   cv::Mat small;
   cv::resize(s.texture, small, cv::Size(), f, f, cv::INTER_AREA);
   const double ax = double(s.texture.cols) / small.cols * f;  // ~1
-  const cv::Matx23d out_to_small(1 / ax, 0, crop.x * f / ax + 0.5 / ax - 0.5, 0,
-                                 1 / ax, crop.y * f / ax + 0.5 / ax - 0.5);
+  const cv::Matx23d out_to_small(1 / ax, 0, crop.x * f / ax + 0.5 / ax - 0.5, 0, 1 / ax,
+                                 crop.y * f / ax + 0.5 / ax - 0.5);
   cv::Mat out;
   cv::warpAffine(small, out, out_to_small, r.rectified.size(),
                  cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_REPLICATE);
   return out;
 }
 
-double MeanAbsGreyDifference(const cv::Mat& a, const cv::Mat& b,
-                             const cv::Mat1b& mask) {
+double MeanAbsGreyDifference(const cv::Mat& a, const cv::Mat& b, const cv::Mat1b& mask) {
   cv::Mat ga, gb, diff;
   cv::cvtColor(a, ga, cv::COLOR_BGR2GRAY);
   cv::cvtColor(b, gb, cv::COLOR_BGR2GRAY);
@@ -184,16 +183,13 @@ TEST(RenderScene, MinifyingFiltersTheFootprint) {
   EXPECT_EQ(aliased.minified_fraction, 0);
   const cv::Mat expected = ExpectedImage(s, filtered);
   const cv::Mat1b mask = Inner(filtered.page_mask, 2);
-  const double err_filtered =
-      MeanAbsGreyDifference(expected, filtered.rectified, mask);
-  const double err_aliased =
-      MeanAbsGreyDifference(expected, aliased.rectified, mask);
+  const double err_filtered = MeanAbsGreyDifference(expected, filtered.rectified, mask);
+  const double err_aliased = MeanAbsGreyDifference(expected, aliased.rectified, mask);
   // What an area resize of the full-density rendering achieves: the best
   // the blur already in the photo allows.
   const auto full = render::Run({}, in);
   cv::Mat area;
-  cv::resize(full.rectified, area, filtered.rectified.size(), 0, 0,
-             cv::INTER_AREA);
+  cv::resize(full.rectified, area, filtered.rectified.size(), 0, 0, cv::INTER_AREA);
   const double err_area = MeanAbsGreyDifference(expected, area, mask);
   std::printf(
       "minify: mean |grey difference| filtered %.2f, aliased %.2f, area resize "
@@ -221,8 +217,7 @@ TEST(RenderScene, CutOffPageIsCroppedByItsRealSidesAndWhatTheViewSees) {
   // bottom row: that is where the seen part of M' begins.
   const double tilt = o.tilt_deg * M_PI / 180;
   const double k = (-0.5 - s.camera.K(0, 2)) / s.camera.K(0, 0);
-  const double x0 =
-      k * (o.page_origin.z() + o.page_h * std::sin(tilt)) - o.page_origin.x();
+  const double x0 = k * (o.page_origin.z() + o.page_h * std::sin(tilt)) - o.page_origin.x();
   const double px = 1 / r.pixels_per_unit;
   EXPECT_NEAR(r.crop_x0, x0, 2 * px);
   EXPECT_NEAR(r.crop_x1, s.page_w, px);
@@ -368,12 +363,10 @@ TEST(RenderScene, PartsTheReferenceViewCannotSeeAreFilled) {
   Keep("tube", r.rectified_grid);
   // The flat half, seen directly, is intact.
   cv::Mat1b left = cv::Mat1b::zeros(r.page_mask.size());
-  left(cv::Rect(0, 0, int(r.rectified.cols * 0.45), r.rectified.rows))
-      .setTo(255);
+  left(cv::Rect(0, 0, int(r.rectified.cols * 0.45), r.rectified.rows)).setTo(255);
   const cv::Mat1b mask = Inner(r.page_mask, 3) & left;
   EXPECT_GT(cv::countNonZero(mask), 0.3 * mask.total());
-  EXPECT_GT(Correlation(Detail(ExpectedImage(s, r)), Detail(r.rectified), mask),
-            0.9);
+  EXPECT_GT(Correlation(Detail(ExpectedImage(s, r)), Detail(r.rectified), mask), 0.9);
   // Sides drawn over the roll map onto other parts of M: they must not tilt
   // or cut the crop.
   SyntheticScene full = MakeScene(o);
@@ -407,8 +400,7 @@ TEST(RenderScene, ScatteredSideBoundsTheCropByItsMedian) {
     s.sides[3].push_back(s.camera.Project(p) + Eigen::Vector2d(k % 2 ? 10 : -10, 0));
   }
   s.sides[0].front() = s.camera.Project(o.page_origin + tilt * Eigen::Vector3d(edge, 0, 0));
-  s.sides[2].front() =
-      s.camera.Project(o.page_origin + tilt * Eigen::Vector3d(edge, o.page_h, 0));
+  s.sides[2].front() = s.camera.Project(o.page_origin + tilt * Eigen::Vector3d(edge, o.page_h, 0));
   const render::RenderResult r = render::Run({}, InputsOf(s));
   ASSERT_TRUE(r.sides[3].scattered) << r.sides[3].note;
   EXPECT_FALSE(r.sides[3].used);
@@ -455,8 +447,7 @@ TEST(RenderInputs, InconsistentInputsAreRejected) {
       render::Run({}, in);
       FAIL() << "no error for a mesh behind the camera";
     } catch (const InputError& e) {
-      EXPECT_NE(std::string(e.what()).find("behind the reference camera"),
-                std::string::npos);
+      EXPECT_NE(std::string(e.what()).find("behind the reference camera"), std::string::npos);
       EXPECT_NE(std::string(e.what()).find("mesh3d.ply"), std::string::npos);
     }
   }
@@ -511,8 +502,7 @@ TEST(RenderCrop, SideLinesIgnoreOutliersAndWrongOrderIsDropped) {
   std::array<render::SideFit, 4> good;
   good[0] = render::FitSideLine(0, true, top, 101);
   good[2] = render::FitSideLine(2, true, bottom, 101);
-  const render::CropRect crop =
-      render::ChooseCrop(&good, Eigen::Vector4d(-0.1, 0, 1.1, 1.3));
+  const render::CropRect crop = render::ChooseCrop(&good, Eigen::Vector4d(-0.1, 0, 1.1, 1.3));
   EXPECT_EQ(crop.rule, "real-sides-and-visible-mesh");
   EXPECT_NEAR(crop.x0, -0.1, 1e-12);
   EXPECT_NEAR(crop.x1, 1.1, 1e-12);
@@ -550,7 +540,7 @@ TEST(RenderCrop, SlightlySlantedSidesBoundTheCropThroughTheirMiddle) {
   slight = sides_with_right_slant(2);
   const double inscribed = 1 - 0.5 * std::tan(2 * M_PI / 180);
   EXPECT_NEAR(render::ChooseCrop(&slight, box).x1, inscribed, 1e-9);  // the default: inscribed
-  auto steep = sides_with_right_slant(5);  // beyond the limit: inscribed
+  auto steep = sides_with_right_slant(5);                             // beyond the limit: inscribed
   EXPECT_NEAR(render::ChooseCrop(&steep, box, limit).x1, 1 - 0.5 * std::tan(5 * M_PI / 180), 1e-9);
 }
 
@@ -635,8 +625,7 @@ TEST(RenderCutSides, AnotherViewFindsThePageEdgePastTheReferenceImage) {
   s3.camera.K(0, 2) -= 240;  // the page's left edge now lies off this photo
   const std::vector<render::ViewMask> short_views = {OtherView(s, o, s3, far)};
   ASSERT_LT(s3.camera.Project(s3.meshes.mesh3d[0]).x(), 0);
-  const auto short_edges =
-      render::FindCutSideEdges(seen, seen.mesh2d, box, cut, short_views, {});
+  const auto short_edges = render::FindCutSideEdges(seen, seen.mesh2d, box, cut, short_views, {});
   ASSERT_TRUE(short_edges[3].measured) << short_edges[3].note;
   EXPECT_FALSE(short_edges[3].edge_seen);
   EXPECT_GT(short_edges[3].bound, 0.0);
@@ -781,9 +770,10 @@ TEST(RenderScene, APartlyMappedSideIsReachedWhenItLiesPastItsLine) {
   const render::RenderResult before = render::Run(old, InputsOf(s));
   const render::RenderResult r = render::Run({}, InputsOf(s));
   const double px = 1 / r.pixels_per_unit;
-  std::printf("[render] partly mapped top: %d of %d samples on M, crop top %.4f without the "
-              "reach, %.4f with it (a row is %.4f)\n",
-              before.sides[0].mapped, before.sides[0].samples, before.crop_y0, r.crop_y0, row);
+  std::printf(
+      "[render] partly mapped top: %d of %d samples on M, crop top %.4f without the "
+      "reach, %.4f with it (a row is %.4f)\n",
+      before.sides[0].mapped, before.sides[0].samples, before.crop_y0, r.crop_y0, row);
   ASSERT_TRUE(before.sides[0].used) << before.sides[0].note;
   EXPECT_LT(before.sides[0].mapped, 0.6 * before.sides[0].samples);
   EXPECT_GT(before.crop_y0, 0.7 * row) << "the line of the snapped samples lies inside";
@@ -817,9 +807,9 @@ TEST(RenderScene, BetterViewTexturesWhatTheReferenceSeesAtAGrazingAngle) {
   view.camera.image = "view_01.png";
   view.camera.R = tilt.transpose();
   view.camera.t = square.page_origin - tilt.transpose() * o.page_origin;
-  ASSERT_LT((view.camera.Project(s.meshes.mesh3d[0]) - s2.camera.Project(s2.meshes.mesh3d[0]))
-                .norm(),
-            1e-6);
+  ASSERT_LT(
+      (view.camera.Project(s.meshes.mesh3d[0]) - s2.camera.Project(s2.meshes.mesh3d[0])).norm(),
+      1e-6);
   view.mask = RasterizeMesh(s2.camera, s2.meshes.mesh3d, s2.meshes.grid.Triangles()).face >= 0;
   view.photo = dir / "view_01.png";
   WriteImageAtomic(view.photo, s2.photo);

@@ -15,11 +15,11 @@
 //     is about as frontal as the most frontal such view;
 //   - the files are what later stages expect (schema, reference frame, median
 //     depth 1, reference.png at the camera's size, COLMAP's model readable).
+#include <gtest/gtest.h>
+
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
-
-#include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 
 #include "common/json_io.h"
@@ -90,8 +90,8 @@ TEST_P(SfmAccuracy, MatchesGroundTruth) {
   EXPECT_LE(f.median_page_distance, kMaxCameraGaugeMedianDistance) << name;
   if (!f.best_true_view.empty()) {
     EXPECT_TRUE(f.reference_whole_page)
-        << name << ": reference " << f.reference << " cuts the page off, "
-        << f.best_true_view << " shows all of it";
+        << name << ": reference " << f.reference << " cuts the page off, " << f.best_true_view
+        << " shows all of it";
     EXPECT_GE(f.reference_resolution, kResolutionFraction * f.best_true_resolution)
         << name << ": reference " << f.reference << " vs " << f.best_true_view;
   }
@@ -110,14 +110,16 @@ TEST_P(SfmAccuracy, MatchesGroundTruth) {
   EXPECT_EQ(ply.colors.size(), ply.vertices.size());
   EXPECT_NE(ply.FindProperty("track_length"), nullptr);
   EXPECT_NE(ply.FindProperty("reprojection_error"), nullptr);
-  const CommandResult schema = RunCommand(
-      Quote((SourceDir() / "scripts" / "validate-json").string()) + " --format "
-      "docunfold.cameras " + Quote((options.out_dir / "cameras.json").string()));
+  const CommandResult schema =
+      RunCommand(Quote((SourceDir() / "scripts" / "validate-json").string()) +
+                 " --format "
+                 "docunfold.cameras " +
+                 Quote((options.out_dir / "cameras.json").string()));
   EXPECT_EQ(schema.exit_code, 0) << schema.output;
   if (!sfm::FindExecutable("colmap").empty()) {
-    const CommandResult analyzer = RunCommand(
-        "colmap model_analyzer --path " +
-        Quote((options.out_dir / "colmap" / "sparse" / "0").string()));
+    const CommandResult analyzer =
+        RunCommand("colmap model_analyzer --path " +
+                   Quote((options.out_dir / "colmap" / "sparse" / "0").string()));
     EXPECT_EQ(analyzer.exit_code, 0) << analyzer.output;
     EXPECT_NE(analyzer.output.find("Registered images: " + std::to_string(f.registered)),
               std::string::npos)
@@ -132,8 +134,7 @@ std::string ParamName(const ::testing::TestParamInfo<fs::path>& info) {
   return s;
 }
 
-INSTANTIATE_TEST_SUITE_P(DataSets, SfmAccuracy, ::testing::ValuesIn(SfmDataSets()),
-                         ParamName);
+INSTANTIATE_TEST_SUITE_P(DataSets, SfmAccuracy, ::testing::ValuesIn(SfmDataSets()), ParamName);
 GTEST_ALLOW_UNINSTANTIATED_PARAMETERIZED_TEST(SfmAccuracy);
 
 }  // namespace

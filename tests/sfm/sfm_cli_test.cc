@@ -1,15 +1,15 @@
 // The sfm command line: a good run on a small copy of a data set, --ref,
 // replacing an earlier output, and every kind of bad input (exit code, one
 // line naming the cause, no partial output left behind).
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <fstream>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <regex>
 #include <set>
 #include <sstream>
-
-#include <gtest/gtest.h>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
 
 #include "common/camera.h"
 #include "common/ply.h"
@@ -42,16 +42,15 @@ int CountLines(const std::string& s) { return int(std::count(s.begin(), s.end(),
 // A failed run: the exit code, exactly one line on stderr saying what is
 // wrong (containing `needle`), and nothing left in `out`'s parent that was
 // not there before.
-void ExpectFailure(const CommandResult& r, int code, const std::string& needle,
-                   const fs::path& out, const std::set<std::string>& parent_before) {
+void ExpectFailure(const CommandResult& r, int code, const std::string& needle, const fs::path& out,
+                   const std::set<std::string>& parent_before) {
   EXPECT_EQ(r.exit_code, code) << r.output;
   EXPECT_NE(r.output.find(needle), std::string::npos) << r.output;
   // Our progress lines are allowed before the error; the error is one line.
   const std::regex error_line("^sfm: (bad input|usage error|error|cannot write output): ");
   int errors = 0;
   std::istringstream lines(r.output);
-  for (std::string line; std::getline(lines, line);)
-    errors += std::regex_search(line, error_line);
+  for (std::string line; std::getline(lines, line);) errors += std::regex_search(line, error_line);
   EXPECT_EQ(errors, 1) << r.output;
   EXPECT_EQ(Listing(out.parent_path()), parent_before) << "left behind in " << out.parent_path();
 }
@@ -82,9 +81,9 @@ class SfmCli : public ::testing::Test {
 TEST_F(SfmCli, HelpListsFlagsWithDefaults) {
   const CommandResult r = Sfm("--help");
   EXPECT_EQ(r.exit_code, 0);
-  for (const char* s : {"--data", "--out", "--ref", "--max-image-size", "1600",
-                        "--camera-model", "SIMPLE_RADIAL", "--threads", "--verbose",
-                        "--max-reprojection-error", "--min-points", "--colmap", "Exit codes"})
+  for (const char* s : {"--data", "--out", "--ref", "--max-image-size", "1600", "--camera-model",
+                        "SIMPLE_RADIAL", "--threads", "--verbose", "--max-reprojection-error",
+                        "--min-points", "--colmap", "Exit codes"})
     EXPECT_NE(r.output.find(s), std::string::npos) << s;
 }
 
@@ -206,11 +205,11 @@ TEST_F(SfmCli, GoodRunThenRefThenFailedRunKeepsTheOutput) {
   EXPECT_NE(r.output.find("sfm: extracting features"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("3/3 views registered"), std::string::npos) << r.output;
   EXPECT_EQ(Listing(out.parent_path()), std::set<std::string>{"10_sfm"});
-  for (const char* f : {"cameras.json", "points.ply", "reference.png", "colmap/database.db",
-                        "colmap/sparse/0/cameras.bin", "colmap/sparse/0/images.bin",
-                        "colmap/sparse/0/points3D.bin", "colmap/feature_extractor.log",
-                        "colmap/matches_raw.txt", "colmap/matches_importer.log",
-                        "colmap/mapper.log"})
+  for (const char* f :
+       {"cameras.json", "points.ply", "reference.png", "colmap/database.db",
+        "colmap/sparse/0/cameras.bin", "colmap/sparse/0/images.bin", "colmap/sparse/0/points3D.bin",
+        "colmap/feature_extractor.log", "colmap/matches_raw.txt", "colmap/matches_importer.log",
+        "colmap/mapper.log"})
     EXPECT_TRUE(fs::is_regular_file(out / f)) << f;
   const CameraSet first = ReadCameras(out / "cameras.json");
   EXPECT_EQ(first.views.size(), 3u);
@@ -279,8 +278,8 @@ TEST_F(SfmCli, RefNotRegistered) {
   cv::imwrite((data / "images" / "zz_noise.jpg").string(), Noise(sample.cols, sample.rows, 3));
   const fs::path out = tmp_ / "work" / "10_sfm";
   fs::create_directories(out.parent_path());
-  ExpectFailure(Sfm(Args(data, out, "--threads 2 --ref zz_noise.jpg")), 3,
-                "could not register", out, {});
+  ExpectFailure(Sfm(Args(data, out, "--threads 2 --ref zz_noise.jpg")), 3, "could not register",
+                out, {});
 }
 
 TEST_F(SfmCli, TooFewPoints) {

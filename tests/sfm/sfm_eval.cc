@@ -1,14 +1,13 @@
 #include "tests/sfm/sfm_eval.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <sstream>
-
-#include <Eigen/Geometry>
 #include <nanoflann.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <sstream>
 
 #include "common/raster.h"
 #include "tests/support/test_support.h"
@@ -27,10 +26,13 @@ struct CentroidCloud {
   size_t kdtree_get_point_count() const { return pts.size(); }
   double kdtree_get_pt(size_t i, size_t d) const { return pts[i][int(d)]; }
   template <class B>
-  bool kdtree_get_bbox(B&) const { return false; }
+  bool kdtree_get_bbox(B&) const {
+    return false;
+  }
 };
-using CentroidTree = nanoflann::KDTreeSingleIndexAdaptor<
-    nanoflann::L2_Simple_Adaptor<double, CentroidCloud>, CentroidCloud, 3, size_t>;
+using CentroidTree =
+    nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, CentroidCloud>,
+                                        CentroidCloud, 3, size_t>;
 
 // Closest points on the true surface, via the triangles whose centroids are
 // nearest (the true meshes have triangles of about 1 mm).
@@ -38,10 +40,10 @@ class SurfaceDistance {
  public:
   explicit SurfaceDistance(const GroundTruth& gt) : gt_(gt) {
     for (const Triangle& t : gt.triangles)
-      cloud_.pts.push_back((gt.mesh.vertices[t[0]] + gt.mesh.vertices[t[1]] +
-                            gt.mesh.vertices[t[2]]) / 3.0);
-    tree_ = std::make_unique<CentroidTree>(3, cloud_,
-                                           nanoflann::KDTreeSingleIndexAdaptorParams(10));
+      cloud_.pts.push_back(
+          (gt.mesh.vertices[t[0]] + gt.mesh.vertices[t[1]] + gt.mesh.vertices[t[2]]) / 3.0);
+    tree_ =
+        std::make_unique<CentroidTree>(3, cloud_, nanoflann::KDTreeSingleIndexAdaptorParams(10));
     tree_->buildIndex();
   }
   double Distance(const Eigen::Vector3d& p, Eigen::Vector3d* foot = nullptr) const {
@@ -53,8 +55,7 @@ class SurfaceDistance {
     for (size_t i = 0; i < n; ++i) {
       const Triangle& t = gt_.triangles[idx[i]];
       Eigen::Vector3d c;
-      const double d = PointTriangleDistance(p, gt_.mesh.vertices[t[0]],
-                                             gt_.mesh.vertices[t[1]],
+      const double d = PointTriangleDistance(p, gt_.mesh.vertices[t[0]], gt_.mesh.vertices[t[1]],
                                              gt_.mesh.vertices[t[2]], &c);
       if (d < best) {
         best = d;
@@ -216,8 +217,7 @@ std::vector<TrueViewFigures> TrueViews(const GroundTruth& gt) {
         const int x = int(std::lround(px.x())), y = int(std::lround(px.y()));
         if (x >= 0 && y >= 0 && x < full.depth.cols && y < full.depth.rows &&
             xc.z() <= full.depth(y, x) * 1.01) {
-          const double cosine =
-              std::abs(cross.normalized().dot((centre - center).normalized()));
+          const double cosine = std::abs(cross.normalized().dot((centre - center).normalized()));
           value = cam.K(0, 0) * cosine / xc.z();
         }
       }
@@ -344,8 +344,7 @@ SfmFigures MeasureSfm(const fs::path& sfm_dir, const GroundTruth& gt) {
     for (const Eigen::Vector3d& p : cur) d.push_back(surface.Distance(p) / diag);
     *median = Median(d);
     double sum = 0;
-    for (size_t i = 0; i < src.size(); ++i)
-      sum += (Apply(icp * T, src[i]) - dst[i]).squaredNorm();
+    for (size_t i = 0; i < src.size(); ++i) sum += (Apply(icp * T, src[i]) - dst[i]).squaredNorm();
     *camera_rms = std::sqrt(sum / src.size()) / diag;
   };
   if (page_points.size() >= 10) {
@@ -384,22 +383,21 @@ std::string FormatFigures(const SfmFigures& f) {
   char buf[768];
   std::snprintf(buf, sizeof buf,
                 "registered %d/%d, camera centres RMS %.3f%%, points %d (on page %d), "
-                "median distance page points %.3f%% (all %.3f%%, shape after ICP %.3f%%; fitting cameras and page together: cameras %.3f%%, "
+                "median distance page points %.3f%% (all %.3f%%, shape after ICP %.3f%%; fitting "
+                "cameras and page together: cameras %.3f%%, "
                 "page points %.3f%%), "
                 "reference %s (true frontality %.3f, resolution %.0f px/m, whole page %s; "
                 "best-resolving whole view %s %.0f)",
                 f.registered, f.views, 100 * f.camera_rms, f.points, f.page_points,
                 100 * f.median_page_distance, 100 * f.median_all_distance,
                 100 * f.shape_median_distance, 100 * f.joint_camera_rms,
-                100 * f.joint_median_distance,
-                f.reference.c_str(), f.reference_frontality,
+                100 * f.joint_median_distance, f.reference.c_str(), f.reference_frontality,
                 f.reference_resolution, f.reference_whole_page ? "yes" : "no",
                 f.best_true_view.c_str(), f.best_true_resolution);
   return buf;
 }
 
-fs::path MakeSmallDataSet(const fs::path& dataset, const fs::path& dir, int count,
-                          int width) {
+fs::path MakeSmallDataSet(const fs::path& dataset, const fs::path& dir, int count, int width) {
   fs::create_directories(dir / "images");
   std::vector<fs::path> photos;
   for (const auto& e : fs::directory_iterator(dataset / "images")) photos.push_back(e.path());
@@ -407,10 +405,10 @@ fs::path MakeSmallDataSet(const fs::path& dataset, const fs::path& dir, int coun
   for (int i = 0; i < count && i < int(photos.size()); ++i) {
     cv::Mat im = cv::imread(photos[i].string());
     cv::Mat small;
-    cv::resize(im, small, cv::Size(width, int(std::lround(im.rows * double(width) / im.cols))),
-               0, 0, cv::INTER_AREA);
-    cv::imwrite((dir / "images" / photos[i].filename()).replace_extension(".jpg").string(),
-                small, {cv::IMWRITE_JPEG_QUALITY, 92});
+    cv::resize(im, small, cv::Size(width, int(std::lround(im.rows * double(width) / im.cols))), 0,
+               0, cv::INTER_AREA);
+    cv::imwrite((dir / "images" / photos[i].filename()).replace_extension(".jpg").string(), small,
+                {cv::IMWRITE_JPEG_QUALITY, 92});
   }
   return dir;
 }

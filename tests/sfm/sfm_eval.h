@@ -3,12 +3,11 @@
 // the chosen reference view is, and small helpers for the sfm tests.
 #pragma once
 
+#include <Eigen/Core>
 #include <filesystem>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
-#include <opencv2/core.hpp>
 
 #include "common/camera.h"
 #include "common/ply.h"
@@ -38,11 +37,11 @@ struct TrueViewFigures {
 std::vector<TrueViewFigures> TrueViews(const GroundTruth& gt);
 
 struct SfmFigures {
-  int views = 0;                 // photos in the data set (true cameras)
-  int registered = 0;            // views in cameras.json that have a true camera
-  double camera_rms = 0;         // RMS camera-centre error, fraction of the diagonal
+  int views = 0;          // photos in the data set (true cameras)
+  int registered = 0;     // views in cameras.json that have a true camera
+  double camera_rms = 0;  // RMS camera-centre error, fraction of the diagonal
   int points = 0;
-  int page_points = 0;           // points on the true page in most views they fall in
+  int page_points = 0;              // points on the true page in most views they fall in
   double median_page_distance = 0;  // median distance of those to the surface, fraction
   double median_all_distance = 0;   // same over every point
   // Median distance of the page points after fitting them to the surface by
@@ -58,7 +57,7 @@ struct SfmFigures {
   double reference_frontality = 0;  // true figures of the chosen reference
   double reference_resolution = 0;
   bool reference_whole_page = false;
-  std::string best_true_view;       // best-resolving true view that sees the whole page
+  std::string best_true_view;  // best-resolving true view that sees the whole page
   double best_true_resolution = 0;
   double reference_median_depth = 0;  // of the points inside the reference image
 };
@@ -77,8 +76,7 @@ double PointTriangleDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
 
 // A copy of `dataset`'s photos (the first `count`, scaled to `width` pixels
 // wide, as JPEG) in <dir>/images; returns dir. For small, fast fixtures.
-fs::path MakeSmallDataSet(const fs::path& dataset, const fs::path& dir, int count,
-                          int width);
+fs::path MakeSmallDataSet(const fs::path& dataset, const fs::path& dir, int count, int width);
 
 // The first data set with truth found, or "" (tests skip then).
 fs::path AnyDataSet();

@@ -2,18 +2,17 @@
 // convention, the reference frame, the reference-view score, the image
 // checks, undistortion, the subprocess runner and exact matching. No COLMAP
 // needed.
+#include <gtest/gtest.h>
 #include <sqlite3.h>
 
+#include <Eigen/Core>
 #include <cstdio>
 #include <fstream>
-#include <random>
-
-#include <Eigen/Core>
-#include <gtest/gtest.h>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <random>
 
 #include "common/errors.h"
 #include "stages/sfm/colmap_model.h"
@@ -60,8 +59,8 @@ struct FakePoint {
 // Writes a model with one camera, the given images (id = index + 1) and
 // points; each image lists a 2D point per observation.
 void WriteModel(const fs::path& dir, const ColmapCamera& camera,
-                const std::vector<ColmapImage>& images,
-                const std::vector<FakePoint>& points, size_t truncate_points_by = 0) {
+                const std::vector<ColmapImage>& images, const std::vector<FakePoint>& points,
+                size_t truncate_points_by = 0) {
   fs::create_directories(dir);
   Bytes c;
   c.Put<uint64_t>(1);
@@ -154,8 +153,7 @@ ColmapCamera SimpleRadial(double f, int w, int h, double k) {
 }
 
 // A page of points on z = 0 (0.2 x 0.3), seen by every image.
-std::vector<FakePoint> PagePoints(int n, const std::vector<uint32_t>& images,
-                                  unsigned seed = 7) {
+std::vector<FakePoint> PagePoints(int n, const std::vector<uint32_t>& images, unsigned seed = 7) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(-0.5, 0.5);
   std::vector<FakePoint> pts;
@@ -168,9 +166,9 @@ TEST(ColmapModelTest, ReadsWhatColmapWrites) {
   const ColmapCamera cam = SimpleRadial(1000, 800, 600, 0.01);
   const Eigen::Matrix3d R =
       Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
-  std::vector<ColmapImage> images = {MakeImage(1, "a.jpg", Eigen::Matrix3d::Identity(),
-                                               Eigen::Vector3d(0, 0, 2)),
-                                     MakeImage(2, "b.jpg", R, Eigen::Vector3d(0.1, 0, 2))};
+  std::vector<ColmapImage> images = {
+      MakeImage(1, "a.jpg", Eigen::Matrix3d::Identity(), Eigen::Vector3d(0, 0, 2)),
+      MakeImage(2, "b.jpg", R, Eigen::Vector3d(0.1, 0, 2))};
   WriteModel(tmp.path(), cam, images,
              {{{0, 0, 0}, {1, 2}}, {{0.1, 0, 0}, {1}}, {{0, 0.1, 0.1}, {2, 1}}});
   const ColmapModel m = sfm::ReadColmapModel(tmp.path());
@@ -298,8 +296,7 @@ TEST(ReferenceViewTest, NormalsOfAPlaneAreItsNormal) {
       Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, -1, 0.3).normalized()).toRotationMatrix();
   for (const FakePoint& p : PagePoints(200, {1})) pts.push_back(R * p.xyz);
   const auto normals = sfm::EstimateNormals(pts, 12);
-  for (const Eigen::Vector3d& n : normals)
-    EXPECT_GT(std::abs(n.dot(R.col(2))), 0.999);
+  for (const Eigen::Vector3d& n : normals) EXPECT_GT(std::abs(n.dot(R.col(2))), 0.999);
 }
 
 TEST(ReferenceViewTest, PrefersTheFrontalViewThatSeesTheWholePage) {
@@ -307,10 +304,10 @@ TEST(ReferenceViewTest, PrefersTheFrontalViewThatSeesTheWholePage) {
   m.cameras[1] = SimpleRadial(1000, 800, 600, 0);
   // Page 0.2 x 0.3 on z = 0; cameras above it (z < 0 is "up" for OpenCV's
   // y-down convention does not matter here: LookAt handles it).
-  m.images[1] = LookAt(1, "oblique.jpg", {0.35, 0.0, -0.5}, {0, 0, 0});     // ~35 deg
-  m.images[2] = LookAt(2, "frontal.jpg", {0.05, 0.03, -0.6}, {0, 0, 0});    // ~5 deg
-  m.images[3] = LookAt(3, "too_close.jpg", {0.0, 0.0, -0.2}, {0, 0, 0});    // head-on, page cut
-  m.images[4] = LookAt(4, "slanted.jpg", {-0.3, 0.25, -0.45}, {0, 0, 0});   // ~40 deg
+  m.images[1] = LookAt(1, "oblique.jpg", {0.35, 0.0, -0.5}, {0, 0, 0});    // ~35 deg
+  m.images[2] = LookAt(2, "frontal.jpg", {0.05, 0.03, -0.6}, {0, 0, 0});   // ~5 deg
+  m.images[3] = LookAt(3, "too_close.jpg", {0.0, 0.0, -0.2}, {0, 0, 0});   // head-on, page cut
+  m.images[4] = LookAt(4, "slanted.jpg", {-0.3, 0.25, -0.45}, {0, 0, 0});  // ~40 deg
   for (const FakePoint& p : PagePoints(400, {1, 2, 3, 4})) {
     ColmapPoint q;
     q.xyz = p.xyz;
@@ -397,8 +394,7 @@ TEST(CheckImagesTest, AcceptsPhotosOfOneSizeAndNamesTheBadOne) {
   cv::imwrite((tmp / "set/images/a.jpg").string(), a);
   std::ofstream(tmp / "set/images/notes.txt") << "not a photo";
   int w = 0, h = 0;
-  EXPECT_EQ(sfm::CheckImages(tmp / "set", &w, &h),
-            (std::vector<std::string>{"a.jpg", "b.png"}));
+  EXPECT_EQ(sfm::CheckImages(tmp / "set", &w, &h), (std::vector<std::string>{"a.jpg", "b.png"}));
   EXPECT_EQ(w, 80);
   EXPECT_EQ(h, 60);
 
@@ -433,8 +429,8 @@ TEST(UndistortTest, DistortedPixelMovesToThePinholeProjection) {
   const Eigen::Vector2d pinhole = kx.head<2>() / kx.z();
   ASSERT_GT((distorted - pinhole).norm(), 5.0);  // the test means something
   cv::Mat photo(480, 640, CV_8UC3, cv::Scalar(0, 0, 0));
-  cv::circle(photo, cv::Point(int(std::lround(distorted.x())), int(std::lround(distorted.y()))),
-             3, cv::Scalar(255, 255, 255), cv::FILLED);
+  cv::circle(photo, cv::Point(int(std::lround(distorted.x())), int(std::lround(distorted.y()))), 3,
+             cv::Scalar(255, 255, 255), cv::FILLED);
   const cv::Mat out = sfm::UndistortPhoto(photo, cam);
   ASSERT_EQ(out.size(), photo.size());
   cv::Mat grey;
@@ -467,8 +463,8 @@ TEST(SubprocessTest, CapturesLinesExitCodeAndLog) {
   sfm::SubprocessOptions o;
   o.log_file = tmp / "run.log";
   o.on_line = [&](const std::string& l) { lines.push_back(l); };
-  const auto r = sfm::RunSubprocess(
-      {"sh", "-c", "echo one; echo two >&2; printf 'three'; exit 3"}, o);
+  const auto r =
+      sfm::RunSubprocess({"sh", "-c", "echo one; echo two >&2; printf 'three'; exit 3"}, o);
   EXPECT_EQ(r.exit_code, 3);
   EXPECT_FALSE(r.timed_out);
   EXPECT_FALSE(r.not_found);
@@ -505,18 +501,18 @@ TEST(SubprocessTest, MissingProgram) {
 
 TEST(SfmEvalTest, PointTriangleDistance) {
   const Eigen::Vector3d a(0, 0, 0), b(1, 0, 0), c(0, 1, 0);
-  EXPECT_DOUBLE_EQ(PointTriangleDistance({0.2, 0.2, 0.5}, a, b, c), 0.5);   // face
-  EXPECT_DOUBLE_EQ(PointTriangleDistance({-1, 0, 0}, a, b, c), 1.0);        // vertex a
-  EXPECT_DOUBLE_EQ(PointTriangleDistance({0.5, -2, 0}, a, b, c), 2.0);      // edge ab
+  EXPECT_DOUBLE_EQ(PointTriangleDistance({0.2, 0.2, 0.5}, a, b, c), 0.5);         // face
+  EXPECT_DOUBLE_EQ(PointTriangleDistance({-1, 0, 0}, a, b, c), 1.0);              // vertex a
+  EXPECT_DOUBLE_EQ(PointTriangleDistance({0.5, -2, 0}, a, b, c), 2.0);            // edge ab
   EXPECT_NEAR(PointTriangleDistance({1, 1, 0}, a, b, c), std::sqrt(0.5), 1e-12);  // edge bc
-  EXPECT_DOUBLE_EQ(PointTriangleDistance({2, 0, 0}, a, b, c), 1.0);         // vertex b
+  EXPECT_DOUBLE_EQ(PointTriangleDistance({2, 0, 0}, a, b, c), 1.0);               // vertex b
 }
 
 // --- exact matching ------------------------------------------------------
 
 // n random SIFT-like descriptors: non-negative, L2 norm 512, as bytes.
 Eigen::Matrix<float, Eigen::Dynamic, 128, Eigen::RowMajor> RandomDescriptors(int n,
-                                                                            std::mt19937* rng) {
+                                                                             std::mt19937* rng) {
   std::uniform_real_distribution<float> u(0, 1);
   Eigen::Matrix<float, Eigen::Dynamic, 128, Eigen::RowMajor> d(n, 128);
   for (int i = 0; i < n; ++i) {
@@ -667,8 +663,11 @@ TEST(ExactMatchingTest, ImagesAreNumberedByNameWithTheirFeatures) {
   sqlite3* raw = nullptr;
   ASSERT_EQ(sqlite3_open(db.c_str(), &raw), SQLITE_OK);
   sqlite3_stmt* stmt = nullptr;
-  ASSERT_EQ(sqlite3_prepare_v2(raw, "SELECT image_id, hex(substr(data, 1, 1)) FROM keypoints "
-                               "ORDER BY image_id", -1, &stmt, nullptr), SQLITE_OK);
+  ASSERT_EQ(sqlite3_prepare_v2(raw,
+                               "SELECT image_id, hex(substr(data, 1, 1)) FROM keypoints "
+                               "ORDER BY image_id",
+                               -1, &stmt, nullptr),
+            SQLITE_OK);
   std::vector<std::string> keypoints;
   while (sqlite3_step(stmt) == SQLITE_ROW)
     keypoints.push_back(std::to_string(sqlite3_column_int(stmt, 0)) + ":" +

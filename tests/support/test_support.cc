@@ -1,24 +1,22 @@
 #include "tests/support/test_support.h"
 
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
 #include <array>
 #include <cstdio>
 #include <cstdlib>
 #include <random>
-#include <sys/wait.h>
-
-#include <gtest/gtest.h>
 
 namespace docunfold::testing {
 
 TempDir::TempDir() {
   const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-  std::string name = info ? std::string(info->test_suite_name()) + "." + info->name()
-                          : "docunfold";
+  std::string name = info ? std::string(info->test_suite_name()) + "." + info->name() : "docunfold";
   for (char& c : name)
     if (c == '/') c = '_';
   std::random_device rd;
-  path_ = fs::temp_directory_path() /
-          ("docunfold-test-" + name + "-" + std::to_string(rd()));
+  path_ = fs::temp_directory_path() / ("docunfold-test-" + name + "-" + std::to_string(rd()));
   fs::create_directories(path_);
 }
 
@@ -34,20 +32,15 @@ CommandResult RunCommand(const std::string& command_line) {
   if (!pipe) return result;
   std::array<char, 4096> buf;
   size_t n;
-  while ((n = std::fread(buf.data(), 1, buf.size(), pipe)) > 0)
-    result.output.append(buf.data(), n);
+  while ((n = std::fread(buf.data(), 1, buf.size(), pipe)) > 0) result.output.append(buf.data(), n);
   int status = ::pclose(pipe);
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return result;
 }
 
-fs::path StageBinary(const std::string& name) {
-  return fs::path(DOCUNFOLD_BIN_DIR) / name;
-}
+fs::path StageBinary(const std::string& name) { return fs::path(DOCUNFOLD_BIN_DIR) / name; }
 fs::path SourceDir() { return fs::path(DOCUNFOLD_SOURCE_DIR); }
-fs::path SampleDir(const std::string& name) {
-  return SourceDir() / "samples" / name;
-}
+fs::path SampleDir(const std::string& name) { return SourceDir() / "samples" / name; }
 fs::path RealisticDir() {
   if (const char* env = std::getenv("DOCUNFOLD_REALISTIC_DIR")) return env;
   fs::path p = SourceDir().parent_path() / "shared" / "realistic";
@@ -58,8 +51,10 @@ fs::path RealisticDir() {
 std::string Quote(const std::string& s) {
   std::string out = "'";
   for (char c : s) {
-    if (c == '\'') out += "'\\''";
-    else out += c;
+    if (c == '\'')
+      out += "'\\''";
+    else
+      out += c;
   }
   return out + "'";
 }

@@ -1,10 +1,9 @@
 #include "tests/support/truth_frame.h"
 
 #include <algorithm>
+#include <opencv2/imgcodecs.hpp>
 #include <random>
 #include <stdexcept>
-
-#include <opencv2/imgcodecs.hpp>
 
 #include "common/atomic_file.h"
 #include "common/json_io.h"
@@ -65,8 +64,8 @@ TrueMeshes TrueMeshesInReferenceFrame(const GroundTruth& gt, const std::string& 
   const auto& t = gt.mesh.FindProperty("t")->values;
   for (size_t i = 0; i < gt.mesh.vertices.size(); ++i) {
     m.mesh3d.vertices.push_back(ref(gt.mesh.vertices[i]));
-    m.mesh2d.vertices.push_back(
-        Eigen::Vector3d(s[i] * gt.width_m, t[i] * gt.height_m, 0) * ref.scale);
+    m.mesh2d.vertices.push_back(Eigen::Vector3d(s[i] * gt.width_m, t[i] * gt.height_m, 0) *
+                                ref.scale);
   }
   m.mesh3d.faces = m.mesh2d.faces = gt.mesh.faces;
   if (auto grid = gt.mesh.GridSize()) {
@@ -76,8 +75,8 @@ TrueMeshes TrueMeshesInReferenceFrame(const GroundTruth& gt, const std::string& 
   return m;
 }
 
-void WriteSfmFromTruth(const GroundTruth& gt, const std::string& reference,
-                       const fs::path& out_dir, const SfmFromTruthOptions& options) {
+void WriteSfmFromTruth(const GroundTruth& gt, const std::string& reference, const fs::path& out_dir,
+                       const SfmFromTruthOptions& options) {
   const RefFromWorld ref = ReferenceFrame(gt, reference);
   const CameraSet cameras = CamerasInReferenceFrame(gt, reference);
   std::mt19937 rng(options.seed);
@@ -104,8 +103,8 @@ void WriteSfmFromTruth(const GroundTruth& gt, const std::string& reference,
 
   PlyData points;
   std::vector<double> track, error;
-  for (int tries = 0; int(points.vertices.size()) < options.num_points &&
-                      tries < options.num_points * 50;
+  for (int tries = 0;
+       int(points.vertices.size()) < options.num_points && tries < options.num_points * 50;
        ++tries) {
     auto p = gt.SurfacePoint({uni(rng) * (gt.flat_width - 1), uni(rng) * (gt.flat_height - 1)});
     if (!p) continue;
@@ -119,11 +118,14 @@ void WriteSfmFromTruth(const GroundTruth& gt, const std::string& reference,
   }
   if (options.outlier_fraction > 0 && !points.vertices.empty()) {
     Eigen::Vector3d lo = points.vertices[0], hi = lo;
-    for (const auto& v : points.vertices) { lo = lo.cwiseMin(v); hi = hi.cwiseMax(v); }
+    for (const auto& v : points.vertices) {
+      lo = lo.cwiseMin(v);
+      hi = hi.cwiseMax(v);
+    }
     const int n = int(options.outlier_fraction * points.vertices.size());
     for (int i = 0; i < n; ++i) {
-      points.vertices.push_back(lo + (hi - lo).cwiseProduct(
-                                         Eigen::Vector3d(uni(rng), uni(rng), uni(rng))));
+      points.vertices.push_back(
+          lo + (hi - lo).cwiseProduct(Eigen::Vector3d(uni(rng), uni(rng), uni(rng))));
       track.push_back(2);
       error.push_back(2.0);
     }

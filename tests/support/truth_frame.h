@@ -4,10 +4,9 @@
 // points, meshes) without running sfm, and compare results with the truth.
 #pragma once
 
+#include <Eigen/Core>
 #include <filesystem>
 #include <string>
-
-#include <Eigen/Core>
 
 #include "common/camera.h"
 #include "common/ply.h"
@@ -40,16 +39,16 @@ struct TrueMeshes {
 TrueMeshes TrueMeshesInReferenceFrame(const GroundTruth& gt, const std::string& reference);
 
 struct SfmFromTruthOptions {
-  int num_points = 3000;         // surface samples seen by >= 2 views
-  double noise = 0.002;          // Gaussian noise, fraction of the page diagonal
-  double outlier_fraction = 0.0; // extra points uniform in the page's bounding box
+  int num_points = 3000;          // surface samples seen by >= 2 views
+  double noise = 0.002;           // Gaussian noise, fraction of the page diagonal
+  double outlier_fraction = 0.0;  // extra points uniform in the page's bounding box
   unsigned seed = 1;
 };
 
 // Writes what sfm would write for `reference` from the ground truth:
 // cameras.json (docunfold.cameras), points.ply and reference.png (the photo,
 // which has no lens distortion in synthetic sets).
-void WriteSfmFromTruth(const GroundTruth& gt, const std::string& reference,
-                       const fs::path& out_dir, const SfmFromTruthOptions& options = {});
+void WriteSfmFromTruth(const GroundTruth& gt, const std::string& reference, const fs::path& out_dir,
+                       const SfmFromTruthOptions& options = {});
 
 }  // namespace docunfold::testing

@@ -3,9 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
-#include <sstream>
-
 #include <opencv2/imgcodecs.hpp>
+#include <sstream>
 
 #include "common/json_io.h"
 #include "stages/synth/folds.h"
@@ -31,14 +30,14 @@ const char* kSmall = "--views 2 --width 480 --height 360 --creases 2";
 TEST(Synth, SameSeedGivesIdenticalFilesAndAnotherSeedDoesNot) {
   TempDir dir;
   for (const char* name : {"a", "b"})
-    ASSERT_EQ(RunCommand(Synth(std::string(kSmall) + " --seed 7 --out " +
-                               Quote((dir / name).string())))
-                  .exit_code,
-              0);
-  ASSERT_EQ(RunCommand(Synth(std::string(kSmall) + " --seed 8 --out " +
-                             Quote((dir / "c").string())))
-                .exit_code,
-            0);
+    ASSERT_EQ(
+        RunCommand(Synth(std::string(kSmall) + " --seed 7 --out " + Quote((dir / name).string())))
+            .exit_code,
+        0);
+  ASSERT_EQ(
+      RunCommand(Synth(std::string(kSmall) + " --seed 8 --out " + Quote((dir / "c").string())))
+          .exit_code,
+      0);
   for (const char* f : {"images/view_00.jpg", "images/view_01.jpg", "ground_truth/flat.png",
                         "ground_truth/mesh.ply", "ground_truth/cameras.json",
                         "ground_truth/features.json", "ground_truth/text.txt"}) {
@@ -52,16 +51,16 @@ TEST(Synth, WritesTheGroundTruthLayoutAndItValidates) {
   TempDir dir;
   for (const char* kind : {"text", "table", "receipt", "poster"}) {
     const fs::path out = dir / kind;
-    CommandResult r = RunCommand(Synth(std::string(kSmall) + " --kind " + kind + " --out " +
-                                       Quote(out.string())));
+    CommandResult r = RunCommand(
+        Synth(std::string(kSmall) + " --kind " + kind + " --out " + Quote(out.string())));
     ASSERT_EQ(r.exit_code, 0) << r.output;
     for (const char* f : {"flat.png", "text.txt", "page.json", "mesh.ply", "cameras.json",
                           "features.json", "synth.json"})
       EXPECT_TRUE(fs::is_regular_file(out / "ground_truth" / f)) << kind << " " << f;
-    CommandResult v = RunCommand(Quote((SourceDir() / "scripts/validate-json").string()) +
-                                 " " + Quote((out / "ground_truth/cameras.json").string()) +
-                                 " " + Quote((out / "ground_truth/features.json").string()) +
-                                 " " + Quote((out / "ground_truth/page.json").string()) + " " +
+    CommandResult v = RunCommand(Quote((SourceDir() / "scripts/validate-json").string()) + " " +
+                                 Quote((out / "ground_truth/cameras.json").string()) + " " +
+                                 Quote((out / "ground_truth/features.json").string()) + " " +
+                                 Quote((out / "ground_truth/page.json").string()) + " " +
                                  Quote((out / "ground_truth/synth.json").string()));
     EXPECT_EQ(v.exit_code, 0) << v.output;
     auto gt = LoadGroundTruth(out);
@@ -111,8 +110,8 @@ TEST(Synth, FoldedSheetIsAnIsometryOfThePage) {
 
 TEST(Synth, CutOffFramingLeavesPartOfThePageOutsideEveryView) {
   TempDir dir;
-  CommandResult r = RunCommand(Synth(std::string(kSmall) + " --cut-off --out " +
-                                     Quote((dir / "cut").string())));
+  CommandResult r =
+      RunCommand(Synth(std::string(kSmall) + " --cut-off --out " + Quote((dir / "cut").string())));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   auto gt = LoadGroundTruth(dir / "cut");
   ASSERT_TRUE(gt);
