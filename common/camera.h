@@ -43,10 +43,18 @@ struct PinholeCamera {
     d.row(1) = (K.row(1) - v * K.row(2)) / h.z();
     return d;
   }
+  // The viewing ray of a pixel in camera coordinates, K^-1 (x, y, 1): the
+  // point of depth 1 on it.
+  Eigen::Vector3d CamRay(const Eigen::Vector2d& pixel) const {
+    return K.inverse() * Eigen::Vector3d(pixel.x(), pixel.y(), 1);
+  }
   // Unit viewing direction of a pixel, in world coordinates.
   Eigen::Vector3d RayDirection(const Eigen::Vector2d& pixel) const {
-    Eigen::Vector3d d = K.inverse() * Eigen::Vector3d(pixel.x(), pixel.y(), 1);
-    return (R.transpose() * d).normalized();
+    return (R.transpose() * CamRay(pixel)).normalized();
+  }
+  // The world point seen at `pixel` at camera depth `depth`.
+  Eigen::Vector3d LiftAtDepth(const Eigen::Vector2d& pixel, double depth) const {
+    return R.transpose() * (depth * CamRay(pixel) - t);
   }
 };
 

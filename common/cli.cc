@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <cstdio>
 #include <cstdlib>
 #include <iostream>
 #include <opencv2/core.hpp>
@@ -28,6 +29,15 @@ void LimitOpenMpThreads(char** argv) {
 }
 
 void Log(const std::string& message) { std::cerr << ProgramName() << ": " << message << std::endl; }
+
+int RunStage(const std::string& program, OptionTable& options, int argc, char** argv,
+             const std::function<void()>& body) {
+  if (argc == 2 && std::string(argv[1]) == "--help-markdown") {
+    std::cout << options.Markdown();
+    return kExitOk;
+  }
+  return RunStage(program, options.app(), argc, argv, body);
+}
 
 int RunStage(const std::string& program, CLI::App& app, int argc, char** argv,
              const std::function<void()>& body) {
@@ -124,5 +134,23 @@ void AddFair2dAlongOption(CLI::App& app, double* fair2d_along) {
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1.0));
 }
+
+std::string Fixed(double value, int decimals) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f", decimals, value);
+  return buf;
+}
+
+StepTimer::StepTimer() : start_(std::chrono::steady_clock::now()), last_(start_) {}
+
+double StepTimer::Mark(const std::string& step) {
+  const auto now = std::chrono::steady_clock::now();
+  const double seconds = std::chrono::duration<double>(now - last_).count();
+  steps_.emplace_back(step, seconds);
+  last_ = now;
+  return seconds;
+}
+
+double StepTimer::Total() const { return SecondsSince(start_); }
 
 }  // namespace docunfold

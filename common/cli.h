@@ -6,8 +6,11 @@
 #include <chrono>
 #include <functional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "common/errors.h"
+#include "common/option_table.h"
 
 namespace docunfold {
 
@@ -18,9 +21,13 @@ const char* ProgramVersion();
 void SetProgramName(const std::string& name);
 const std::string& ProgramName();
 
-// Runs `body` and maps what it throws to an exit code, printing exactly one
-// line "<program>: error: <message>" to stderr. CLI11 parse errors become
-// exit 2 (or 0 for --help / --version).
+// Parses the command line into `options`' fields, runs `body` and maps what
+// it throws to an exit code, printing exactly one line
+// "<program>: <kind>: <message>" to stderr. CLI11 parse errors become exit 2
+// (or 0 for --help / --version). `--help-markdown` prints the options' table
+// for docs/stages/ instead.
+int RunStage(const std::string& program, OptionTable& options, int argc, char** argv,
+             const std::function<void()>& body);
 int RunStage(const std::string& program, CLI::App& app, int argc, char** argv,
              const std::function<void()>& body);
 
@@ -63,5 +70,26 @@ class Progress {
 
 // Seconds since `start` as a double; for summaries and log.json.
 double SecondsSince(std::chrono::steady_clock::time_point start);
+
+// `value` with `decimals` digits after the point ("%.*f"), for log lines.
+std::string Fixed(double value, int decimals);
+
+// Wall time of a stage's steps, for its summary line and the times in its
+// JSON output.
+class StepTimer {
+ public:
+  StepTimer();
+  // Records the seconds since the previous Mark (or the start) under `step`
+  // and returns them.
+  double Mark(const std::string& step);
+  // Seconds since the start.
+  double Total() const;
+  // (step, seconds) in the order marked.
+  const std::vector<std::pair<std::string, double>>& steps() const { return steps_; }
+
+ private:
+  std::chrono::steady_clock::time_point start_, last_;
+  std::vector<std::pair<std::string, double>> steps_;
+};
 
 }  // namespace docunfold

@@ -1,6 +1,8 @@
 // Order statistics of samples, shared by the stages.
 #pragma once
 
+#include <algorithm>
+#include <cstddef>
 #include <vector>
 
 namespace docunfold {
@@ -9,7 +11,15 @@ namespace docunfold {
 // median is q = 0.5, the upper one for even n); 0 when there are none.
 double Quantile(std::vector<double> values, double q);
 
-// Quantile(values, 0.5).
+// Quantile(values, 0.5): the value at rank n / 2.
 double Median(std::vector<double> values);
+
+// The value at rank `k` (0-based, k < n) of the samples, for a caller that
+// fixes its rank another way than Quantile (e.g. n * 95 / 100).
+template <typename T>
+T NthSmallest(std::vector<T> values, size_t k) {
+  std::nth_element(values.begin(), values.begin() + long(k), values.end());
+  return values[k];
+}
 
 }  // namespace docunfold

@@ -51,6 +51,7 @@
 
 #include "common/grid_mesh.h"
 #include "common/json_io.h"
+#include "common/option_table.h"
 
 namespace docunfold::isometry {
 
@@ -270,6 +271,11 @@ struct Result {
   std::vector<double> point_distance;  // distance to the final M (caller's units; +inf when far)
   SolveReport report;
 };
+
+// Declares the solver's flags (weights, outliers, fairness, the method and
+// its stopping rule) into `table`, bound to `options`' fields: the same flags
+// in init-mesh and optimize, each with that stage's default.
+void DeclareSolveOptions(OptionTable& table, SolveOptions* options);
 
 // Minimises F from problem's initial values. Throws std::invalid_argument on
 // an inconsistent problem (sizes, non-finite values, bad marker triangles).

@@ -42,19 +42,32 @@ InkComponents FindComponents(const cv::Mat1b& ink) {
 
 }  // namespace detail
 
-Json FeaturesOptions::ToJson() const {
-  return Json{{"margin_px", margin_px},
-              {"sauvola_window", sauvola_window},
-              {"sauvola_k", sauvola_k},
-              {"straightness_px", straightness_px},
-              {"straightness_rel", straightness_rel},
-              {"straightness_window", straightness_window},
-              {"max_gap", max_gap},
-              {"min_text_length", min_text_length},
-              {"min_length_px", min_length_px},
-              {"step_edges", step_edges},
-              {"join_gap", join_gap},
-              {"lsd_upscale", lsd_upscale}};
+void DeclareOptions(OptionTable& table, FeaturesOptions* o) {
+  table.Value("margin", &o->margin_px, 0.0, 1000.0,
+              "pixels kept from the region's outline; 0 = 0.6% of the image diagonal");
+  table.Value("sauvola-window", &o->sauvola_window, 0, 1001,
+              "binarisation window (px); 0 = 1.5% of the image diagonal");
+  table.Value("sauvola-k", &o->sauvola_k, 0.01, 1.0, "Sauvola's k");
+  table.Value("bend-px", &o->bend_px, 0.1, 20.0,
+              "text: cut a baseline where it leaves a line by more than this (px)...");
+  table.Value("bend-rel", &o->bend_rel, 0.0, 1.0,
+              "...or by this fraction of the text height, if larger");
+  table.Value("bend-window", &o->bend_window, 0.0, 10.0,
+              "text: judge the bend on the baseline's running median over this many text "
+              "heights either way (0 = on every sample)");
+  table.Value("max-gap", &o->max_gap, 0.1, 10.0, "text: largest gap chained, in text heights");
+  table.Value("min-text-length", &o->min_text_length, 0.0, 1000.0,
+              "text: shortest segment, in text heights");
+  table.Value("min-length", &o->min_length_px, 0.0, 10000.0, "shortest segment of any kind (px)");
+  table.Value("join-gap", &o->join_gap, 0.0, 1000.0,
+              "join LSD pieces of one straight edge across gaps up to this many px (or half a "
+              "text height); 0 = off");
+  table.Value("lsd-upscale", &o->lsd_upscale, 0.0, 4.0,
+              "run LSD on the region enlarged this many times (thin rules); 0 = 2 when the text "
+              "is under 12 px high and the region under 4 MP, else 1");
+  table.Switch("step-edges", &o->step_edges,
+               "also keep single step edges (colour fields, shading), not only thin lines");
+  table.Switch("verbose", &o->verbose, "log each step and its time");
 }
 
 FeaturesResult DetectFeatures(const cv::Mat& image, const cv::Mat& mask_in,
@@ -115,8 +128,8 @@ FeaturesResult DetectFeatures(const cv::Mat& image, const cv::Mat& mask_in,
 }
 
 Json FeaturesToJson(const FeaturesResult& r, const std::string& image_name, int width, int height,
-                    const FeaturesOptions& options) {
-  Json doc = MakeHeader("docunfold.features", 1, "detect-features", options.ToJson());
+                    const Json& options_record) {
+  Json doc = MakeHeader("docunfold.features", 1, "detect-features", options_record);
   doc["image"] = image_name;
   doc["width"] = width;
   doc["height"] = height;

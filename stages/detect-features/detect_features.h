@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "common/json_io.h"
+#include "common/option_table.h"
 
 namespace docunfold::features {
 
@@ -35,11 +36,11 @@ struct FeaturesOptions {
   double sauvola_k = 0.2;
   // Text: a chain's baseline is cut where it leaves a straight line by more
   // than this many pixels, or this fraction of the text height if larger.
-  double straightness_px = 1.2;
-  double straightness_rel = 0.12;
+  double bend_px = 1.2;
+  double bend_rel = 0.12;
   // Text: whether a baseline bends is judged on its running median over
   // this many text heights either way (0 = on the raw samples).
-  double straightness_window = 1.0;
+  double bend_window = 1.0;
   // Text: neighbours are chained across gaps up to this many text heights.
   double max_gap = 1.0;
   // Shortest segment kept, in text heights (text) or pixels (both).
@@ -58,9 +59,11 @@ struct FeaturesOptions {
   double lsd_upscale = 0;
   // Log each step and its time.
   bool verbose = false;
-
-  Json ToJson() const;
 };
+
+// Declares every field of `options` as a flag of `table` (see
+// common/option_table.h); the field's value is its default.
+void DeclareOptions(OptionTable& table, FeaturesOptions* options);
 
 struct Segment {
   std::string kind;                 // "text" or "edge"
@@ -84,9 +87,10 @@ struct FeaturesResult {
 FeaturesResult DetectFeatures(const cv::Mat& image, const cv::Mat& mask,
                               const FeaturesOptions& options);
 
-// features.json (format docunfold.features, version 1).
+// features.json (format docunfold.features, version 1); `options_record`
+// goes into its producer record (OptionTable::Record).
 Json FeaturesToJson(const FeaturesResult& result, const std::string& image_name, int width,
-                    int height, const FeaturesOptions& options);
+                    int height, const Json& options_record);
 
 // Segments drawn over the image (text red, edges cyan, outside the region
 // darkened); at most `max_size` pixels long.

@@ -475,7 +475,7 @@ TextResult DetectTextSegments(const InkComponents& ink, const FeaturesOptions& o
 
   // 6. Baselines: the outline on the baseline side, descenders and raised
   //    parts dropped, cut where it bends, fitted piece by piece.
-  const double tolerance = std::max(options.straightness_px, options.straightness_rel * x_height);
+  const double tolerance = std::max(options.bend_px, options.bend_rel * x_height);
   const double min_length = std::max(options.min_length_px, options.min_text_length * x_height);
   for (const auto& chain : chains) {
     for (int k : chain) result.is_character[size_t(marks[k].label)] = 1;
@@ -491,10 +491,9 @@ TextResult DetectTextSegments(const InkComponents& ink, const FeaturesOptions& o
     // samples a pixel off (the pixel grid, serifs, JPEG) would otherwise cut
     // a straight line into pieces too short to keep, while a crease bends it
     // over more than the window and still cuts it.
-    const std::vector<double> noise =
-        options.straightness_window > 0
-            ? offsets(kept_samples, options.straightness_window * x_height)
-            : std::vector<double>(kept_samples.size(), 0.0);
+    const std::vector<double> noise = options.bend_window > 0
+                                          ? offsets(kept_samples, options.bend_window * x_height)
+                                          : std::vector<double>(kept_samples.size(), 0.0);
     std::vector<cv::Point2d> kept, smooth;
     std::vector<int> kept_mark;
     for (size_t k = 0; k < kept_samples.size(); ++k) {

@@ -193,7 +193,7 @@ TEST(DetectFeatures, PixelNoiseDoesNotCutSmallSlantedText) {
   for (size_t k = 0; k + 1 < ends.size(); k += 2) baselines.emplace_back(ends[k], ends[k + 1]);
   auto measure = [&](double window) {
     FeaturesOptions options;
-    options.straightness_window = window;
+    options.bend_window = window;
     double length = 0;
     for (const Segment& s : DetectFeatures(photo, mask, options).segments) {
       if (s.kind != "text") continue;
