@@ -263,8 +263,8 @@ run_set() {  # run_set <data dir> <work dir>
   fi
   echo "$status" > "$work/bench/pipeline.exit"
   [[ $status -eq 0 ]] || echo "bench: pipeline failed (exit $status; see $work/bench/pipeline.log)" >&2
-  # The front end against the truth in sfm's reference view (issue 3's
-  # figures): boundary IoU, corners, real sides; features precision, recall.
+  # The front end against the truth in sfm's reference view: boundary IoU,
+  # corners, real sides; features precision, recall.
   if [[ -f $work/10_sfm/cameras.json && -f $data/ground_truth/mesh.ply ]]; then
     "$timer" "$work/bench/timings.jsonl" "evaluate:front-end" "$bin/evaluate" --front-end \
       --data "$data" --work "$work" --out "$work/70_eval/front_end.json" \

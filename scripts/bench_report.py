@@ -229,7 +229,7 @@ def fmt(v, f):
 
 
 def mark(value, ok, f):
-    """A figure with ✗ after it when it misses issue 3's threshold."""
+    """A figure with ✗ after it when it misses the front end's target."""
     return fmt(value, f) + ("" if ok or not finite(value) else " ✗")
 
 
@@ -240,8 +240,8 @@ def front_end_markdown(sets):
     lines = ["", "## Front end against the ground truth", "",
              "segment-boundary and detect-features in the reference view sfm picked "
              "(`evaluate --front-end`, 70_eval/front_end.json), the truth moved into "
-             "reference.png by sfm's undistortion. ✗ marks a figure short of issue 3's "
-             "(IoU ≥ 0.97; every visible true corner within 1 % of the page diagonal; real "
+             "reference.png by sfm's undistortion. ✗ marks a figure short of the front end's "
+             "targets (IoU ≥ 0.97; every visible true corner within 1 % of the page diagonal; real "
              "sides on the true edge and covering it; a cut page has a side flagged not real, "
              "a whole page none; precision ≥ 0.95; recall ≥ 0.5 on text pages and tables). "
              "Corners and sides are not judged where a true corner is hidden by a fold.", "",

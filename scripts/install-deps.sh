@@ -33,6 +33,9 @@ packages=(
   python3 python3-jsonschema
   # stage timing for the benchmark and the report (/usr/bin/time)
   time
+  # scripts/code-size finds functions with universal-ctags (a test keeps
+  # files and functions short)
+  universal-ctags
   # tests (assimp reads our PLYs as an independent check; chromium opens the
   # HTML report)
   googletest libgtest-dev assimp-utils chromium

@@ -187,7 +187,8 @@ TEST_P(EndToEnd, FeatureSegmentsLieOnTrueLines) {
       f["edge_segments"].get<int>(), f["precision"].get<double>(), f["recall"].get<double>(),
       f["recall_text"].get<double>(), f["recall_rule"].get<double>(),
       f["recall_required"].get<bool>() ? " (text page or table)" : "");
-  // Issue 3's figures, in sfm's reference view of this run.
+  // The front end's targets (docs/decisions/pipeline.md, "Front-end targets"), in sfm's
+  // reference view of this run.
   EXPECT_GE(f["precision"].get<double>(), 0.95) << set_;
   if (f["recall_required"].get<bool>()) {
     EXPECT_GE(f["recall"].get<double>(), 0.5) << set_;
@@ -225,7 +226,7 @@ TEST_P(EndToEnd, SfmPointsKeptOnThePageLieOnTheTrueSurface) {
 }
 
 // Whether a binary PLY's first data byte is '\n', which assimp 5.2's PLY
-// reader skips, shifting everything after it (assimp issue 5341): it then
+// reader skips, shifting everything after it (assimp's bug tracker, #5341): it then
 // reports a valid file as broken (seen on r03, whose first vertex's x began
 // with 0x0a; '\r', '\f' and '\0' there are read correctly).
 bool AssimpMisreadsBinaryPly(const fs::path& path) {
@@ -246,34 +247,10 @@ TEST_P(EndToEnd, MeshesAreCloseToTheTruthAndReadable) {
       "%s: M to the true surface %.3f %% (init) %.3f %% (final) of the diagonal; "
       "isometry error %.4f / %.4f\n",
       set_.c_str(), init_surface, final_surface, init_iso, final_iso);
-  // Targets (issue 5): 1 % and 0.005. Measured in the benchmark of
-  // 2026-11-24 (densify leaving out the table points hidden behind the page):
-  // surface 0.05-0.45 % on ten sets, 0.8-1.6 % on set07 and set08 over
-  // several sfm runs (set02 was 2.1 % before, its raised flap bent by those
-  // points); asserted here are the bounds every set meets, and that optimize
-  // does not move M away from the truth (beyond run-to-run noise). Since
-  // init-mesh compares edge lengths too, its isometry error is 0.01-0.31 %
-  // on every set over five sfm runs but set07's, 0.17-1.30 % (5.5-6.4 % with
-  // the paper's diagonals alone; 0.25 % on the 1.30 % run since init stops
-  // no more on heavily damped steps).
-  // Since init-mesh's outline prior (2026-11-25), set07's init isometry
-  // error is 0.07, 0.11 and 0.19 % and its M 0.41, 0.40 and 0.78 % off in three runs; the
-  // benchmark's run: isometry at most 0.12 % (r01) on every set.
-  // Since densify's shading-step points (2026-11-25) set08's far panel has
-  // points: its init M 0.83, 0.64, 0.52 and 0.72 % over four sfm runs (1.09,
-  // 1.21, 0.74 and 1.10 % without), every other set's at most 0.71 %
-  // (set07); issue 5's 1 % is asserted. Those few points still let it
-  // above 1 % in 3 of 17 later runs; with densify's second texture pass on
-  // (2026-11-26) the far panel has 800-3000 points and set08's init M was
-  // 0.33-0.47 % in 8 of 8 runs with view_00 as reference (1.32 % when sfm
-  // picks view_03: its third strip gets no point; README).
-  // Where the page has no points (set07's blank middle between names and
-  // prices, on its grazing panel) optimize's first round moves M: its M'
-  // fairness (lambda4 = 0.1, ten times init-mesh's) dominates F there at the
-  // start and is traded for the shape of that band. Over 16 sfm runs of
-  // set07 (2026-11-26) optimize moved M by -0.12 to +0.09 % of the diagonal,
-  // and by +0.21 (0.378 -> 0.588 %) in the CI run of 4e4b931, so the guard
-  // against optimize spoiling M allows half the init's distance again.
+  // Targets: M within 1 % of the page diagonal of the true surface and an isometry error
+  // under 0.005 for init-mesh; optimize must not move M away from the truth beyond the
+  // run-to-run spread of sfm, so the final M may be half the init's distance farther
+  // (docs/decisions/pipeline.md, "Geometry bounds in the end-to-end test").
   EXPECT_LT(init_surface, 1.0) << set_;
   EXPECT_LE(final_surface, 3.0) << set_;
   EXPECT_LE(final_surface, 1.5 * init_surface + 0.1) << set_;
@@ -322,15 +299,10 @@ TEST_P(EndToEnd, OptimizeLowersFWithinEveryRound) {
         EXPECT_LE(i["F_after_step"].get<double>(), i.at("F").get<double>() * (1 + 1e-9))
             << set_ << " round " << round.value("round", -1) << " iteration " << i["iteration"];
       }
-    // Between iterations footpoints, outliers and the feature markers
-    // (re-cast, and projected onto their lines, which moves them off their
-    // rays: the ray term rises) are re-decided, so F from one iteration to
-    // the next is not one function and not monotone (seen: up to +70 % within
-    // a round, r03; x2.3 on set03 in one clean-clone run; x4.6 on r03 in
-    // another, its ray term x30 once the markers were projected onto their
-    // lines in round 2, which then stopped as oscillating). Issue 6's "F
-    // decreasing" holds per step only (above); asserted across the round is
-    // that it does not run away.
+    // Between iterations footpoints, outliers and the feature markers are re-decided (and
+    // the markers projected onto their lines, which moves them off their rays), so F from
+    // one iteration to the next is not one function and not monotone: it falls within a
+    // step (asserted above); across a round it must not run away.
     EXPECT_LE(last, first * 8) << set_ << " round " << round.value("round", -1);
   }
 }
@@ -347,22 +319,13 @@ TEST_P(EndToEnd, ResultIsBetterThanTheReferenceMethods) {
       set_.c_str(), ours, init, homography, oracle, Metric(rows, "docunfold", "ld"));
   ASSERT_FALSE(std::isnan(ours)) << set_ << ": no docunfold row";
   RecordProperty("ms_ssim", std::to_string(ours));
-  // Issues 5 and 6 ask for docunfold-init and docunfold above the homography
-  // on every set; not asserted. Since the homography reads the page the way
-  // up render turned docunfold's (2026-11-25; before, it scored a page a
-  // quarter or half turn off on 7 of 12 sets), set07's margins were +0.018
-  // (docunfold) and +0.034 (init) in one sfm run, -0.003 and -0.010 in
-  // another; with init-mesh's outline prior no longer lost on it (bc53454)
-  // docunfold's margin was +0.046 in the benchmark, but -0.001 to +0.047 over
-  // four other front ends. Issue 6 also asks for docunfold above init - 0.01 on every set;
-  // set07 is 0.015-0.03 below its init in most runs (README, "Where set07
-  // loses to its init"), set05 within 0.01 either way.
+  // docunfold and docunfold-init beat the homography on every set in the benchmark, but by
+  // little on set07 in some sfm runs, and docunfold comes within 0.01 of its init or below it
+  // there (docs/decisions/pipeline.md, "Where set07 loses to its init"): not asserted.
   // Asserted: a real page comes out, and the oracle row is sound.
   EXPECT_GT(ours, 0.25) << set_;
   EXPECT_GT(oracle, homography + 0.05) << set_ << ": the oracle should clearly beat homography";
-  // The light's shading divided out (render/baseline --shading remove) never
-  // costs the page: measured +0.0001 (r02) to +0.14 (set07) on docunfold and
-  // +0.0006 to +0.16 on the oracle over the 12 sets.
+  // The light's shading divided out (render/baseline --shading remove) never costs the page.
   const double deshaded = Metric(rows, "docunfold-deshaded", "ms_ssim");
   const double oracle_deshaded = Metric(rows, "oracle-deshaded", "ms_ssim");
   std::printf("%s: MS-SSIM with the shading removed: docunfold %.4f, oracle %.4f\n", set_.c_str(),
@@ -452,7 +415,7 @@ INSTANTIATE_TEST_SUITE_P(Sets, EndToEnd, ::testing::ValuesIn(E2eSets()),
                          });
 GTEST_ALLOW_UNINSTANTIATED_PARAMETERIZED_TEST(EndToEnd);
 
-// Across the samples: what the optimisation issue asks of the whole set.
+// Across the samples: the means over the whole set.
 TEST(EndToEndSummary, SamplesOnAverage) {
   const Json results = ReadJsonFile(E2eDir() / "results.json");
   double ours = 0, oracle = 0, oracle_seen = 0, ld = 0, ld_whole = 0;
@@ -484,22 +447,12 @@ TEST(EndToEndSummary, SamplesOnAverage) {
       "samples: mean MS-SSIM docunfold %.4f, oracle %.4f, oracle cropped to what the photos "
       "see %.4f; mean LD %.2f (%.2f over the %d pages seen whole)\n",
       ours / n, oracle / n, oracle_seen / n, ld / n, ld_whole / n_whole, n_whole);
-  // Issue 6's targets: within 0.05 of the oracle (not met: 0.795-0.808
-  // against 0.882 over eight runs since 2026-11-25's outline prior, 0.786-0.816
-  // over eight with the shading-step points; set08, cut off in every photo,
-  // alone costs 0.05 of it) and mean LD <= 2 (1.46-2.39 over those runs,
-  // 1.74-2.70 with the steps: not met in all; set08's LD alone swings
-  // 4.4-8.9, moving the mean by 0.55). Over the seven pages seen whole the
-  // mean LD was 1.29-1.60 in the four runs that recorded it, 1.36 in the
-  // test suite's of 2026-11-26, but 2.23 in that day's benchmark, where sfm
-  // gave set02 (LD 5.6) and set07 (6.5) a poor run at once. Asserted: no
-  // regression beyond the runs' spread, and issue 6's LD target where the
-  // whole page is seen, with a margin for two sets' swing at once.
-  // The oracle knows where a cut-off page ends from the true surface; cropped
-  // to the part some photo sees (baseline --crop-to-seen) it is the ceiling
-  // for a method that has only the photos: set08 0.751 -> 0.364 for the 31
-  // rows of 1754 no photo shows, the samples' mean 0.882 -> 0.833 (2026-11-28).
-  // Issue 6's margin of 0.05, measured against that ceiling, is asserted.
+  // Targets: the samples' mean MS-SSIM within 0.05 of the oracle cropped to the part of the
+  // page some photo sees (baseline --crop-to-seen: the ceiling for a method that has only the
+  // photos when a page is cut off in all of them) and a mean LD of at most 2 where the whole
+  // page is seen. Asserted: the margin against that ceiling, and no regression beyond the
+  // spread of sfm runs, with a margin for two sets' swing at once
+  // (docs/decisions/pipeline.md, "The samples' means in the end-to-end test").
   EXPECT_FALSE(std::isnan(ours));
   EXPECT_FALSE(std::isnan(oracle_seen)) << "no oracle-seen row";
   EXPECT_GT(ours / n, oracle_seen / n - 0.05);
