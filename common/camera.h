@@ -54,7 +54,8 @@ struct PinholeCamera {
   }
   // The world point seen at `pixel` at camera depth `depth`.
   Eigen::Vector3d LiftAtDepth(const Eigen::Vector2d& pixel, double depth) const {
-    return R.transpose() * (depth * CamRay(pixel) - t);
+    const Eigen::Vector3d x_cam = depth * (K.inverse() * Eigen::Vector3d(pixel.x(), pixel.y(), 1));
+    return R.transpose() * (x_cam - t);
   }
 };
 
