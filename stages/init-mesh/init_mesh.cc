@@ -100,31 +100,6 @@ using PixelTree =
     nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, PixelCloud>,
                                         PixelCloud, 2, uint32_t>;
 
-// Distance from a 3D position to the nearest of a fixed set of points.
-class NearestPoint {
- public:
-  explicit NearestPoint(const std::vector<Eigen::Vector3d>& points)
-      : cloud_{&points}, tree_(3, cloud_, nanoflann::KDTreeSingleIndexAdaptorParams(10)) {
-    tree_.buildIndex();
-  }
-  double Distance(const Eigen::Vector3d& x) const {
-    if (cloud_.pts->empty()) return std::numeric_limits<double>::infinity();
-    uint32_t index = 0;
-    double d2 = 0;
-    nanoflann::KNNResultSet<double, uint32_t> knn(1);
-    knn.init(&index, &d2);
-    tree_.findNeighbors(knn, x.data(), nanoflann::SearchParams());
-    return std::sqrt(d2);
-  }
-
- private:
-  using Cloud = VectorCloud<3>;
-  Cloud cloud_;
-  nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, Cloud>, Cloud, 3,
-                                      uint32_t>
-      tree_;
-};
-
 // ---------------------------------------------------------------------------
 // The grid in the image.
 
@@ -484,74 +459,6 @@ double UprightAngle(const MeshPair& m, const std::vector<Eigen::Vector2d>& pts) 
   return std::remainder(best, 2 * M_PI);
 }
 
-// Markers holding M's border vertices to the page's outline in the reference
-// image: each to the plane through the camera centre and the outline's
-// tangent line at the outline point nearest its projection, so it may slide
-// along the outline but not across it (re-decided every outer iteration).
-std::vector<isometry::Marker> OutlineMarkers(const MeshPair& m, const PinholeCamera& cam,
-                                             const std::vector<Eigen::Vector2d>& contour,
-                                             const NearestPoint& points, const Options& o) {
-  const double min_cos = std::cos(o.outline_hold_max_angle_deg * M_PI / 180);
-  const double max_gap = o.outline_hold_support * isometry::ModelSize(m);
-  std::vector<isometry::Marker> markers;
-  const QuadGrid& g = m.grid;
-  const size_t n = contour.size();
-  if (n < 3 || g.nx < 2 || g.ny < 2) return markers;
-  const Eigen::Vector3d centre = cam.Center();
-  // The image border where the page is cut off is no edge of it.
-  auto on_frame = [&](const Eigen::Vector2d& p) {
-    return p.x() < 2 || p.y() < 2 || p.x() > cam.width - 3 || p.y() > cam.height - 3;
-  };
-  for (int r = 0; r < g.ny; ++r)
-    for (int c = 0; c < g.nx; ++c) {
-      if (r != 0 && r != g.ny - 1 && c != 0 && c != g.nx - 1) continue;
-      const int v = g.Index(r, c);
-      const Eigen::Vector3d x = cam.CamFromWorld(m.mesh3d[v]);
-      if (!(x.z() > 0)) continue;
-      // Where M is seen at a grazing angle the outline is likely its
-      // silhouette (a curl, a panel seen edge-on), not the page's edge.
-      const auto& p3 = m.mesh3d;
-      const Eigen::Vector3d along_row =
-          p3[g.Index(r, std::min(c + 1, g.nx - 1))] - p3[g.Index(r, std::max(c - 1, 0))];
-      const Eigen::Vector3d along_col =
-          p3[g.Index(std::min(r + 1, g.ny - 1), c)] - p3[g.Index(std::max(r - 1, 0), c)];
-      const Eigen::Vector3d normal = along_row.cross(along_col).normalized();
-      if (!(std::abs(normal.dot((m.mesh3d[v] - centre).normalized())) >= min_cos)) continue;
-      // Far from every point M's shape there is a guess (a panel past a
-      // fold without points stays flat): pulling its border onto the
-      // outline would tilt the guess, not correct it.
-      if (!(points.Distance(m.mesh3d[v]) <= max_gap)) continue;
-      const Eigen::Vector2d px = cam.ProjectCam(x);
-      double best = std::numeric_limits<double>::infinity();
-      Eigen::Vector2d q, tangent;
-      bool cut = false;
-      for (size_t i = 0; i < n; ++i) {
-        const Eigen::Vector2d a = contour[i], b = contour[(i + 1) % n];
-        const Eigen::Vector2d d = b - a;
-        const double len2 = d.squaredNorm();
-        if (!(len2 > 0)) continue;
-        const double u = std::clamp((px - a).dot(d) / len2, 0.0, 1.0);
-        const Eigen::Vector2d on = a + u * d;
-        const double dist = (px - on).squaredNorm();
-        if (dist < best) {
-          best = dist;
-          q = on;
-          tangent = d / std::sqrt(len2);
-          cut = on_frame(a) && on_frame(b);
-        }
-      }
-      if (!std::isfinite(best) || cut) continue;
-      isometry::Marker mk;
-      mk.where = VertexSurfacePoint(g, r, c);
-      mk.ray_origin = centre;
-      mk.ray_direction = cam.RayDirection(q);
-      mk.across = mk.ray_direction.cross(cam.RayDirection(q + tangent)).normalized();
-      if (!mk.across.allFinite()) continue;
-      markers.push_back(mk);
-    }
-  return markers;
-}
-
 }  // namespace
 
 // ---------------------------------------------------------------------------
@@ -722,14 +629,7 @@ Result Run(const Inputs& in, const Options& o) {
   problem.points = region_points;
   isometry::SolveOptions so = o.refine;
   so.weights.line = 0;
-  so.weights.ray = o.outline_hold;
-  if (o.outline_hold > 0 && !in.boundary.contour.empty()) {
-    auto nearest = std::make_shared<NearestPoint>(region_points);
-    problem.markers = OutlineMarkers(m, cam, in.boundary.contour, *nearest, o);
-    so.on_outer_iteration = [&, nearest](const isometry::OuterIterationContext& c) {
-      *c.markers = OutlineMarkers(*c.meshes, cam, in.boundary.contour, *nearest, o);
-    };
-  }
+  so.weights.ray = 0;
   isometry::Result refined = isometry::Solve(problem, so);
   m = refined.meshes;
   res.refine = refined.report;
@@ -823,8 +723,7 @@ Json OptionsToJson(const Options& o) {
         {"prior_weight", o.outline_prior.prior_weight},
         {"agreement", o.outline_prior.agreement}}},
       {"refine",
-       {{"lambda",
-         {r.weights.iso, r.weights.dist, r.weights.fair3d, r.weights.fair2d, 0.0, o.outline_hold}},
+       {{"lambda", {r.weights.iso, r.weights.dist, r.weights.fair3d, r.weights.fair2d, 0.0, 0.0}},
         {"beta", {r.beta_point, r.beta_normal}},
         {"outlier_distance", r.outlier_distance},
         {"unsupported_fairness", r.unsupported_fairness},
@@ -833,9 +732,6 @@ Json OptionsToJson(const Options& o) {
          r.iso_normalization == isometry::IsoNormalization::kStrain ? "strain" : "raw"},
         {"iso_edges", r.iso_edges},
         {"fair2d_along", r.fair2d_along},
-        {"outline_hold", o.outline_hold},
-        {"outline_hold_max_angle_deg", o.outline_hold_max_angle_deg},
-        {"outline_hold_support", o.outline_hold_support},
         {"method", r.method == isometry::Method::kGaussNewton ? "gn" : "lbfgs"},
         {"max_outer_iterations", r.max_outer_iterations},
         {"relative_tolerance", r.relative_tolerance},

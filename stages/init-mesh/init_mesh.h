@@ -102,15 +102,6 @@ struct Options {
     return o;
   }();
   bool upright = true;
-  // λ6 of E_ray on markers holding M's border vertices to the page outline
-  // in the reference image (they may slide along it); 0 = off.
-  double outline_hold = 0;
-  // Border vertices where M's normal is more than this off the viewing ray
-  // are not held (there the outline is likely a silhouette).
-  double outline_hold_max_angle_deg = 70;
-  // ... and those farther than this (fraction of the model size) from every
-  // point of the region.
-  double outline_hold_support = 0.1;
   // The depth of blank paper from the page's outline in 3D (densify's
   // outline points, source 2 in points.ply): outline_prior.h.
   OutlinePriorOptions outline_prior;

@@ -97,21 +97,6 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"strain", "raw"}));
   AddIsoEdgesOption(app, &o.refine.iso_edges);
   AddFair2dAlongOption(app, &o.refine.fair2d_along);
-  app.add_option("--outline-hold", o.outline_hold,
-                 "weight of the term holding M's border to the page outline in the reference "
-                 "image (sliding along it); 0 = off")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 1e6));
-  app.add_option("--outline-hold-max-angle", o.outline_hold_max_angle_deg,
-                 "border vertices where M is seen more than this far off its normal (degrees) are "
-                 "not held: the outline there is likely a silhouette")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 90.0));
-  app.add_option("--outline-hold-support", o.outline_hold_support,
-                 "border vertices farther than this from every point (fraction of the model "
-                 "size) are not held: M's shape there is a guess")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 10.0));
   app.add_option("--method", method, "gn: Gauss-Newton/Levenberg-Marquardt; lbfgs: L-BFGS")
       ->capture_default_str()
       ->check(CLI::IsMember({"gn", "lbfgs"}));

@@ -92,56 +92,6 @@ TEST(InitMeshCli, TheOutlineShapesBlankPaperBetweenFolds) {
   EXPECT_FALSE(ReadJsonFile(without / "40_init/init.json")["outline_prior"]["used"].get<bool>());
 }
 
-// Mean distance, in reference pixels, from M's border vertices to the page
-// outline of boundary.json.
-double BorderToOutlinePx(const fs::path& work) {
-  const MeshPair m = ReadMeshPair(work / "40_init");
-  const CameraSet cams = ReadCameras(work / "10_sfm/cameras.json");
-  const PinholeCamera& cam = *cams.Find(cams.reference);
-  const Json boundary = ReadJsonFile(work / "20_boundary/boundary.json");
-  std::vector<Eigen::Vector2d> contour;
-  for (const Json& p : boundary.at("contour"))
-    contour.emplace_back(p.at(0).get<double>(), p.at(1).get<double>());
-  double sum = 0;
-  int count = 0;
-  for (int r = 0; r < m.grid.ny; ++r)
-    for (int c = 0; c < m.grid.nx; ++c) {
-      if (r != 0 && r != m.grid.ny - 1 && c != 0 && c != m.grid.nx - 1) continue;
-      const Eigen::Vector2d px = cam.Project(m.mesh3d[m.grid.Index(r, c)]);
-      double best = 1e300;
-      for (size_t i = 0; i < contour.size(); ++i) {
-        const Eigen::Vector2d a = contour[i], d = contour[(i + 1) % contour.size()] - a;
-        const double u = std::clamp((px - a).dot(d) / std::max(d.squaredNorm(), 1e-12), 0.0, 1.0);
-        best = std::min(best, (px - a - u * d).norm());
-      }
-      sum += best;
-      ++count;
-    }
-  return sum / count;
-}
-
-// --outline-hold keeps M's border on the page outline where the margins have
-// no points, without moving M off the page (support 1: every border vertex
-// is held, also those farther than the default 0.1 of the size from points).
-TEST(InitMeshCli, OutlineHoldKeepsTheBorderOnTheOutline) {
-  TempDir held, free;
-  const MeshPair truth = WriteFoldedPageWithMarginsWork(held.path(), 40, 30, 0.15);
-  WriteFoldedPageWithMarginsWork(free.path(), 40, 30, 0.15);
-  const CommandResult a =
-      RunCommand(InitMeshCommand(held.path(), "--outline-hold 1 --outline-hold-support 1"));
-  ASSERT_EQ(a.exit_code, 0) << a.output;
-  const CommandResult b = RunCommand(InitMeshCommand(free.path()));
-  ASSERT_EQ(b.exit_code, 0) << b.output;
-  const double with = BorderToOutlinePx(held.path()), without = BorderToOutlinePx(free.path());
-  std::printf("[init] border to outline: %.2f px held, %.2f px not\n", with, without);
-  EXPECT_LT(with, 0.5);
-  EXPECT_LE(with, without + 0.05);
-  const double size = isometry::ModelSize(truth);
-  EXPECT_LT(SurfaceDistance(ReadMeshPair(held / "40_init"), truth).mean, 0.002 * size);
-  const Json init = ReadJsonFile(held / "40_init/init.json");
-  EXPECT_EQ(init.at("producer").at("options").at("refine").at("outline_hold").get<double>(), 1.0);
-}
-
 TEST(InitMeshCli, MissingOrCorruptFilesAreBadInput) {
   TempDir dir;
   WriteSyntheticWork(dir.path(), 400);
