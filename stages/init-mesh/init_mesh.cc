@@ -565,7 +565,7 @@ Result Run(const Inputs& in, const Options& o) {
   }
   res.points_for_depth = int(kept_px.size());
   const DepthField depth(kept_px, kept_depth, std::max(1, o.depth_neighbours), res.rbf_scale_px,
-                         o.depth_model, o.planar_neighbours, o.planar_guard);
+                         o.depth_model, o.planar_neighbours);
   const Eigen::Matrix3d K_inv = cam.K.inverse();
   const Eigen::Matrix3d R_t = cam.R.transpose();
   auto lift = [&](const Eigen::Vector2d& px) -> Eigen::Vector3d {
@@ -706,7 +706,6 @@ Json OptionsToJson(const Options& o) {
       {"rbf_scale_px", o.rbf_scale_px},
       {"depth_model", o.depth_model == DepthModel::kPlanar ? "planar" : "average"},
       {"planar_neighbours", o.planar_neighbours},
-      {"planar_guard", o.planar_guard},
       {"depth_outlier", o.depth_outlier},
       {"mask_margin_px", o.mask_margin_px},
       {"min_points", o.min_points},
@@ -756,7 +755,7 @@ Json ResultToJson(const Inputs& in, const Result& r, const Options& o, double re
                   {"rbf_scale_px", r.rbf_scale_px},
                   {"model", o.depth_model == DepthModel::kPlanar ? "planar" : "average"},
                   {"planar_neighbours", o.planar_neighbours},
-                  {"planar_guard", o.planar_guard}};
+                  {"planar_guard", 0.0}};
   {
     const OutlinePriorResult& p = r.outline_prior;
     doc["outline_prior"] = {{"used", p.used},

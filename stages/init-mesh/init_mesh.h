@@ -50,14 +50,6 @@ struct Options {
   // continue their panel's plane instead of taking the nearest text's depth.
   DepthModel depth_model = DepthModel::kPlanar;
   int planar_neighbours = 16;
-  // Where the planar fit to the 2·planar_neighbours nearest disagrees with
-  // the fit to the planar_neighbours nearest by more than this fraction of
-  // the depth, the wider fit is taken (0 = off). It repaired one front end of
-  // set06 (a few short text lines tilted the fit at the curl, M 0.43 % off
-  // the true surface: MS-SSIM 0.606, 0.892 with 0.01) but, over four front
-  // ends, moved the other sets either way by a few hundredths (README,
-  // "Depth of blank paper"), so it is off.
-  double planar_guard = 0;
   // Points whose depth differs by more than this fraction from the median
   // depth of their 8 nearest image neighbours are not used for the depth
   // (they still take part in the refinement, where φ decides).

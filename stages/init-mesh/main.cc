@@ -50,12 +50,6 @@ int main(int argc, char** argv) {
   app.add_option("--planar-k", o.planar_neighbours, "nearest SfM points in each planar depth fit")
       ->capture_default_str()
       ->check(CLI::Range(6, 256));
-  app.add_option("--planar-guard", o.planar_guard,
-                 "where the planar fits to the 2 x --planar-k and the --planar-k nearest "
-                 "points disagree by more than this fraction of the depth, take the wider "
-                 "one; 0 = off")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 1.0));
   app.add_option("--depth-outlier", o.depth_outlier,
                  "points off the median depth of their image neighbours by more than this "
                  "fraction are not used for the depth")
