@@ -41,17 +41,16 @@ TEST(InitMeshCli, SyntheticSheetIsReconstructed) {
 
 // A folded, tilted page whose margins have no points (as printed pages):
 // the default depth model and fairness carry each panel out to the edge.
-// The paper's settings are printed for comparison (on exact, dense points
-// like these they do as well; the difference shows on SfM clouds with
-// gaps, README "Blank paper").
+// The paper's depth model is printed for comparison (on exact, dense points
+// like these it does as well; the difference shows on SfM clouds with
+// gaps).
 TEST(InitMeshCli, BlankMarginsContinueTheirPanels) {
   TempDir ours, paper;
   const MeshPair truth = WriteFoldedPageWithMarginsWork(ours.path(), 40, 30, 0.15);
   WriteFoldedPageWithMarginsWork(paper.path(), 40, 30, 0.15);
   const CommandResult a = RunCommand(InitMeshCommand(ours.path()));
   ASSERT_EQ(a.exit_code, 0) << a.output;
-  const CommandResult b =
-      RunCommand(InitMeshCommand(paper.path(), "--depth-model average --unsupported-fairness 1"));
+  const CommandResult b = RunCommand(InitMeshCommand(paper.path(), "--depth-model average"));
   ASSERT_EQ(b.exit_code, 0) << b.output;
   const double size = isometry::ModelSize(truth);
   const auto with = SurfaceDistance(ReadMeshPair(ours / "40_init"), truth);
@@ -169,16 +168,38 @@ TEST(InitMeshCli, PointsOnPartOfThePageNameTheMissingPart) {
   EXPECT_NE(r2.output.find("inside the document region"), std::string::npos) << r2.output;
 }
 
+// boundary.json is read as every stage reads it: one that does not follow
+// its schema is bad input, naming the file and the part.
+TEST(InitMeshCli, MalformedBoundaryIsBadInput) {
+  TempDir dir;
+  WriteSyntheticWork(dir.path(), 400);
+  Json doc = ReadJsonFile(dir / "20_boundary/boundary.json");
+  doc["corners"] = Json::array({{10, 10}, {20, 20}});
+  WriteJsonAtomic(dir / "20_boundary/boundary.json", doc);
+  const CommandResult r = RunCommand(InitMeshCommand(dir.path()));
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("boundary.json:/corners"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(dir / "40_init/init.json"));
+}
+
+// A boundary whose sides cannot carry a Coons patch (here the left side is
+// a stub, cut off by the image border) gives a grid over the mask's bounding
+// box, with a warning.
 TEST(InitMeshCli, UnusableBoundaryFallsBackToTheMaskWithAWarning) {
   TempDir dir;
   const MeshPair truth = WriteSyntheticWork(dir.path());
   Json doc = ReadJsonFile(dir / "20_boundary/boundary.json");
-  doc["corners"] = Json::array({{10, 10}, {20, 20}});
-  doc["sides"].erase("left");
+  Json& left = doc["sides"]["left"];
+  const Json first = left["points"][0];
+  left["points"] = Json::array(
+      {first, {first[0].get<double>(), first[1].get<double>() + 2}});  // 2 px: too short
+  left["real"] = false;
   WriteJsonAtomic(dir / "20_boundary/boundary.json", doc);
   const CommandResult r = RunCommand(InitMeshCommand(dir.path(), "--grid 8x12"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_NE(r.output.find("warning"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("warning: boundary unusable (the left side is too short"),
+            std::string::npos)
+      << r.output;
   const Json init = ReadJsonFile(dir / "40_init/init.json");
   EXPECT_EQ(init["grid"]["source"], "mask_bbox");
   // The real sides it still has are found on the bounding-box grid.
