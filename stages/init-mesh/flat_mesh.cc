@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <opencv2/imgproc.hpp>
 #include <optional>
 #include <string>
 #include <vector>
@@ -14,27 +15,17 @@
 namespace docunfold::init_mesh {
 namespace {
 
-// Convex hull (Andrew's monotone chain), counter-clockwise in x-right y-up.
-std::vector<Eigen::Vector2d> ConvexHull(std::vector<Eigen::Vector2d> p) {
-  std::sort(p.begin(), p.end(), [](const auto& a, const auto& b) {
-    return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
-  });
-  if (p.size() < 3) return p;
-  auto cross = [](const Eigen::Vector2d& o, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
-    return (a.x() - o.x()) * (b.y() - o.y()) - (a.y() - o.y()) * (b.x() - o.x());
-  };
-  std::vector<Eigen::Vector2d> h(2 * p.size());
-  size_t k = 0;
-  for (size_t i = 0; i < p.size(); ++i) {
-    while (k >= 2 && cross(h[k - 2], h[k - 1], p[i]) <= 0) --k;
-    h[k++] = p[i];
-  }
-  for (size_t i = p.size() - 1, t = k + 1; i-- > 0;) {
-    while (k >= t && cross(h[k - 2], h[k - 1], p[i]) <= 0) --k;
-    h[k++] = p[i];
-  }
-  h.resize(k - 1);
-  return h;
+// The points of `p` on its convex hull, counter-clockwise in x-right y-up.
+// OpenCV decides which they are on the points rounded to float; the hull's
+// points are `p`'s own.
+std::vector<Eigen::Vector2d> ConvexHull(const std::vector<Eigen::Vector2d>& p) {
+  std::vector<cv::Point2f> rounded;
+  for (const Eigen::Vector2d& q : p) rounded.emplace_back(float(q.x()), float(q.y()));
+  std::vector<int> on_hull;
+  cv::convexHull(rounded, on_hull, /*clockwise=*/false, /*returnPoints=*/false);
+  std::vector<Eigen::Vector2d> hull;
+  for (const int i : on_hull) hull.push_back(p[size_t(i)]);
+  return hull;
 }
 
 // Direction (radians) of an axis of the minimum-area bounding rectangle: one
