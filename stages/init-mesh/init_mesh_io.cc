@@ -147,8 +147,7 @@ Json ResultToJson(const Inputs& in, const Result& r, const Options& o, const Jso
   doc["depth"] = {{"neighbours", o.depth_neighbours},
                   {"rbf_scale_px", r.rbf_scale_px},
                   {"model", o.depth_model == DepthModel::kPlanar ? "planar" : "average"},
-                  {"planar_neighbours", o.planar_neighbours},
-                  {"planar_guard", 0.0}};
+                  {"planar_neighbours", o.planar_neighbours}};
   {
     const OutlinePriorResult& p = r.outline_prior;
     doc["outline_prior"] = {{"used", p.used},
