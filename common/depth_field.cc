@@ -9,23 +9,21 @@
 namespace docunfold {
 
 DepthField::DepthField(std::vector<Eigen::Vector2d> pixels, std::vector<double> depths, int k,
-                       double scale, DepthModel model, int planar_k, double planar_guard)
+                       double scale, DepthModel model, int planar_k)
     : pixels_(std::move(pixels)),
       depths_(std::move(depths)),
       k_(k),
       scale_(scale),
       model_(model),
       planar_k_(planar_k),
-      planar_guard_(planar_guard),
       index_(std::make_unique<PointIndex2d>(pixels_)) {}
 
 DepthField::~DepthField() = default;
 
 double DepthField::At(const Eigen::Vector2d& px) const {
   const bool planar = model_ == DepthModel::kPlanar;
-  const int fit_k = planar_guard_ > 0 ? 2 * planar_k_ : planar_k_;
   const std::vector<std::pair<int, double>> nearest =
-      index_->Nearest(px, planar ? std::max(k_, fit_k) : k_);
+      index_->Nearest(px, planar ? std::max(k_, planar_k_) : k_);
   double sw = 0, sz = 0;
   for (size_t i = 0; i < std::min<size_t>(nearest.size(), size_t(k_)); ++i) {
     const double weight = 1 / (1 + nearest[i].second / (scale_ * scale_));
@@ -34,14 +32,8 @@ double DepthField::At(const Eigen::Vector2d& px) const {
   }
   const double average = sz / sw;
   if (!planar) return average;
-  double inv = PlanarInverseDepth(px, nearest, std::min<size_t>(nearest.size(), size_t(planar_k_)));
-  if (planar_guard_ > 0 && nearest.size() > size_t(planar_k_)) {
-    const double wide =
-        PlanarInverseDepth(px, nearest, std::min<size_t>(nearest.size(), size_t(fit_k)));
-    // Compared as depths: |1/inv - 1/wide| > guard / wide.
-    if (std::isfinite(wide) && (!std::isfinite(inv) || std::abs(wide / inv - 1) > planar_guard_))
-      inv = wide;
-  }
+  const double inv =
+      PlanarInverseDepth(px, nearest, std::min<size_t>(nearest.size(), size_t(planar_k_)));
   return std::isfinite(inv) ? 1 / inv : average;
 }
 

@@ -19,15 +19,12 @@ enum class DepthModel { kAverage, kPlanar };
 // (r in units of the farthest of them), which is exact for a plane and so
 // carries each panel on over blank paper (margins, gaps between columns)
 // instead of levelling it to the nearest points' depth; it stays within
-// those neighbours' depth range. With `planar_guard` > 0 the fit is also made
-// over the 2·planar_k nearest, and that wider fit is taken where the two
-// disagree by more than planar_guard of the depth: a few close clusters
-// (short text lines beside blank paper) can tilt the narrow fit's plane.
+// those neighbours' depth range.
 class DepthField {
  public:
   // `pixels` and `depths` (> 0) correspond; at least one point.
   DepthField(std::vector<Eigen::Vector2d> pixels, std::vector<double> depths, int k, double scale,
-             DepthModel model, int planar_k, double planar_guard = 0);
+             DepthModel model, int planar_k);
   ~DepthField();
   DepthField(const DepthField&) = delete;
   DepthField& operator=(const DepthField&) = delete;
@@ -47,7 +44,6 @@ class DepthField {
   double scale_;
   DepthModel model_;
   int planar_k_;
-  double planar_guard_;
   std::unique_ptr<PointIndex2d> index_;
 };
 

@@ -1,6 +1,6 @@
 // init-mesh: the initial pair of meshes M (3D page) and M' (its flat twin)
-// from the SfM points and the page boundary in the reference image (paper
-// §"Initialization", DESIGN §5):
+// from the SfM points and the page boundary in the reference image (the
+// paper's "Initialization"):
 //  1. a quad grid M^r on the page in the reference image: a Coons patch of
 //     the four boundary sides (resampled by arc length on the page), else a
 //     grid over the mask's bounding box;
@@ -16,7 +16,6 @@
 #pragma once
 
 #include <Eigen/Core>
-#include <array>
 #include <filesystem>
 #include <opencv2/core.hpp>
 #include <string>
@@ -27,17 +26,24 @@
 #include "common/grid_mesh.h"
 #include "common/isometry/isometry.h"
 #include "common/json_io.h"
+#include "common/option_table.h"
+#include "common/page_files.h"
+#include "common/point_source.h"
 #include "stages/init-mesh/outline_prior.h"
 
 namespace docunfold::init_mesh {
 
 namespace fs = std::filesystem;
 
+// Quads of the grid M^r: `short_side` across the page's shorter side,
+// `long_side` along its longer side (sides measured on the page in 3D).
+struct GridQuads {
+  int short_side = 20;
+  int long_side = 30;
+};
+
 struct Options {
-  // Grid of M^r in quads: `grid_short` across the page's shorter side,
-  // `grid_long` along its longer side (sides measured on the page in 3D).
-  int grid_short = 20;
-  int grid_long = 30;
+  GridQuads grid;
   // Depth of a grid vertex: the k nearest projected SfM points, weighted by
   // φ(r) = 1/(1+r²) with r = pixel distance / rbf_scale_px. 0 = automatic:
   // the median spacing of the projected points, so the weights do not depend
@@ -50,14 +56,6 @@ struct Options {
   // continue their panel's plane instead of taking the nearest text's depth.
   DepthModel depth_model = DepthModel::kPlanar;
   int planar_neighbours = 16;
-  // Where the planar fit to the 2·planar_neighbours nearest disagrees with
-  // the fit to the planar_neighbours nearest by more than this fraction of
-  // the depth, the wider fit is taken (0 = off). It repaired one front end of
-  // set06 (a few short text lines tilted the fit at the curl, M 0.43 % off
-  // the true surface: MS-SSIM 0.606, 0.892 with 0.01) but, over four front
-  // ends, moved the other sets either way by a few hundredths (README,
-  // "Depth of blank paper"), so it is off.
-  double planar_guard = 0;
   // Points whose depth differs by more than this fraction from the median
   // depth of their 8 nearest image neighbours are not used for the depth
   // (they still take part in the refinement, where φ decides).
@@ -67,74 +65,51 @@ struct Options {
   // Bad input (exit 3): fewer points than this in the document region, or
   // points (at least min_points_per_ninth) in fewer than min_covered_ninths
   // of the page's 3x3 parts. A third of the page without points is a
-  // warning: fairness and isometry carry the mesh over it (set08's far panel
-  // is seen by one other photo only, realistic/r04 has 2 points in its right
-  // third).
+  // warning: fairness and isometry carry the mesh over it (a panel of a fold
+  // that only one other photo sees has none; see docs/decisions/init-mesh.md,
+  // "Points on part of the page").
   int min_points = 30;
   int min_points_per_ninth = 1;
   int min_covered_ninths = 5;
   // After unfolding, re-grid uniformly on the page (a Coons patch of the
   // border of M'), so that M' starts fair.
   bool regrid_on_page = true;
-  // The refinement: the joint optimisation with λ5 = λ6 = 0 (forced). λ4
-  // (fairness of M') is 0.01 here instead of the paper's 0.1: measured on the
-  // truth of all data sets, 0.1 leaves 0.9 % isometry error on a page cut
-  // by the image border (set08: the visible region is no quadrilateral on
-  // the page, so its grid lines are curves in M' that fairness fights) and
-  // 0.01 gives 0.17 % there while changing nothing measurable elsewhere.
-  // λ3 is not stiffened away from the points (unsupported_fairness, off
-  // here as in optimize): on a folded page whose fold runs through blank
-  // margins it rounds the fold there (init test
-  // BlankMarginsContinueTheirPanels: 0.33 % instead of 0.11 %).
-  // Edge-length rows join the paper's diagonal rows in E_iso (iso_edges
-  // 0.5): with diagonals only, the quads of set07's first grid (a zig-zag
-  // receipt seen at a grazing angle) twisted out of their planes and kept
-  // 5.7 % edge error; with them 0.2-0.3 %, M 0.8 % instead of 1.0-1.1 %
-  // off the truth, and the final result +0.024 MS-SSIM there (mean of 12
-  // sets +0.002 and +0.006 on two sfm runs). optimize keeps the paper's
-  // diagonals: there the edge rows cost set02 and r01 up to 0.04.
+  // The refinement: the joint optimisation with λ5 = λ6 = 0 (forced), with
+  // init-mesh's own defaults:
+  //  - λ4 (fairness of M') 0.01 instead of the paper's 0.1: on a page cut by
+  //    the image border the visible region is no quadrilateral on the page,
+  //    so its grid lines are curves in M' that a stronger fairness fights;
+  //  - edge-length rows join the paper's diagonal rows in E_iso (iso_edges
+  //    0.5): with diagonals only, quads seen at a grazing angle twist out of
+  //    their planes (optimize keeps the paper's diagonals);
+  //  - |ΔF/F| below the tolerance does not stop the refinement while the
+  //    Levenberg-Marquardt damping is above 0.01 (its steps are then short,
+  //    not converged).
+  // See docs/decisions/init-mesh.md, "The refinement's defaults".
   isometry::SolveOptions refine = [] {
     isometry::SolveOptions o;
     o.weights.fair2d = 0.01;
     o.iso_edges = 0.5;
-    // set07 stopped at 10-20x the F of other runs with μ at 0.2-0.7 (README).
     o.converged_max_damping = 0.01;
     return o;
   }();
   bool upright = true;
-  // λ6 of E_ray on markers holding M's border vertices to the page outline
-  // in the reference image (they may slide along it); 0 = off.
-  double outline_hold = 0;
-  // Border vertices where M's normal is more than this off the viewing ray
-  // are not held (there the outline is likely a silhouette).
-  double outline_hold_max_angle_deg = 70;
-  // ... and those farther than this (fraction of the model size) from every
-  // point of the region.
-  double outline_hold_support = 0.1;
   // The depth of blank paper from the page's outline in 3D (densify's
-  // outline points, source 2 in points.ply): outline_prior.h.
+  // outline points, PointSource::kOutline in points.ply): outline_prior.h.
   OutlinePriorOptions outline_prior;
+  bool verbose = false;  // log every outer iteration of the refinement
 };
 
-// boundary.json as init-mesh uses it (pixels of the reference image).
-struct Boundary {
-  struct Side {
-    std::vector<Eigen::Vector2d> points;
-    bool real = false;
-  };
-  std::vector<Eigen::Vector2d> contour;
-  std::vector<Eigen::Vector2d> corners;  // TL, TR, BR, BL when complete
-  std::array<Side, 4> sides;  // top (TL→TR), right (TR→BR), bottom (BL→BR), left (TL→BL)
-  std::vector<std::string> problems;  // why a part could not be read
-};
-inline constexpr std::array<const char*, 4> kSideNames = {"top", "right", "bottom", "left"};
+// Declares init-mesh's flags, bound to `options`' fields (the solver's
+// through isometry::DeclareSolveOptions).
+void DeclareOptions(OptionTable& table, Options* options);
 
 struct Inputs {
   PinholeCamera reference;              // the reference view
   std::vector<Eigen::Vector3d> points;  // SfM points, world frame
-  // Per point: points.ply's `source` (densify: 0 sfm, 1 texture, 2 outline,
-  // ...); empty when the file has none (sfm's own cloud).
-  std::vector<int> point_sources;
+  // Per point: points.ply's `source`; empty when the file has none (sfm's
+  // own cloud).
+  std::vector<PointSource> point_sources;
   Boundary boundary;
   cv::Mat1b mask;            // 255 inside the page
   fs::path reference_image;  // 10_sfm/reference.png
@@ -142,8 +117,6 @@ struct Inputs {
 
 // Reads and validates 10_sfm/{cameras.json, points.ply, reference.png} and
 // 20_boundary/{boundary.json, mask.png}; throws InputError naming the file.
-// An unusable boundary.json content is not an error (Run falls back to the
-// mask), a missing or corrupt file is.
 // `points_path` empty: sfm_dir/points.ply.
 Inputs ReadInputs(const fs::path& sfm_dir, const fs::path& boundary_dir,
                   const fs::path& points_path = {});
@@ -176,12 +149,15 @@ struct Result {
 // a third of the page without points), naming the part of the page.
 Result Run(const Inputs& inputs, const Options& options);
 
-Json OptionsToJson(const Options& options);
-// init.json (format docunfold.init).
+// Logs the warnings, whether the outline prior was used and, with
+// options.verbose, every outer iteration of the refinement.
+void LogResult(const Result& result, const Options& options);
+
+// init.json (format docunfold.init); `options_record` goes into its producer.
 Json ResultToJson(const Inputs& inputs, const Result& result, const Options& options,
-                  double read_seconds, double write_seconds);
+                  const Json& options_record, double read_seconds, double write_seconds);
 // mesh3d.ply, mesh2d.ply (textured by the reference image) and init.json.
 void WriteOutputs(const fs::path& out_dir, const Inputs& inputs, const Result& result,
-                  const Options& options, double read_seconds);
+                  const Options& options, const Json& options_record, double read_seconds);
 
 }  // namespace docunfold::init_mesh

@@ -1,11 +1,16 @@
 #include "stages/init-mesh/outline_prior.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "common/point_index.h"
 #include "common/raster.h"
+#include "common/statistics.h"
 
 namespace docunfold::init_mesh {
 namespace {
@@ -54,9 +59,8 @@ void SmoothProfile(Profile* p) {
   std::vector<double> out(n);
   for (size_t i = 0; i < n; ++i) {
     const size_t lo = i < 2 ? 0 : i - 2, hi = std::min(n, i + 3);
-    std::vector<double> w(p->inverse_depth.begin() + long(lo), p->inverse_depth.begin() + long(hi));
-    std::nth_element(w.begin(), w.begin() + long(w.size() / 2), w.end());
-    out[i] = w[w.size() / 2];
+    out[i] = Median(std::vector<double>(p->inverse_depth.begin() + long(lo),
+                                        p->inverse_depth.begin() + long(hi)));
   }
   p->inverse_depth = std::move(out);
 }
@@ -89,27 +93,14 @@ bool FillBorderLine(const std::vector<Eigen::Vector2d>& pixels,
   return true;
 }
 
-}  // namespace
-
-OutlinePriorResult OutlinePriorDepths(
-    const QuadGrid& grid, const std::vector<Eigen::Vector2d>& grid_pixels,
-    const std::vector<double>& grid_depths,
-    const std::array<std::vector<Eigen::Vector2d>, 4>& sides, const std::array<bool, 4>& real,
-    const PinholeCamera& camera, const std::vector<Eigen::Vector2d>& outline_pixels,
-    const std::vector<double>& outline_depths, const std::vector<Eigen::Vector2d>& point_pixels,
-    const std::vector<double>& point_depths, const OutlinePriorOptions& o) {
-  OutlinePriorResult r;
-  const int nx = grid.nx, ny = grid.ny;
-  if (!o.enabled) {
-    r.note = "off";
-    return r;
-  }
-  if (nx < 2 || ny < 2 || int(grid_pixels.size()) != nx * ny) {
-    r.note = "no grid";
-    return r;
-  }
-
-  // 1. The real sides' inverse depth along them, from the outline points.
+// 1. The real sides' inverse depth along them, from the outline points
+// (each on the nearest real side within side_distance_px), sorted along the
+// side and smoothed; counted into r->side_points and r->measured_sides.
+std::array<Profile, 4> SideProfiles(const std::array<std::vector<Eigen::Vector2d>, 4>& sides,
+                                    const std::array<bool, 4>& real,
+                                    const std::vector<Eigen::Vector2d>& outline_pixels,
+                                    const std::vector<double>& outline_depths,
+                                    const OutlinePriorOptions& o, OutlinePriorResult* r) {
   std::array<Profile, 4> profiles;
   for (size_t i = 0; i < outline_pixels.size(); ++i) {
     int side = -1;
@@ -139,17 +130,20 @@ OutlinePriorResult OutlinePriorDepths(
     }
     SmoothProfile(&sorted);
     p = std::move(sorted);
-    r.side_points[s] = int(p.t.size());
-    r.measured_sides += p.Usable(o.min_side_points);
+    r->side_points[s] = int(p.t.size());
+    r->measured_sides += p.Usable(o.min_side_points);
   }
-  if (r.measured_sides < o.min_measured_sides) {
-    r.note = std::to_string(r.measured_sides) + " sides with outline points (" +
-             std::to_string(o.min_measured_sides) + " needed)";
-    return r;
-  }
+  return profiles;
+}
 
-  // 2. The grid's border vertices at the depth of the side they lie on; a
-  // side without its own points straight between its corners.
+// 2. The grid's border vertices at the inverse depth of the side they lie
+// on; a side without its own points straight between its corners. False
+// (and why in `note`) when a border line gets no depth.
+bool BorderInverseDepths(const QuadGrid& grid, const std::vector<Eigen::Vector2d>& grid_pixels,
+                         const std::array<std::vector<Eigen::Vector2d>, 4>& sides,
+                         const std::array<Profile, 4>& profiles, const OutlinePriorOptions& o,
+                         std::vector<double>* border_out, std::string* note) {
+  const int nx = grid.nx, ny = grid.ny;
   std::vector<double> border(size_t(nx) * ny, kNaN);
   auto border_vertex = [&](int row, int col) {
     const Eigen::Vector2d& p = grid_pixels[size_t(grid.Index(row, col))];
@@ -188,8 +182,7 @@ OutlinePriorResult OutlinePriorDepths(
   // A line without points of its own (no outline point on its side) gets
   // its corners from the crossing lines, so the rows go again once the
   // columns are done: which side that is depends only on how the grid lies
-  // on the page (set07 lost the prior in every sfm run that labelled its
-  // unseen side top or bottom).
+  // on the page (see docs/decisions/init-mesh.md, "The outline prior").
   for (int pass = 0; pass < 2; ++pass)
     for (const auto& line : lines) {
       std::vector<Eigen::Vector2d> px;
@@ -204,15 +197,22 @@ OutlinePriorResult OutlinePriorDepths(
   for (const auto& line : lines)
     for (int v : line)
       if (!(border[size_t(v)] > 0)) {
-        r.note = "a border of the grid has no depth from the outline";
-        return r;
+        *note = "a border of the grid has no depth from the outline";
+        return false;
       }
+  *border_out = std::move(border);
+  return true;
+}
 
-  // 3. The Coons patch of the four border curves in 3D (camera frame).
-  const Eigen::Matrix3d K_inv = camera.K.inverse();
+// 3. The Coons patch of the four border curves in 3D (camera frame): the
+// inverse depth it gives each grid vertex. False (and why in `note`) when it
+// passes behind the camera.
+bool PatchInverseDepths(const QuadGrid& grid, const std::vector<Eigen::Vector2d>& grid_pixels,
+                        const std::vector<double>& border, const PinholeCamera& camera,
+                        std::vector<double>* prior_out, std::string* note) {
+  const int nx = grid.nx, ny = grid.ny;
   auto on_ray = [&](int v) -> Eigen::Vector3d {
-    const Eigen::Vector2d& p = grid_pixels[size_t(v)];
-    return (K_inv * Eigen::Vector3d(p.x(), p.y(), 1)) / border[size_t(v)];
+    return camera.CamRay(grid_pixels[size_t(v)]) / border[size_t(v)];
   };
   std::vector<double> prior(size_t(nx) * ny, kNaN);  // inverse depth
   const Eigen::Vector3d c00 = on_ray(grid.Index(0, 0)), c01 = on_ray(grid.Index(0, nx - 1)),
@@ -229,13 +229,28 @@ OutlinePriorResult OutlinePriorDepths(
     }
   for (double w : prior)
     if (!(w > 0)) {
-      r.note = "the outline's patch passes behind the camera";
-      return r;
+      *note = "the outline's patch passes behind the camera";
+      return false;
     }
+  *prior_out = std::move(prior);
+  return true;
+}
 
-  // 4. The points' residuals against the patch: its inverse depth at their
-  // pixels from a raster of the image grid.
-  const double diagonal = std::hypot(camera.width, camera.height);
+// The points judged against the patch: their pixels, their inverse depth
+// minus the patch's, and that residual relative to their depth.
+struct Residuals {
+  std::vector<Eigen::Vector2d> pixels;
+  std::vector<double> residual, relative;
+};
+
+// 4. The points' residuals against the patch (`prior`, inverse depth per
+// grid vertex): its inverse depth at their pixels from a raster of the
+// image grid.
+Residuals PointResiduals(const QuadGrid& grid, const std::vector<Eigen::Vector2d>& grid_pixels,
+                         const std::vector<double>& grid_depths, const std::vector<double>& prior,
+                         const PinholeCamera& camera,
+                         const std::vector<Eigen::Vector2d>& point_pixels,
+                         const std::vector<double>& point_depths) {
   const double scale = std::min(1.0, 1600.0 / std::max(camera.width, camera.height));
   std::vector<Eigen::Vector3d> screen;
   for (size_t v = 0; v < grid_pixels.size(); ++v)
@@ -247,46 +262,87 @@ OutlinePriorResult OutlinePriorDepths(
   Eigen::MatrixXf attribute(prior.size(), 1);
   for (size_t v = 0; v < prior.size(); ++v) attribute(long(v), 0) = float(prior[v]);
   const cv::Mat prior_image = InterpolateAttributes(raster, triangles, attribute);
-  std::vector<Eigen::Vector2d> judged_px;
-  std::vector<double> residual, relative;
+  Residuals judged;
   for (size_t i = 0; i < point_pixels.size(); ++i) {
     const int x = int(std::lround(point_pixels[i].x() * scale)),
               y = int(std::lround(point_pixels[i].y() * scale));
     if (x < 0 || y < 0 || x >= prior_image.cols || y >= prior_image.rows) continue;
     const float w = prior_image.at<float>(y, x);
     if (!std::isfinite(w) || !(point_depths[i] > 0)) continue;
-    judged_px.push_back(point_pixels[i]);
-    residual.push_back(1 / point_depths[i] - w);
-    relative.push_back(residual.back() * point_depths[i]);
+    judged.pixels.push_back(point_pixels[i]);
+    judged.residual.push_back(1 / point_depths[i] - w);
+    judged.relative.push_back(judged.residual.back() * point_depths[i]);
   }
-  if (judged_px.empty()) {
-    r.note = "no point on the grid";
-    return r;
-  }
+  return judged;
+}
 
-  // 5. Per grid vertex: the patch corrected by the points near it, weighed
-  // against the points' own planar depth by how well the patch fits them.
-  const PointIndex2d index(judged_px);
+// 5. Per grid vertex: the patch corrected by the points near it, weighed
+// against the points' own planar depth by how well the patch fits them.
+// Fills r->depth and r->mean_weight.
+void BlendWithPoints(const std::vector<Eigen::Vector2d>& grid_pixels,
+                     const std::vector<double>& grid_depths, const std::vector<double>& prior,
+                     const Residuals& judged, const PinholeCamera& camera,
+                     const OutlinePriorOptions& o, OutlinePriorResult* r) {
+  const double diagonal = std::hypot(camera.width, camera.height);
+  const PointIndex2d index(judged.pixels);
   const double radius = o.radius_fraction * diagonal;
-  r.depth.resize(prior.size());
+  r->depth.resize(prior.size());
   double weight_sum = 0;
   for (size_t v = 0; v < prior.size(); ++v) {
     double sw = 0, swr = 0, swe = 0;
     for (const auto& [i, d2] : index.Nearest(grid_pixels[v], o.neighbours)) {
       const double w = 1 / (1 + d2 / (radius * radius));
       sw += w;
-      swr += w * residual[size_t(i)];
-      swe += w * relative[size_t(i)] * relative[size_t(i)];
+      swr += w * judged.residual[size_t(i)];
+      swe += w * judged.relative[size_t(i)] * judged.relative[size_t(i)];
     }
     const double correction = swr / (o.prior_weight + sw);
     const double rms = sw > 0 ? std::sqrt(swe / sw) : 0;
     const double alpha = std::exp(-(rms * rms) / (o.agreement * o.agreement));
     const double inverse =
         alpha * (prior[v] + correction) + (1 - alpha) / std::max(grid_depths[v], 1e-9);
-    r.depth[v] = inverse > 0 ? 1 / inverse : grid_depths[v];
+    r->depth[v] = inverse > 0 ? 1 / inverse : grid_depths[v];
     weight_sum += alpha;
   }
-  r.mean_weight = weight_sum / double(prior.size());
+  r->mean_weight = weight_sum / double(prior.size());
+}
+
+}  // namespace
+
+OutlinePriorResult OutlinePriorDepths(
+    const QuadGrid& grid, const std::vector<Eigen::Vector2d>& grid_pixels,
+    const std::vector<double>& grid_depths,
+    const std::array<std::vector<Eigen::Vector2d>, 4>& sides, const std::array<bool, 4>& real,
+    const PinholeCamera& camera, const std::vector<Eigen::Vector2d>& outline_pixels,
+    const std::vector<double>& outline_depths, const std::vector<Eigen::Vector2d>& point_pixels,
+    const std::vector<double>& point_depths, const OutlinePriorOptions& o) {
+  OutlinePriorResult r;
+  const int nx = grid.nx, ny = grid.ny;
+  if (!o.enabled) {
+    r.note = "off";
+    return r;
+  }
+  if (nx < 2 || ny < 2 || int(grid_pixels.size()) != nx * ny) {
+    r.note = "no grid";
+    return r;
+  }
+  const std::array<Profile, 4> profiles =
+      SideProfiles(sides, real, outline_pixels, outline_depths, o, &r);
+  if (r.measured_sides < o.min_measured_sides) {
+    r.note = std::to_string(r.measured_sides) + " sides with outline points (" +
+             std::to_string(o.min_measured_sides) + " needed)";
+    return r;
+  }
+  std::vector<double> border, prior;
+  if (!BorderInverseDepths(grid, grid_pixels, sides, profiles, o, &border, &r.note)) return r;
+  if (!PatchInverseDepths(grid, grid_pixels, border, camera, &prior, &r.note)) return r;
+  const Residuals judged =
+      PointResiduals(grid, grid_pixels, grid_depths, prior, camera, point_pixels, point_depths);
+  if (judged.pixels.empty()) {
+    r.note = "no point on the grid";
+    return r;
+  }
+  BlendWithPoints(grid_pixels, grid_depths, prior, judged, camera, o, &r);
   r.used = true;
   return r;
 }

@@ -5,11 +5,10 @@
 // along lines that run from side to side (each fold a straight line between
 // two points of the outline: a ruled surface), and there the points inside
 // the page, often only a few rows of print, cannot tell a panel's blank middle
-// from a bulge: set07's receipt, whose folds cross blank paper, had init-mesh's
-// M 1.17 % of the diagonal off the true surface with the points alone and
-// 0.41 % with this prior (README, "Choices we measured"). Where the points
+// from a bulge (a receipt whose folds cross blank paper; see
+// docs/decisions/init-mesh.md, "The outline prior"). Where the points
 // disagree with the patch (a fold from a side to the next side, a curl, a
-// flap), the points decide, as before.
+// flap), the points decide.
 #pragma once
 
 #include <Eigen/Core>

@@ -17,6 +17,7 @@
 #include "common/grid_mesh.h"
 #include "common/json_io.h"
 #include "common/ply.h"
+#include "common/point_source.h"
 #include "common/raster.h"
 #include "tests/isometry/test_meshes.h"
 #include "tests/support/ground_truth.h"
@@ -187,7 +188,7 @@ inline MeshPair WriteFoldedPageWithMarginsWork(const fs::path& work, double fold
 // A sheet folded twice along lines from its top side to its bottom side (a
 // zig-zag, like a receipt), tilted, with points only in strips along the top
 // and bottom sides (`strip` of the height each: rows of print) and none in the
-// blank band between, plus densify-like outline points (source 2) along all
+// blank band between, plus densify-like outline points (PointSource::kOutline) along all
 // four sides; points.ply carries `source` (0 for the strips' points).
 inline MeshPair WriteZigZagWithBlankBandWork(const fs::path& work, double fold_deg, double strip) {
   const int nx = 31, ny = 30;
@@ -210,7 +211,7 @@ inline MeshPair WriteZigZagWithBlankBandWork(const fs::path& work, double fold_d
     for (int k = 0; k < 8; ++k) {
       cloud.vertices.push_back(a + (b - a) * (k / 8.0));
       cloud.colors.push_back({250, 250, 250});
-      source.values.push_back(2);
+      source.values.push_back(double(PointSource::kOutline));
     }
   };
   for (int c = 0; c + 1 < g.nx; ++c) {
