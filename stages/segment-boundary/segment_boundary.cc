@@ -21,9 +21,9 @@ void DeclareOptions(OptionTable& table, BoundaryOptions* o, OtherViews* views) {
               "colour distance (std. deviations of the background) beyond which a pixel is not "
               "background");
   table.Value("weak-table-distance", &o->weak_table_distance, 1.0, 100.0,
-              "pixels this far from the background (std. deviations; but not --table-distance) "
-              "are page where they touch it in areas --weak-min-width wide (e.g. the shaded "
-              "panel of a fold); set it to --table-distance to turn off");
+              "colour distance (std. deviations of the background) from which pixels are page "
+              "where they touch it in areas --weak-min-width wide (e.g. the shaded panel of a "
+              "fold); set it to --table-distance to turn off");
   table.Value("weak-min-width", &o->weak_min_width, 1, 101,
               "smallest width (px of the downscaled image) of such an area");
   table.Value("min-area", &o->min_area_fraction, 0.0, 1.0,

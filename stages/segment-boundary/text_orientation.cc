@@ -155,7 +155,8 @@ TextOrientation EstimateTextTopSide(const cv::Mat3b& image, const cv::Mat1b& mas
   out.votes = v.up + v.down;
   out.confidence = out.votes > 0 ? double(std::max(v.up, v.down)) / out.votes : 0.0;
   // Decide only on a clear majority: three standard deviations of a fair
-  // coin's count (single lines vote wrongly often).
+  // coin's count (single lines vote wrongly often; see
+  // docs/decisions/segment-boundary.md, "Text orientation by a clear majority").
   const double lead = std::abs(v.up - v.down);
   if (out.votes < 10 || lead < 3.0 * std::sqrt(double(out.votes))) {
     out.why = "text lines do not agree clearly (" + std::to_string(v.up) + " up, " +
