@@ -28,7 +28,7 @@ namespace fs = std::filesystem;
 // Where the page's top comes from.
 enum class OrientationSource {
   kAuto,      // the text when the page has enough of it to tell, else geometry
-  kText,      // the text; no page found when it does not tell
+  kText,      // the text; bad input when it does not tell
   kGeometry,  // the side facing the image's top
 };
 
