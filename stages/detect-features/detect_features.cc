@@ -82,8 +82,7 @@ FeaturesResult DetectFeatures(const cv::Mat& image, const cv::Mat& mask_in,
   if (cv::countNonZero(mask) == 0) throw InputError("mask is empty (no document region)");
   const auto start = std::chrono::steady_clock::now();
   auto step = [&](const std::string& what) {
-    if (options.verbose)
-      Log(what + " (" + std::to_string(SecondsSince(start)).substr(0, 5) + " s)");
+    if (options.verbose) Log(what + " (" + Fixed(SecondsSince(start), 3) + " s)");
   };
 
   const double diag = std::hypot(image.cols, image.rows);
@@ -103,7 +102,7 @@ FeaturesResult DetectFeatures(const cv::Mat& image, const cv::Mat& mask_in,
   step("ink: " + std::to_string(components.count - 1) + " marks");
   detail::TextResult text = detail::DetectTextSegments(components, options);
   step("text: " + std::to_string(text.segments.size()) + " segments, height " +
-       std::to_string(text.height).substr(0, 4) + " px");
+       Fixed(text.height, 2) + " px");
   std::vector<Segment> edges =
       detail::DetectEdgeSegments(grey, ink, components, text, region, options);
   step("edges: " + std::to_string(edges.size()) + " segments");

@@ -1,6 +1,6 @@
 // detect-features: short, locally reliable, straight segments in the
-// reference image (paper §"Feature line extraction", feature segment
-// detection), restricted to the document region:
+// reference image (the paper's feature segment detection, in its feature
+// line extraction), restricted to the document region:
 //   - text segments: pieces of text baselines. Characters (connected
 //     components of a Sauvola-binarised image) are chained with their
 //     neighbours of similar size along the text direction; each chain's

@@ -2,6 +2,7 @@
 // pairs of LSD edges, away from the region's outline and from characters.
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <map>
 #include <opencv2/imgproc.hpp>
 
@@ -111,16 +112,17 @@ std::vector<Piece> JoinCollinear(std::vector<Piece> pieces, double max_gap, doub
   return kept;
 }
 
-}  // namespace
+// Pieces shorter than this (px) are pixel noise even where a gap is bridged.
+constexpr double kShortestPiece = 4.0;
 
-std::vector<Segment> DetectEdgeSegments(const cv::Mat1b& grey, const cv::Mat1b& ink,
-                                        const InkComponents& components, const TextResult& text,
-                                        const cv::Mat1b& region, const FeaturesOptions& options) {
+// Step 1: LSD's line segments in `grey` (its pixels). LSD smooths before it
+// looks for gradients, which wipes out rules one pixel wide (a table's
+// column rules, seen obliquely): with small text it runs on the region's box
+// enlarged.
+std::vector<cv::Vec4f> DetectLsdLines(const cv::Mat1b& grey, const cv::Mat1b& region,
+                                      const TextResult& text, const FeaturesOptions& options) {
   std::vector<cv::Vec4f> lines;
   cv::Ptr<cv::LineSegmentDetector> lsd = cv::createLineSegmentDetector(cv::LSD_REFINE_STD);
-  // LSD smooths before it looks for gradients, which wipes out rules one
-  // pixel wide (a table's column rules, seen obliquely): with small text it
-  // runs on the region's box enlarged.
   const cv::Rect box = cv::boundingRect(region) & cv::Rect(0, 0, grey.cols, grey.rows);
   double upscale = options.lsd_upscale;
   if (upscale <= 0) upscale = text.height > 0 && text.height < 12 && box.area() <= 4e6 ? 2 : 1;
@@ -137,12 +139,13 @@ std::vector<Segment> DetectEdgeSegments(const cv::Mat1b& grey, const cv::Mat1b& 
   } else {
     lsd->detect(grey, lines);
   }
-  // Character strokes are shorter than a few text heights.
-  const double min_length =
-      std::max(options.min_length_px, text.height > 0 ? 3.0 * text.height : 0.0);
-  const double max_width = std::max(4.0, 0.6 * text.height);
-  // Pieces shorter than this are pixel noise even where a gap is bridged.
-  constexpr double kShortestPiece = 4.0;
+  return lines;
+}
+
+// Step 2: the LSD lines as edges: clipped to the region, at least
+// kShortestPiece long, their normal towards the darker side; longest first.
+std::vector<Edge> RegionEdges(const std::vector<cv::Vec4f>& lines, const cv::Mat1b& grey,
+                              const cv::Mat1b& region) {
   std::vector<Edge> edges;
   for (const cv::Vec4f& l : lines) {
     Edge e;
@@ -166,54 +169,71 @@ std::vector<Segment> DetectEdgeSegments(const cv::Mat1b& grey, const cv::Mat1b& 
   }
   std::sort(edges.begin(), edges.end(),
             [](const Edge& p, const Edge& q) { return p.length > q.length; });
+  return edges;
+}
 
-  std::vector<Segment> out;
-  std::vector<Piece> pieces;
-  // The ink a line runs along: none (a faint rule), or one component that
-  // is not a character and is line-like (long and thin, or a large grid).
-  auto along_printed_line = [&](const cv::Point2d& a, const cv::Point2d& b, double length) {
-    std::map<int, int> votes;
-    const int steps = std::max(2, int(length / 3.0));
-    for (int k = 0; k <= steps; ++k) {
-      const cv::Point2d p = a + (b - a) * (double(k) / steps);
-      const int x = int(std::lround(p.x)), y = int(std::lround(p.y));
-      int label = 0;
-      for (int dy = -1; dy <= 1 && !label; ++dy)
-        for (int dx = -1; dx <= 1 && !label; ++dx) {
-          const int xx = x + dx, yy = y + dy;
-          if (xx >= 0 && yy >= 0 && xx < ink.cols && yy < ink.rows && ink(yy, xx))
-            label = components.labels(yy, xx);
-        }
-      ++votes[label];
-    }
-    int best = 0, best_votes = 0;
-    for (auto [label, n] : votes)
-      if (n > best_votes) {
-        best = label;
-        best_votes = n;
+// Whether the line a-b (of `length` px) runs along printed ink: none (a
+// faint rule), or one component that is not a character and is line-like
+// (long and thin, or a large grid).
+bool AlongPrintedLine(const cv::Mat1b& ink, const InkComponents& components, const TextResult& text,
+                      const cv::Point2d& a, const cv::Point2d& b, double length) {
+  std::map<int, int> votes;
+  const int steps = std::max(2, int(length / 3.0));
+  for (int k = 0; k <= steps; ++k) {
+    const cv::Point2d p = a + (b - a) * (double(k) / steps);
+    const int x = int(std::lround(p.x)), y = int(std::lround(p.y));
+    int label = 0;
+    for (int dy = -1; dy <= 1 && !label; ++dy)
+      for (int dx = -1; dx <= 1 && !label; ++dx) {
+        const int xx = x + dx, yy = y + dy;
+        if (xx >= 0 && yy >= 0 && xx < ink.cols && yy < ink.rows && ink(yy, xx))
+          label = components.labels(yy, xx);
       }
-    // A faint rule may be too light to count as ink; text never is.
-    if (best == 0) return true;
-    if (best_votes < 0.8 * (steps + 1)) return false;
-    if (best < int(text.is_character.size()) && text.is_character[size_t(best)]) return false;
-    // Longer than the line found (a grid, a frame), or thin: for a line of
-    // length L and width w the box's diagonal is about L and the area L w,
-    // so diagonal^2 / area is about L / w, whatever the line's slant.
-    const double w = components.stats(best, cv::CC_STAT_WIDTH);
-    const double h = components.stats(best, cv::CC_STAT_HEIGHT);
-    const double area = components.stats(best, cv::CC_STAT_AREA);
-    const double diagonal = std::hypot(w, h);
-    return diagonal >= 1.5 * length || diagonal * diagonal / area >= 10.0;
-  };
+    ++votes[label];
+  }
+  int best = 0, best_votes = 0;
+  for (auto [label, n] : votes)
+    if (n > best_votes) {
+      best = label;
+      best_votes = n;
+    }
+  // A faint rule may be too light to count as ink; text never is.
+  if (best == 0) return true;
+  if (best_votes < 0.8 * (steps + 1)) return false;
+  if (best < int(text.is_character.size()) && text.is_character[size_t(best)]) return false;
+  // Longer than the line found (a grid, a frame), or thin: for a line of
+  // length L and width w the box's diagonal is about L and the area L w,
+  // so diagonal^2 / area is about L / w, whatever the line's slant.
+  const double w = components.stats(best, cv::CC_STAT_WIDTH);
+  const double h = components.stats(best, cv::CC_STAT_HEIGHT);
+  const double area = components.stats(best, cv::CC_STAT_AREA);
+  const double diagonal = std::hypot(w, h);
+  return diagonal >= 1.5 * length || diagonal * diagonal / area >= 10.0;
+}
 
+using LineTest = std::function<bool(const cv::Point2d&, const cv::Point2d&, double)>;
+
+// What pairing the edges found.
+struct Pairing {
+  std::vector<Piece> pieces;  // centre lines of thin dark lines, as found
+  int paired = 0;             // pairs of edges
+  int rejected = 0;           // ... of them not along a printed line
+};
+
+// Step 3: the centre lines between pairs of edges (the two sides of one thin
+// dark line, at most `max_width` apart) that run along printed ink; marks
+// the edges used. First the edges `min_length` long, which give a segment on
+// their own, then (when joining) the pieces, so that a piece never takes a
+// long edge's partner.
+Pairing PairEdges(std::vector<Edge>& edges, double min_length, double max_width,
+                  const FeaturesOptions& options, const LineTest& along_printed_line) {
+  Pairing pairing;
+  std::vector<Piece>& pieces = pairing.pieces;
   // Where t lies along s: the range of s (distances from s.a) it overlaps.
   auto overlap_along = [](const Edge& s, const Edge& t) {
     const double ua = (t.a - s.a).dot(s.dir), ub = (t.b - s.a).dot(s.dir);
     return std::pair(std::max(0.0, std::min(ua, ub)), std::min(s.length, std::max(ua, ub)));
   };
-  int paired = 0, rejected = 0;
-  // First the edges long enough to give a segment on their own, then (to be
-  // joined) the pieces, so that a piece never takes a long edge's partner.
   std::vector<double> shortest{min_length};
   if (options.join_gap > 0) shortest.push_back(kShortestPiece);
   for (const double shortest_edge : shortest)
@@ -251,7 +271,7 @@ std::vector<Segment> DetectEdgeSegments(const cv::Mat1b& grey, const cv::Mat1b& 
           return p - tn * (0.5 * dist);
         };
         const cv::Point2d p0 = midpoint(u0), p1 = midpoint(u1);
-        ++paired;
+        ++pairing.paired;
         if (cv::norm(p1 - p0) >= std::max(shortest_edge, kShortestPiece) &&
             along_printed_line(p0, p1, cv::norm(p1 - p0))) {
           pieces.push_back({p0, p1, false, {}});
@@ -259,9 +279,31 @@ std::vector<Segment> DetectEdgeSegments(const cv::Mat1b& grey, const cv::Mat1b& 
           edges[size_t(partner)].used = true;
           continue;
         }
-        ++rejected;
+        ++pairing.rejected;
       }
     }
+  return pairing;
+}
+
+}  // namespace
+
+std::vector<Segment> DetectEdgeSegments(const cv::Mat1b& grey, const cv::Mat1b& ink,
+                                        const InkComponents& components, const TextResult& text,
+                                        const cv::Mat1b& region, const FeaturesOptions& options) {
+  const std::vector<cv::Vec4f> lines = DetectLsdLines(grey, region, text, options);
+  // Character strokes are shorter than a few text heights.
+  const double min_length =
+      std::max(options.min_length_px, text.height > 0 ? 3.0 * text.height : 0.0);
+  const double max_width = std::max(4.0, 0.6 * text.height);
+  std::vector<Edge> edges = RegionEdges(lines, grey, region);
+
+  std::vector<Segment> out;
+  const LineTest along_printed_line = [&](const cv::Point2d& a, const cv::Point2d& b,
+                                          double length) {
+    return AlongPrintedLine(ink, components, text, a, b, length);
+  };
+  Pairing pairing = PairEdges(edges, min_length, max_width, options, along_printed_line);
+  std::vector<Piece>& pieces = pairing.pieces;
   if (options.step_edges)
     for (Edge& s : edges)
       if (!s.used && s.length >= min_length) {
@@ -290,8 +332,8 @@ std::vector<Segment> DetectEdgeSegments(const cv::Mat1b& grey, const cv::Mat1b& 
     Log("LSD: " + std::to_string(lines.size()) + " edges, " + std::to_string(edges.size()) +
         " inside the region, " + std::to_string(paired_pieces) + " lines between them, " +
         std::to_string(pieces.size()) + " after joining, " + std::to_string(kept_lines) +
-        " long enough; " + std::to_string(paired) + " pairs, " + std::to_string(rejected) +
-        " of them not along a printed line");
+        " long enough; " + std::to_string(pairing.paired) + " pairs, " +
+        std::to_string(pairing.rejected) + " of them not along a printed line");
   return out;
 }
 

@@ -40,6 +40,6 @@ int main(int argc, char** argv) {
                                              image.rows, table.Record()));
     Log(std::to_string(result.text_segments) + " text and " + std::to_string(result.edge_segments) +
         " edge segments (text height " + std::to_string(int(std::lround(result.text_height))) +
-        " px), " + std::to_string(SecondsSince(start)).substr(0, 4) + " s");
+        " px), " + Fixed(SecondsSince(start), 2) + " s");
   });
 }

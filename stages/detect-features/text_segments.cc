@@ -180,11 +180,12 @@ std::vector<std::pair<int, int>> SplitWhereBent(const std::vector<cv::Point2d>& 
   return out;
 }
 
-TextResult DetectTextSegments(const InkComponents& ink, const FeaturesOptions& options) {
-  TextResult result;
-  result.is_character.assign(size_t(ink.count), 0);
+namespace {
+
+// Step 1: the marks of character size (merged letters of a word included),
+// with their pixels and centres; none when there are fewer than three.
+std::vector<Mark> CharacterMarks(const InkComponents& ink) {
   const double diag = std::hypot(ink.labels.cols, ink.labels.rows);
-  // 1. Marks of character size (merged letters of a word included).
   std::vector<int> mark_of(size_t(ink.count), -1);
   std::vector<Mark> marks;
   for (int l = 1; l < ink.count; ++l) {
@@ -199,26 +200,38 @@ TextResult DetectTextSegments(const InkComponents& ink, const FeaturesOptions& o
     mark_of[size_t(l)] = int(marks.size());
     marks.push_back(std::move(m));
   }
-  if (marks.size() < 3) return result;
+  if (marks.size() < 3) return {};
   for (int y = 0; y < ink.labels.rows; ++y) {
     const int* row = ink.labels.ptr<int>(y);
     for (int x = 0; x < ink.labels.cols; ++x)
       if (row[x] > 0 && mark_of[size_t(row[x])] >= 0)
         marks[size_t(mark_of[size_t(row[x])])].pixels.emplace_back(x, y);
   }
-  std::vector<double> sizes;
   for (Mark& m : marks) {
     cv::Point2d c(0, 0);
     for (const cv::Point& p : m.pixels) c += cv::Point2d(p);
     m.centre = c * (1.0 / double(m.pixels.size()));
-    sizes.push_back(std::sqrt(double(m.box.area())));
   }
+  return marks;
+}
 
-  // 2. Text direction d and its normal n (n points down the image for
-  //    left-to-right lines).
-  const double theta = TextDirection(marks, Median(sizes));
+// The text direction d and its normal n (n points down the image for
+// left-to-right lines).
+struct TextAxes {
+  double theta = 0;  // radians
+  cv::Point2d d, n;
+};
+
+// Step 2: the text direction, and every mark's extent along d and n.
+TextAxes FindTextAxes(std::vector<Mark>& marks) {
+  std::vector<double> sizes;
+  for (const Mark& m : marks) sizes.push_back(std::sqrt(double(m.box.area())));
+  TextAxes axes;
+  axes.theta = TextDirection(marks, Median(sizes));
+  const double theta = axes.theta;
   const cv::Point2d d(std::cos(theta), std::sin(theta)), n(-std::sin(theta), std::cos(theta));
-  result.direction_deg = theta * 180.0 / CV_PI;
+  axes.d = d;
+  axes.n = n;
   for (Mark& m : marks) {
     m.a0 = m.c0 = 1e300;
     m.a1 = m.c1 = -1e300;
@@ -230,18 +243,21 @@ TextResult DetectTextSegments(const InkComponents& ink, const FeaturesOptions& o
       m.c1 = std::max(m.c1, c);
     }
   }
-  std::vector<double> heights;
-  for (const Mark& m : marks) heights.push_back(m.height());
-  const double h_med = Median(heights);
-  // Dots, commas and noise are too small to chain; large marks are not text.
+  return axes;
+}
+
+// Step 3: chains of neighbours: the nearest mark ahead along d of similar
+// height whose across-extent overlaps, if each is the other's choice. Only
+// marks of about the median height `h_med` take part (dots, commas and noise
+// are too small to chain; large marks are not text). `cell`: the grid the
+// marks are looked up in.
+std::vector<std::vector<int>> ChainMarks(const std::vector<Mark>& marks, double h_med, double cell,
+                                         const FeaturesOptions& options) {
   std::vector<int> usable;
   for (size_t i = 0; i < marks.size(); ++i)
     if (marks[i].height() >= 0.4 * h_med && marks[i].height() <= 2.5 * h_med)
       usable.push_back(int(i));
 
-  // 3. Chain neighbours: the nearest mark ahead along d of similar height
-  //    whose across-extent overlaps, if each is the other's choice.
-  const double cell = 4.0 * h_med;
   double ax0 = 1e300, cy0 = 1e300;
   for (int i : usable) {
     ax0 = std::min(ax0, marks[i].a0);
@@ -293,9 +309,13 @@ TextResult DetectTextSegments(const InkComponents& ink, const FeaturesOptions& o
     for (int k = i; next[k] >= 0 && prev[next[k]] == k; k = next[k]) chain.push_back(next[k]);
     if (chain.size() >= 2) chains.push_back(std::move(chain));
   }
+  return chains;
+}
 
-  // 4. Line height (x-height band) from each chain's medians of tops and
-  //    bottoms, after removing its tilt.
+// Step 4: the line height (x-height band) from each chain's medians of tops
+// and bottoms, after removing its tilt; `h_med` when no chain has three marks.
+double LineHeight(const std::vector<Mark>& marks, const std::vector<std::vector<int>>& chains,
+                  double h_med) {
   std::vector<double> line_heights;
   for (const auto& chain : chains) {
     if (chain.size() < 3) continue;
@@ -312,84 +332,104 @@ TextResult DetectTextSegments(const InkComponents& ink, const FeaturesOptions& o
     }
     line_heights.push_back(Median(bottoms) - Median(tops) + 1);
   }
-  result.height = line_heights.empty() ? h_med : Median(line_heights);
-  const double x_height = result.height;
-  const double bin = std::max(1.5, 0.4 * x_height);
+  return line_heights.empty() ? h_med : Median(line_heights);
+}
 
-  // The outline of a chain on one side: in narrow bins along the line, the
-  // ink's extreme towards sign * n (sign +1: the +n side).
-  struct Sample {
-    double a, c;
-    int mark;
-  };
-  auto outline = [&](const std::vector<int>& chain, double sign) {
-    std::vector<Sample> samples;
-    for (int k : chain) {
-      const Mark& m = marks[k];
-      const int bins = int((m.a1 - m.a0) / bin) + 1;
-      std::vector<double> best(size_t(bins), -1e300), best_a(size_t(bins), 0),
-          least(size_t(bins), 1e300);
-      for (const cv::Point& p : m.pixels) {
-        const double a = p.x * d.x + p.y * d.y, c = sign * (p.x * n.x + p.y * n.y);
-        const int b = std::min(bins - 1, int((a - m.a0) / bin));
-        if (c > best[size_t(b)]) {
-          best[size_t(b)] = c;
-          best_a[size_t(b)] = a;
-        }
-        least[size_t(b)] = std::min(least[size_t(b)], c);
+// The chained text lines, as the later steps read them.
+struct TextLines {
+  std::vector<Mark> marks;
+  std::vector<std::vector<int>> chains;
+  cv::Point2d d, n;
+  double x_height = 0;
+  double bin = 0;   // width of the bins along d an outline is sampled in
+  double cell = 0;  // grid cell of the mark lookups
+};
+
+// One sample of a chain's outline: where along d, how far along sign * n,
+// and which mark it is on.
+struct Sample {
+  double a, c;
+  int mark;
+};
+
+// The outline of a chain on one side: in narrow bins along the line, the
+// ink's extreme towards sign * n (sign +1: the +n side).
+std::vector<Sample> Outline(const TextLines& lines, const std::vector<int>& chain, double sign) {
+  const std::vector<Mark>& marks = lines.marks;
+  const cv::Point2d d = lines.d, n = lines.n;
+  const double bin = lines.bin, x_height = lines.x_height;
+  std::vector<Sample> samples;
+  for (int k : chain) {
+    const Mark& m = marks[k];
+    const int bins = int((m.a1 - m.a0) / bin) + 1;
+    std::vector<double> best(size_t(bins), -1e300), best_a(size_t(bins), 0),
+        least(size_t(bins), 1e300);
+    for (const cv::Point& p : m.pixels) {
+      const double a = p.x * d.x + p.y * d.y, c = sign * (p.x * n.x + p.y * n.y);
+      const int b = std::min(bins - 1, int((a - m.a0) / bin));
+      if (c > best[size_t(b)]) {
+        best[size_t(b)] = c;
+        best_a[size_t(b)] = a;
       }
-      // Only bins the ink crosses nearly from one side of the x-height band
-      // to the other (stems, bowls): at the flanks of round letters the
-      // extreme is somewhere in the middle of the band. The ink's edge lies
-      // half a pixel beyond the last ink pixel's centre.
-      for (int b = 0; b < bins; ++b)
-        if (best[size_t(b)] > -1e299 && best[size_t(b)] - least[size_t(b)] >= 0.6 * x_height)
-          samples.push_back({best_a[size_t(b)], best[size_t(b)] + 0.5, k});
+      least[size_t(b)] = std::min(least[size_t(b)], c);
     }
-    std::sort(samples.begin(), samples.end(),
-              [](const Sample& p, const Sample& q) { return p.a < q.a; });
-    return samples;
-  };
-  // Each sample's offset from the median of its neighbours within
-  // `half_window` pixels either way, the chain's overall tilt removed.
-  // Descenders, or ascenders, stick out.
-  auto offsets = [&](const std::vector<Sample>& samples, double half_window) {
-    std::vector<double> out(samples.size(), 0.0);
-    if (samples.size() < 3) return out;
-    std::vector<cv::Point2d> raw;
-    for (const Sample& s : samples) raw.emplace_back(s.a, s.c);
-    const LineFit tilt = FitLine(raw);
-    const double slope =
-        tilt.direction.y / (std::abs(tilt.direction.x) > 1e-9 ? tilt.direction.x : 1e-9);
-    std::vector<double> e(samples.size());
-    for (size_t k = 0; k < samples.size(); ++k)
-      e[k] = samples[k].c - (tilt.point.y + slope * (samples[k].a - tilt.point.x));
-    for (size_t k = 0, lo = 0, hi = 0; k < samples.size(); ++k) {
-      while (samples[lo].a < samples[k].a - half_window) ++lo;
-      while (hi < samples.size() && samples[hi].a <= samples[k].a + half_window) ++hi;
-      out[k] = e[k] - Median(std::vector<double>(e.begin() + long(lo), e.begin() + long(hi)));
-    }
-    return out;
-  };
+    // Only bins the ink crosses nearly from one side of the x-height band
+    // to the other (stems, bowls): at the flanks of round letters the
+    // extreme is somewhere in the middle of the band. The ink's edge lies
+    // half a pixel beyond the last ink pixel's centre.
+    for (int b = 0; b < bins; ++b)
+      if (best[size_t(b)] > -1e299 && best[size_t(b)] - least[size_t(b)] >= 0.6 * x_height)
+        samples.push_back({best_a[size_t(b)], best[size_t(b)] + 0.5, k});
+  }
+  std::sort(samples.begin(), samples.end(),
+            [](const Sample& p, const Sample& q) { return p.a < q.a; });
+  return samples;
+}
 
-  // 5. Which side is the baseline. Two kinds of evidence:
-  //    - Almost every letter sits on the baseline, while on the other side
-  //      the x-height and the ascenders, capitals and digits alternate: the
-  //      side whose outline strays less from its local median is the
-  //      baseline (counted over narrow bins, so letters merged into words at
-  //      low resolution do not matter).
-  //    - Small marks: periods and commas sit inside the band on the
-  //      baseline, i- and j-dots float outside it on the other side.
-  //    Where neither is clear (a receipt of capitals and digits without
-  //    periods) or they disagree, no text segments are made: a mean line
-  //    taken for a baseline would be off by a whole x-height.
-  double stray_plus = 0, stray_minus = 0;
-  for (const auto& chain : chains) {
+// Each sample's offset from the median of its neighbours within
+// `half_window` pixels either way, the chain's overall tilt removed.
+// Descenders, or ascenders, stick out.
+std::vector<double> Offsets(const std::vector<Sample>& samples, double half_window) {
+  std::vector<double> out(samples.size(), 0.0);
+  if (samples.size() < 3) return out;
+  std::vector<cv::Point2d> raw;
+  for (const Sample& s : samples) raw.emplace_back(s.a, s.c);
+  const LineFit tilt = FitLine(raw);
+  const double slope =
+      tilt.direction.y / (std::abs(tilt.direction.x) > 1e-9 ? tilt.direction.x : 1e-9);
+  std::vector<double> e(samples.size());
+  for (size_t k = 0; k < samples.size(); ++k)
+    e[k] = samples[k].c - (tilt.point.y + slope * (samples[k].a - tilt.point.x));
+  for (size_t k = 0, lo = 0, hi = 0; k < samples.size(); ++k) {
+    while (samples[lo].a < samples[k].a - half_window) ++lo;
+    while (hi < samples.size() && samples[hi].a <= samples[k].a + half_window) ++hi;
+    out[k] = e[k] - Median(std::vector<double>(e.begin() + long(lo), e.begin() + long(hi)));
+  }
+  return out;
+}
+
+// Step 5a: how far (pixels, summed over the chains) the outlines on the +n
+// and on the -n side stray from their local median: almost every letter
+// sits on the baseline, while on the other side the x-height and the
+// ascenders, capitals and digits alternate (counted over narrow bins, so
+// letters merged into words at low resolution do not matter).
+void StrayVotes(const TextLines& lines, double* stray_plus, double* stray_minus) {
+  const double x_height = lines.x_height;
+  for (const auto& chain : lines.chains) {
     if (chain.size() < 3) continue;
     for (double side : {1.0, -1.0})
-      for (double o : offsets(outline(chain, side), 3 * x_height))
-        (side > 0 ? stray_plus : stray_minus) += std::min(std::abs(o), 0.6 * x_height);
+      for (double o : Offsets(Outline(lines, chain, side), 3 * x_height))
+        (side > 0 ? *stray_plus : *stray_minus) += std::min(std::abs(o), 0.6 * x_height);
   }
+}
+
+// Step 5b: small marks by the chains: periods and commas sit inside the band
+// on the baseline, i- and j-dots float outside it on the other side.
+// Counts the evidence that the baseline is on +n and on -n.
+void DotVotes(const InkComponents& ink, const TextLines& lines, int* dots_plus, int* dots_minus) {
+  const std::vector<Mark>& marks = lines.marks;
+  const cv::Point2d d = lines.d, n = lines.n;
+  const double x_height = lines.x_height, cell = lines.cell;
   std::vector<Mark> small;
   for (int l = 1; l < ink.count; ++l) {
     const int w = ink.stats(l, cv::CC_STAT_WIDTH), h = ink.stats(l, cv::CC_STAT_HEIGHT);
@@ -413,8 +453,7 @@ TextResult DetectTextSegments(const InkComponents& ink, const FeaturesOptions& o
   for (const Mark& m : small)
     small_grid[{int(std::floor(m.along_mid() / cell)), int(std::floor(m.across_mid() / cell))}]
         .push_back(&m);
-  int dots_plus = 0, dots_minus = 0;  // evidence that the baseline is on +n / -n
-  for (const auto& chain : chains) {
+  for (const auto& chain : lines.chains) {
     if (chain.size() < 3) continue;
     std::vector<cv::Point2d> mids;
     for (int k : chain) mids.emplace_back(marks[k].along_mid(), marks[k].across_mid());
@@ -442,21 +481,32 @@ TextResult DetectTextSegments(const InkComponents& ink, const FeaturesOptions& o
           const double c0 = m->c0 - base, c1 = m->c1 - base, c = 0.5 * (c0 + c1);
           if (c < t - 0.9 * x || c > b + 0.9 * x) continue;
           if (c1 < t + 0.1 * x)
-            ++dots_plus;  // a dot above the band (-n side)
+            ++*dots_plus;  // a dot above the band (-n side)
           else if (c0 > b - 0.1 * x)
-            ++dots_minus;  // a dot beyond the +n side
+            ++*dots_minus;  // a dot beyond the +n side
           else if (c1 >= b - 0.25 * x && c0 > t + 0.4 * x)
-            ++dots_plus;  // a period on +n
+            ++*dots_plus;  // a period on +n
           else if (c0 <= t + 0.25 * x && c1 < b - 0.4 * x)
-            ++dots_minus;  // a period on -n
+            ++*dots_minus;  // a period on -n
         }
       }
   }
-  result.votes_upright = int(std::lround(stray_minus));
-  result.votes_upside_down = int(std::lround(stray_plus));
-  result.dots_upright = dots_plus;
-  result.dots_upside_down = dots_minus;
-  // -1: baseline on -n, +1: on +n, 0: unclear.
+}
+
+// Step 5: which side is the baseline, from both kinds of evidence (recorded
+// in `result`): -1 on -n, +1 on +n, 0 where neither is clear (a receipt of
+// capitals and digits without periods) or they disagree. Then no text
+// segments are made: a mean line taken for a baseline would be off by a
+// whole x-height.
+int BaselineSide(const InkComponents& ink, const TextLines& lines, TextResult* result) {
+  double stray_plus = 0, stray_minus = 0;
+  StrayVotes(lines, &stray_plus, &stray_minus);
+  int dots_plus = 0, dots_minus = 0;  // evidence that the baseline is on +n / -n
+  DotVotes(ink, lines, &dots_plus, &dots_minus);
+  result->votes_upright = int(std::lround(stray_minus));
+  result->votes_upside_down = int(std::lround(stray_plus));
+  result->dots_upright = dots_plus;
+  result->dots_upside_down = dots_minus;
   const int by_stray = stray_minus > 1.15 * stray_plus   ? 1
                        : stray_plus > 1.15 * stray_minus ? -1
                                                          : 0;
@@ -464,65 +514,107 @@ TextResult DetectTextSegments(const InkComponents& ink, const FeaturesOptions& o
   const int by_dots = dots >= 5 && dots_plus >= 0.75 * dots    ? 1
                       : dots >= 5 && dots_minus >= 0.75 * dots ? -1
                                                                : 0;
-  const int side = by_stray != 0 && by_dots != 0 && by_stray != by_dots ? 0
-                   : by_stray != 0                                      ? by_stray
-                                                                        : by_dots;
-  const double sign = side < 0 ? -1.0 : 1.0;
-  result.orientation_known = side != 0;
-  if (side != 0) result.down = sign * n;
-  // Upside down: the baselines lie on the image-up side of their letters.
-  result.upside_down = side != 0 && sign * n.y < 0;
+  return by_stray != 0 && by_dots != 0 && by_stray != by_dots ? 0
+         : by_stray != 0                                      ? by_stray
+                                                              : by_dots;
+}
 
-  // 6. Baselines: the outline on the baseline side, descenders and raised
-  //    parts dropped, cut where it bends, fitted piece by piece.
+// Step 6, for one chain: the outline on the baseline side (`sign`),
+// descenders and raised parts dropped, cut where it bends, fitted piece by
+// piece; appends the pieces long enough to `segments`.
+void AddBaselineSegments(const TextLines& lines, const std::vector<int>& chain, double sign,
+                         const FeaturesOptions& options, std::vector<Segment>* segments) {
+  const cv::Point2d d = lines.d, n = lines.n;
+  const double x_height = lines.x_height;
   const double tolerance = std::max(options.bend_px, options.bend_rel * x_height);
   const double min_length = std::max(options.min_length_px, options.min_text_length * x_height);
-  for (const auto& chain : chains) {
+  const std::vector<Sample> samples = Outline(lines, chain, sign);
+  if (samples.size() < 5) return;
+  const std::vector<double> off = Offsets(samples, 3 * x_height);
+  const double band = 0.2 * x_height + 0.5;
+  std::vector<Sample> kept_samples;
+  for (size_t k = 0; k < samples.size(); ++k)
+    if (std::abs(off[k]) <= band) kept_samples.push_back(samples[k]);
+  // Where to cut is decided on the running median of the baseline: single
+  // samples a pixel off (the pixel grid, serifs, JPEG) would otherwise cut
+  // a straight line into pieces too short to keep, while a crease bends it
+  // over more than the window and still cuts it.
+  const std::vector<double> noise = options.bend_window > 0
+                                        ? Offsets(kept_samples, options.bend_window * x_height)
+                                        : std::vector<double>(kept_samples.size(), 0.0);
+  std::vector<cv::Point2d> kept, smooth;
+  std::vector<int> kept_mark;
+  for (size_t k = 0; k < kept_samples.size(); ++k) {
+    const double c = sign * kept_samples[k].c;  // back to image pixels
+    const double cs = sign * (kept_samples[k].c - noise[k]);
+    kept.emplace_back(kept_samples[k].a * d.x + c * n.x, kept_samples[k].a * d.y + c * n.y);
+    smooth.emplace_back(kept_samples[k].a * d.x + cs * n.x, kept_samples[k].a * d.y + cs * n.y);
+    kept_mark.push_back(kept_samples[k].mark);
+  }
+  for (auto [first, last] : SplitWhereBent(smooth, tolerance)) {
+    // Each piece's line is fitted to its samples within half the tolerance
+    // of the running median: the few farther off (serifs, a descender's
+    // stub) would tilt it.
+    std::vector<cv::Point2d> piece;
+    for (int k = first; k <= last; ++k)
+      if (std::abs(noise[size_t(k)]) <= 0.5 * tolerance) piece.push_back(kept[size_t(k)]);
+    int characters = 0;
+    for (int k = first; k <= last; ++k)
+      characters += k == first || kept_mark[size_t(k)] != kept_mark[size_t(k - 1)];
+    if (piece.size() < 5 || characters < 3) continue;
+    const LineFit fit = FitLine(piece);
+    if (fit.rms > 0.5 * tolerance) continue;
+    auto project = [&](const cv::Point2d& p) {
+      return fit.point + fit.direction * (p - fit.point).dot(fit.direction);
+    };
+    const cv::Point2d p0 = project(kept[size_t(first)]), p1 = project(kept[size_t(last)]);
+    if (cv::norm(p1 - p0) < min_length) continue;
+    segments->push_back({"text", {p0, p1}, characters});
+  }
+}
+
+}  // namespace
+
+TextResult DetectTextSegments(const InkComponents& ink, const FeaturesOptions& options) {
+  TextResult result;
+  result.is_character.assign(size_t(ink.count), 0);
+  // 1. Marks of character size.
+  TextLines lines;
+  lines.marks = CharacterMarks(ink);
+  if (lines.marks.size() < 3) return result;
+  const std::vector<Mark>& marks = lines.marks;
+
+  // 2. Text direction d and its normal n.
+  const TextAxes axes = FindTextAxes(lines.marks);
+  lines.d = axes.d;
+  lines.n = axes.n;
+  result.direction_deg = axes.theta * 180.0 / CV_PI;
+  std::vector<double> heights;
+  for (const Mark& m : marks) heights.push_back(m.height());
+  const double h_med = Median(heights);
+
+  // 3. Chains of neighbouring marks.
+  lines.cell = 4.0 * h_med;
+  lines.chains = ChainMarks(marks, h_med, lines.cell, options);
+
+  // 4. Line height.
+  result.height = LineHeight(marks, lines.chains, h_med);
+  lines.x_height = result.height;
+  lines.bin = std::max(1.5, 0.4 * lines.x_height);
+
+  // 5. Which side is the baseline.
+  const int side = BaselineSide(ink, lines, &result);
+  const double sign = side < 0 ? -1.0 : 1.0;
+  result.orientation_known = side != 0;
+  if (side != 0) result.down = sign * lines.n;
+  // Upside down: the baselines lie on the image-up side of their letters.
+  result.upside_down = side != 0 && sign * lines.n.y < 0;
+
+  // 6. Baselines, cut where they bend and fitted piece by piece.
+  for (const auto& chain : lines.chains) {
     for (int k : chain) result.is_character[size_t(marks[k].label)] = 1;
     if (!result.orientation_known) continue;
-    const std::vector<Sample> samples = outline(chain, sign);
-    if (samples.size() < 5) continue;
-    const std::vector<double> off = offsets(samples, 3 * x_height);
-    const double band = 0.2 * x_height + 0.5;
-    std::vector<Sample> kept_samples;
-    for (size_t k = 0; k < samples.size(); ++k)
-      if (std::abs(off[k]) <= band) kept_samples.push_back(samples[k]);
-    // Where to cut is decided on the running median of the baseline: single
-    // samples a pixel off (the pixel grid, serifs, JPEG) would otherwise cut
-    // a straight line into pieces too short to keep, while a crease bends it
-    // over more than the window and still cuts it.
-    const std::vector<double> noise = options.bend_window > 0
-                                          ? offsets(kept_samples, options.bend_window * x_height)
-                                          : std::vector<double>(kept_samples.size(), 0.0);
-    std::vector<cv::Point2d> kept, smooth;
-    std::vector<int> kept_mark;
-    for (size_t k = 0; k < kept_samples.size(); ++k) {
-      const double c = sign * kept_samples[k].c;  // back to image pixels
-      const double cs = sign * (kept_samples[k].c - noise[k]);
-      kept.emplace_back(kept_samples[k].a * d.x + c * n.x, kept_samples[k].a * d.y + c * n.y);
-      smooth.emplace_back(kept_samples[k].a * d.x + cs * n.x, kept_samples[k].a * d.y + cs * n.y);
-      kept_mark.push_back(kept_samples[k].mark);
-    }
-    for (auto [first, last] : SplitWhereBent(smooth, tolerance)) {
-      // Each piece's line is fitted to its samples within half the tolerance
-      // of the running median: the few farther off (serifs, a descender's
-      // stub) would tilt it.
-      std::vector<cv::Point2d> piece;
-      for (int k = first; k <= last; ++k)
-        if (std::abs(noise[size_t(k)]) <= 0.5 * tolerance) piece.push_back(kept[size_t(k)]);
-      int characters = 0;
-      for (int k = first; k <= last; ++k)
-        characters += k == first || kept_mark[size_t(k)] != kept_mark[size_t(k - 1)];
-      if (piece.size() < 5 || characters < 3) continue;
-      const LineFit fit = FitLine(piece);
-      if (fit.rms > 0.5 * tolerance) continue;
-      auto project = [&](const cv::Point2d& p) {
-        return fit.point + fit.direction * (p - fit.point).dot(fit.direction);
-      };
-      const cv::Point2d p0 = project(kept[size_t(first)]), p1 = project(kept[size_t(last)]);
-      if (cv::norm(p1 - p0) < min_length) continue;
-      result.segments.push_back({"text", {p0, p1}, characters});
-    }
+    AddBaselineSegments(lines, chain, sign, options, &result.segments);
   }
   return result;
 }

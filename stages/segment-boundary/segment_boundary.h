@@ -1,7 +1,7 @@
 // segment-boundary: the document region in the reference image, its outline,
-// its four corners and its four sides (paper §"Reference image and document
-// boundary"). Sides that run along the image border, because the page is cut
-// off there, are marked not real: they must never be straightened.
+// its four corners and its four sides (the paper's reference image and
+// document boundary). Sides that run along the image border, because the
+// page is cut off there, are marked not real: they must never be straightened.
 //
 // Orientation convention (also in schemas/docunfold.boundary.schema.json):
 // corners are TL, TR, BR, BL, in clockwise order as seen in the image. Which
@@ -12,14 +12,25 @@
 #pragma once
 
 #include <array>
+#include <filesystem>
 #include <functional>
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
 
 #include "common/json_io.h"
+#include "common/option_table.h"
 
 namespace docunfold::boundary {
+
+namespace fs = std::filesystem;
+
+// Where the page's top comes from.
+enum class OrientationSource {
+  kAuto,      // the text when the page has enough of it to tell, else geometry
+  kText,      // the text; bad input when it does not tell
+  kGeometry,  // the side facing the image's top
+};
 
 struct BoundaryOptions {
   // Long side, in pixels, of the downscaled image the region is found on
@@ -49,14 +60,23 @@ struct BoundaryOptions {
   double max_cut_fraction = 0.02;
   // Douglas–Peucker tolerance of the stored contour and sides (pixels).
   double contour_epsilon_px = 0.7;
-  // "auto": text when the page has enough text to tell, else geometry;
-  // "text" or "geometry" force one.
-  std::string orientation = "auto";
+  OrientationSource orientation = OrientationSource::kAuto;
   // Log each step and its time on stderr.
   bool verbose = false;
-
-  Json ToJson() const;
 };
+
+// The other photos of the scene: when `views_dir` is given, the page is also
+// found in every view that `cameras_path` (sfm's cameras.json) registers but
+// the reference.
+struct OtherViews {
+  fs::path views_dir;     // folder of the photos; empty: none
+  fs::path cameras_path;  // cameras.json, given with views_dir
+};
+
+// Declares every field of `options`, and --views/--cameras into `views`, as
+// flags of `table` (see common/option_table.h); a field's value is its
+// default.
+void DeclareOptions(OptionTable& table, BoundaryOptions* options, OtherViews* views);
 
 // One side of the page: a polyline along the outline from one corner to the
 // next, and which parts of it are the true page edge.
@@ -95,14 +115,38 @@ struct BoundaryResult {
 // no page-like region (an empty table, a blank image).
 BoundaryResult SegmentBoundary(const cv::Mat& bgr_image, const BoundaryOptions& options);
 
-// boundary.json (format docunfold.boundary, version 1).
+// boundary.json (format docunfold.boundary, version 1); `options_record`
+// goes into its producer record (OptionTable::Record).
 Json BoundaryToJson(const BoundaryResult& result, const std::string& image_name, int width,
-                    int height, const BoundaryOptions& options);
+                    int height, const Json& options_record);
 
 // The reference image with the outline, corners and side names drawn: real
 // sides in green, cut sides dashed in red; at most `max_size` pixels long.
 cv::Mat DrawBoundaryOverlay(const cv::Mat& bgr_image, const BoundaryResult& result,
                             int max_size = 1600);
+
+// What the stage writes for one photo into `dir`: mask.png, overlay.png and
+// boundary.json.
+struct BoundaryFiles {
+  fs::path dir;
+  cv::Mat1b mask;
+  cv::Mat overlay;
+  Json doc;
+};
+
+// The page in every view of `views` but the reference, each for
+// <out_dir>/views/<photo name>/. A view without a page is logged and left
+// out (render uses whichever views it finds); a photo that is missing or not
+// the size cameras.json says fails. `tried` receives how many views were
+// tried.
+std::vector<BoundaryFiles> SegmentOtherViews(const OtherViews& views, const fs::path& out_dir,
+                                             const BoundaryOptions& options,
+                                             const Json& options_record, int* tried);
+
+// Writes `reference` (into its dir, the output directory), removes the views
+// of an earlier run from <dir>/views (they would no longer match), then
+// writes `views`.
+void WriteBoundaryFiles(const BoundaryFiles& reference, const std::vector<BoundaryFiles>& views);
 
 // Internals exposed for tests.
 namespace detail {
@@ -131,15 +175,14 @@ bool IsShadingStep(const cv::Mat1f& grey, const cv::Mat1b& mask, double scale, c
 // Where a corner in the image is the end of a fold's crease that meets a
 // side a short way from the page's corner, moves the corner there: with the
 // narrow panel beyond the crease seen foreshortened, the crease's end turns
-// the outline more than the corner does (set08's reference view: 45 degrees
-// at a quarter of the corner reach, the corner 65 px further on 33). It
-// moves when, at that finer scale, exactly one of its arms turns by
-// `min_turn_deg` or more within `max_arm_fraction` of the arm, by less than
-// the corner found turns, which turns by under 60 degrees (a page corner
-// turns more); and when `is_fold` joins the corner found, but not that turn,
-// to an outline point at least an eighth of the outline away (else the
-// corner found may be the page's and the turn the crease's end: r03's
-// view_03).
+// the outline more than the corner does. It moves when, at a quarter of the
+// corner reach, exactly one of its arms turns by `min_turn_deg` or more
+// within `max_arm_fraction` of the arm, by less than the corner found turns,
+// which turns by under 60 degrees (a page corner turns more); and when
+// `is_fold` joins the corner found, but not that turn, to an outline point at
+// least an eighth of the outline away (else the corner found may be the
+// page's and the turn the crease's end). See docs/decisions/segment-boundary.md,
+// "Corners beside a crease's end and where the page leaves the image".
 std::array<int, 4> MoveFoldEndsToPageCorners(const std::vector<cv::Point>& contour,
                                              std::array<int, 4> idx,
                                              const std::function<bool(const cv::Point&)>& on_border,
@@ -149,11 +192,12 @@ std::array<int, 4> MoveFoldEndsToPageCorners(const std::vector<cv::Point>& conto
 // (the page runs out of the image there), moves it to a sharp convex turn
 // (>= `min_turn_deg`) on its real arm within `max_arm_fraction` of that
 // arm's length, when there is one: the page's own corner, with the short
-// piece from it to the border belonging to the next, cut side (set08's
-// reference view: the border exit turns 67 degrees, the true corner 39,
-// 16 % up the arm). Taking a crease kink there instead costs little: the
-// piece joins a cut side, which is never straightened, while a real side
-// running on past its corner would be straightened through it.
+// piece from it to the border belonging to the next, cut side (the border
+// exit can turn more sharply than the true corner). Taking a crease kink
+// there instead costs little: the piece joins a cut side, which is never
+// straightened, while a real side running on past its corner would be
+// straightened through it. See docs/decisions/segment-boundary.md, "Corners
+// beside a crease's end and where the page leaves the image".
 // `on_border` says whether an outline point lies on the image border.
 std::array<int, 4> MoveBorderCornersToPageCorners(
     const std::vector<cv::Point>& contour, std::array<int, 4> idx,

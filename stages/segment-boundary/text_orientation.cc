@@ -6,6 +6,8 @@
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
+#include "common/statistics.h"
+
 namespace docunfold::boundary {
 namespace {
 
@@ -102,8 +104,7 @@ TextOrientation EstimateTextTopSide(const cv::Mat3b& image, const cv::Mat1b& mas
     out.why = "too few character-like marks (" + std::to_string(heights.size()) + ")";
     return out;
   }
-  std::nth_element(heights.begin(), heights.begin() + heights.size() / 2, heights.end());
-  const double char_size = heights[heights.size() / 2];
+  const double char_size = NthSmallest(heights, heights.size() / 2);
   cv::Mat1b text = cv::Mat1b::zeros(ink.size());
   for (int y = 0; y < ink.rows; ++y)
     for (int x = 0; x < ink.cols; ++x)
@@ -154,8 +155,8 @@ TextOrientation EstimateTextTopSide(const cv::Mat3b& image, const cv::Mat1b& mas
   out.votes = v.up + v.down;
   out.confidence = out.votes > 0 ? double(std::max(v.up, v.down)) / out.votes : 0.0;
   // Decide only on a clear majority: three standard deviations of a fair
-  // coin's count (single lines vote wrongly often; on our data sets every
-  // decision taken this way was right).
+  // coin's count (single lines vote wrongly often; see
+  // docs/decisions/segment-boundary.md, "Text orientation by a clear majority").
   const double lead = std::abs(v.up - v.down);
   if (out.votes < 10 || lead < 3.0 * std::sqrt(double(out.votes))) {
     out.why = "text lines do not agree clearly (" + std::to_string(v.up) + " up, " +

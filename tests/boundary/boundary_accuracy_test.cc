@@ -33,7 +33,7 @@ struct ViewFigures {
 
 ViewFigures Measure(const GroundTruth& gt, const PinholeCamera& cam, const BoundaryResult& r) {
   const Boundary boundary =
-      ParseBoundary(boundary::BoundaryToJson(r, cam.image, cam.width, cam.height, {}),
+      ParseBoundary(boundary::BoundaryToJson(r, cam.image, cam.width, cam.height, Json::object()),
                     "segment-boundary's result for " + cam.image);
   ViewFigures v;
   v.f = evaluate::MeasureBoundary(evaluate::SeeTruth(gt, cam), r.mask, boundary);

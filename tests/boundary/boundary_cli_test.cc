@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 #include <random>
 
+#include "common/json_io.h"
 #include "tests/support/test_support.h"
 
 namespace docunfold::testing {
@@ -54,6 +55,18 @@ TEST(SegmentBoundaryCli, WritesMaskBoundaryAndOverlay) {
       RunCommand(Quote((SourceDir() / "scripts" / "validate-json").string()) + " " +
                  Quote((dir / "out" / "boundary.json").string()));
   EXPECT_EQ(valid.exit_code, 0) << valid.output;
+}
+
+TEST(SegmentBoundaryCli, OrientationIsAChoiceRecordedByName) {
+  TempDir dir;
+  const fs::path image = WriteScene(dir, true);
+  const CommandResult r = RunCommand(Binary() + " --image " + Quote(image.string()) + " --out " +
+                                     Quote((dir / "out").string()) + " --orientation geometry");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const Json doc = ReadJsonFile(dir / "out" / "boundary.json");
+  EXPECT_EQ(doc.at("orientation").at("method"), "geometry");
+  EXPECT_EQ(doc.at("producer").at("options").at("orientation"), "geometry");
+  EXPECT_EQ(doc.at("producer").at("options").at("verbose"), false);
 }
 
 TEST(SegmentBoundaryCli, MissingImageIsBadInput) {
@@ -131,6 +144,15 @@ TEST(SegmentBoundaryCli, OtherViewsGetTheirOwnPageMasks) {
   EXPECT_EQ(mask.size(), cv::Size(800, 600));
   EXPECT_GT(cv::countNonZero(mask), 0.15 * mask.total());
   EXPECT_TRUE(fs::is_regular_file(dir / "out" / "views" / "again" / "boundary.json"));
+  // Every boundary.json records the options the stage ran with, the same.
+  const Json reference_options =
+      ReadJsonFile(dir / "out" / "boundary.json").at("producer").at("options");
+  EXPECT_EQ(reference_options.at("orientation"), "auto");
+  EXPECT_EQ(reference_options.at("work_size"), 640);
+  EXPECT_FALSE(reference_options.contains("views"));  // paths are not recorded
+  EXPECT_EQ(
+      ReadJsonFile(dir / "out" / "views" / "again" / "boundary.json").at("producer").at("options"),
+      reference_options);
   EXPECT_FALSE(fs::exists(dir / "out" / "views" / "table"));
   EXPECT_NE(r.output.find("table.png"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("page found in 1 of 2 other views"), std::string::npos) << r.output;

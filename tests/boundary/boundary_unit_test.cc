@@ -98,7 +98,7 @@ TEST(SegmentBoundary, FindsAPageOnATexturedTable) {
 TEST(SegmentBoundary, GeometricOrientationPutsTheUpwardSideOnTop) {
   const Scene s = DrawScene(kTilted, false);
   BoundaryOptions opt;
-  opt.orientation = "geometry";
+  opt.orientation = OrientationSource::kGeometry;
   const BoundaryResult r = SegmentBoundary(s.image, opt);
   EXPECT_EQ(r.orientation.method, "geometry");
   EXPECT_LE(cv::norm(r.corners[0] - kTilted[0]), 3.0);  // (380, 140) starts the top side
@@ -108,7 +108,7 @@ TEST(SegmentBoundary, CutOffPageHasItsCutSideNotReal) {
   // The page runs off the bottom of the image.
   const Scene s = DrawScene({{350, 300}, {850, 320}, {840, 1100}, {340, 1080}}, true);
   BoundaryOptions opt;
-  opt.orientation = "geometry";
+  opt.orientation = OrientationSource::kGeometry;
   const BoundaryResult r = SegmentBoundary(s.image, opt);
   EXPECT_GE(Iou(r.mask, s.mask), 0.98);
   EXPECT_TRUE(r.sides[kTop].real);
