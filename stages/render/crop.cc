@@ -25,7 +25,7 @@ std::optional<Eigen::Vector2d> RayThroughTrianglePlane(const MeshPair& mesh,
   const Eigen::Vector3d a = camera.CamFromWorld(mesh.mesh3d[t[0]]);
   const Eigen::Vector3d b = camera.CamFromWorld(mesh.mesh3d[t[1]]);
   const Eigen::Vector3d c = camera.CamFromWorld(mesh.mesh3d[t[2]]);
-  const Eigen::Vector3d d = camera.K.inverse() * Eigen::Vector3d(pixel.x(), pixel.y(), 1);
+  const Eigen::Vector3d d = camera.CamRay(pixel);
   Eigen::Matrix3d A;
   A << b - a, c - a, -d;
   const Eigen::Vector3d sol = A.colPivHouseholderQr().solve(-a);
@@ -195,8 +195,7 @@ void RotateSide(SideFit* side, double angle) {
   side->direction = rot * side->direction;
 }
 
-CropRect ChooseCrop(std::array<SideFit, 4>* sides_in, const Eigen::Vector4d& visible_box,
-                    double middle_max_slant) {
+CropRect ChooseCrop(std::array<SideFit, 4>* sides_in, const Eigen::Vector4d& visible_box) {
   std::array<SideFit, 4>& sides = *sides_in;
   const double cx = 0.5 * (visible_box[0] + visible_box[2]);
   const double cy = 0.5 * (visible_box[1] + visible_box[3]);
@@ -214,28 +213,15 @@ CropRect ChooseCrop(std::array<SideFit, 4>* sides_in, const Eigen::Vector4d& vis
     drop(1, "right line lies left of the left line in M'");
   }
   CropRect crop{visible_box[0], visible_box[1], visible_box[2], visible_box[3], ""};
-  std::array<bool, 4> middle{};
-  for (int i = 0; i < 4; ++i)
-    middle[i] = sides[i].used && std::abs(SlantOf(sides[i], i)) <= middle_max_slant;
   // Each line bounds the rectangle where it is tightest over the extent the
-  // other sides leave (or, for a `middle` side, where it crosses the middle
-  // of that extent); the lines are within 45 degrees of their axes, so a few
-  // alternations settle on the rectangle.
+  // other sides leave; the lines are within 45 degrees of their axes, so a
+  // few alternations settle on the rectangle.
   for (int iter = 0; iter < 8; ++iter) {
     CropRect next = crop;
-    const double mx = 0.5 * (crop.x0 + crop.x1), my = 0.5 * (crop.y0 + crop.y1);
-    if (sides[0].used)
-      next.y0 =
-          middle[0] ? YAt(sides[0], mx) : std::max(YAt(sides[0], crop.x0), YAt(sides[0], crop.x1));
-    if (sides[2].used)
-      next.y1 =
-          middle[2] ? YAt(sides[2], mx) : std::min(YAt(sides[2], crop.x0), YAt(sides[2], crop.x1));
-    if (sides[3].used)
-      next.x0 =
-          middle[3] ? XAt(sides[3], my) : std::max(XAt(sides[3], crop.y0), XAt(sides[3], crop.y1));
-    if (sides[1].used)
-      next.x1 =
-          middle[1] ? XAt(sides[1], my) : std::min(XAt(sides[1], crop.y0), XAt(sides[1], crop.y1));
+    if (sides[0].used) next.y0 = std::max(YAt(sides[0], crop.x0), YAt(sides[0], crop.x1));
+    if (sides[2].used) next.y1 = std::min(YAt(sides[2], crop.x0), YAt(sides[2], crop.x1));
+    if (sides[3].used) next.x0 = std::max(XAt(sides[3], crop.y0), XAt(sides[3], crop.y1));
+    if (sides[1].used) next.x1 = std::min(XAt(sides[1], crop.y0), XAt(sides[1], crop.y1));
     crop = next;
   }
   const int used = int(sides[0].used) + sides[1].used + sides[2].used + sides[3].used;

@@ -1,7 +1,7 @@
 // The crop of the rectified page: boundary sides mapped onto M', straight
 // lines fitted to them, the small rotation that makes them axis aligned,
-// and the rectangle they bound (paper §"Image generation of rectified
-// document"; DESIGN §5).
+// and the rectangle they bound (the paper's "Image generation of rectified
+// document").
 #pragma once
 
 #include <Eigen/Core>
@@ -59,12 +59,7 @@ struct CropRect {
 // the wrong order (top below bottom, left right of right) are dropped
 // (their `used` cleared, `note` set); a degenerate result falls back to the
 // visible box.
-// A used side whose line is within `middle_max_slant` (radians) of its axis
-// bounds the rectangle where it crosses the middle of the other axis' extent
-// instead: a slightly slanted line then cuts off as much page at one end as
-// it leaves table at the other. (Negative: every side inscribed.)
-CropRect ChooseCrop(std::array<SideFit, 4>* sides, const Eigen::Vector4d& visible_box,
-                    double middle_max_slant = -1);
+CropRect ChooseCrop(std::array<SideFit, 4>* sides, const Eigen::Vector4d& visible_box);
 
 // A page cut off where no photo sees its edge ends somewhere past the crop;
 // a paper format of long-to-short ratio `aspect` says where. Lengthens `crop`

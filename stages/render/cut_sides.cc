@@ -57,6 +57,150 @@ Border GridBorder(const QuadGrid& g, int b, int depth) {
   return border;
 }
 
+// The grid border lying farthest out on the side of M' whose outward
+// normal is `n`.
+int OutermostBorder(const QuadGrid& g, const std::vector<Eigen::Vector2d>& flat,
+                    const Eigen::Vector2d& n) {
+  int best = 0;
+  double best_out = -1e300;
+  for (int b = 0; b < 4; ++b) {
+    const Border border = GridBorder(g, b, 0);
+    double sum = 0;
+    for (int v : border.vertex) sum += n.dot(flat[v]);
+    if (sum / border.vertex.size() > best_out) {
+      best_out = sum / border.vertex.size();
+      best = b;
+    }
+  }
+  return best;
+}
+
+// What the views see along the surface continued out from each column of
+// a border.
+struct BorderScan {
+  std::vector<double> crossings;  // where a view sees the page edge (the bound's coordinate)
+  std::vector<double> seen_page;  // per column: the farthest page seen
+  // Per border column: the continuation's direction (per step of t).
+  std::vector<Eigen::Vector3d> dir3;
+  std::vector<Eigen::Vector2d> dir2;
+  std::vector<char> view_crossed;  // per view: it saw the edge at least once
+};
+
+// Continues the surface out from every column of `border` (its inner
+// vertices `depth` steps inwards) past side `side`, up to
+// options.max_extension times `extent`, and follows it in every view's page
+// mask: where it leaves the page (a crossing) or how far the view sees page.
+BorderScan ScanBorder(const MeshPair& meshes, const std::vector<Eigen::Vector2d>& flat,
+                      const Border& border, int depth, int side, double extent,
+                      const std::vector<ViewMask>& views, const CutSideOptions& options) {
+  const Eigen::Vector2d n = Outward(side);
+  const bool vertical_axis = side == 0 || side == 2;  // the bound is a y
+  constexpr int kStepsPerExtent = 400;
+  BorderScan scan;
+  std::vector<double>& crossings = scan.crossings;
+  std::vector<double>& seen_page = scan.seen_page;
+  std::vector<Eigen::Vector3d>& dir3 = scan.dir3;
+  std::vector<Eigen::Vector2d>& dir2 = scan.dir2;
+  std::vector<char>& view_crossed = scan.view_crossed;
+  dir3.assign(border.vertex.size(), Eigen::Vector3d::Zero());
+  dir2.assign(border.vertex.size(), Eigen::Vector2d::Zero());
+  view_crossed.assign(views.size(), 0);
+  for (size_t k = 0; k < border.vertex.size(); ++k) {
+    const int vb = border.vertex[k], vi = border.inner[k];
+    const Eigen::Vector3d d3 = (meshes.mesh3d[vb] - meshes.mesh3d[vi]) / depth;
+    const Eigen::Vector2d d2 = (flat[vb] - flat[vi]) / depth;
+    const double speed = n.dot(d2);  // outward M' distance per step of t
+    if (!(speed > 0)) continue;
+    dir3[k] = d3;
+    dir2[k] = d2;
+    const double dt = extent / (kStepsPerExtent * speed);
+    const int steps = int(std::ceil(options.max_extension * kStepsPerExtent));
+    double column_seen = std::nan("");  // farthest page any view sees here
+    for (size_t v = 0; v < views.size(); ++v) {
+      const ViewMask& view = views[v];
+      const double m = options.frame_margin * std::hypot(view.camera.width, view.camera.height);
+      // -1 unseen (behind the camera or off the photo), 0 table, 1 page.
+      auto state_at = [&](int j, Eigen::Vector2d* px) {
+        const auto projected =
+            ProjectDistorted(view.camera, view.distortion, meshes.mesh3d[vb] + j * dt * d3);
+        if (!projected) return -1;
+        *px = *projected;
+        if (!(px->x() >= m && px->y() >= m && px->x() <= view.camera.width - 1 - m &&
+              px->y() <= view.camera.height - 1 - m))
+          return -1;
+        return view.mask(int(std::lround(px->y())), int(std::lround(px->x()))) ? 1 : 0;
+      };
+      // Out from the border for as long as the view sees page there.
+      Eigen::Vector2d px;
+      if (state_at(0, &px) != 1) continue;
+      int last_page = 0;
+      for (int j = 1; j <= steps; ++j) {
+        const int state = state_at(j, &px);
+        if (state == 1) {
+          last_page = j;
+          continue;
+        }
+        if (state == -1) break;  // off the photo: page at least to last_page
+        // Table from here on for confirm_px in the photo: a notch in the
+        // mask or a dark print blob is not the page edge.
+        int l = j + 1, ahead = 0;
+        Eigen::Vector2d px_ahead = px;
+        for (; l <= steps && (px_ahead - px).norm() < options.confirm_px; ++l)
+          if ((ahead = state_at(l, &px_ahead)) != 0) break;
+        if (ahead == 0 && (px_ahead - px).norm() >= options.confirm_px) {
+          const Eigen::Vector2d q = flat[vb] + (j - 0.5) * dt * d2;
+          crossings.push_back(vertical_axis ? q.y() : q.x());
+          view_crossed[v] = 1;
+          last_page = 0;  // the edge says more than a lower bound
+          break;
+        }
+        if (ahead != 1) break;
+        last_page = j = l;
+      }
+      if (last_page > 0) {
+        const Eigen::Vector2d q = flat[vb] + last_page * dt * d2;
+        const double c = vertical_axis ? q.y() : q.x();
+        column_seen = std::isnan(column_seen)  ? c
+                      : side == 0 || side == 3 ? std::min(column_seen, c)
+                                               : std::max(column_seen, c);
+      }
+    }
+    if (!std::isnan(column_seen)) seen_page.push_back(column_seen);
+  }
+  return scan;
+}
+
+// The surface continued past side `side` from every column of `border` up
+// to the line of edge->bound in M' (edge->strip).
+void BuildStrip(const MeshPair& meshes, const std::vector<Eigen::Vector2d>& flat,
+                const Border& border, int depth, int side, const BorderScan& scan,
+                const CutSideOptions& options, CutSideEdge* edge_out) {
+  const Eigen::Vector2d n = Outward(side);
+  const CutSideEdge& edge = *edge_out;
+  const std::vector<Eigen::Vector3d>& dir3 = scan.dir3;
+  const std::vector<Eigen::Vector2d>& dir2 = scan.dir2;
+  // Each column continues until it reaches the bound's line in M'.
+  ExtensionStrip& strip = edge_out->strip;
+  strip.cols = int(border.vertex.size());
+  const int band = std::max(0, options.band_rows);
+  strip.rows = band + std::max(2, options.strip_rows);
+  strip.mesh3d.resize(size_t(strip.cols) * strip.rows);
+  strip.flat.resize(strip.mesh3d.size());
+  const double target = (side == 0 || side == 3) ? -edge.bound : edge.bound;
+  for (int k = 0; k < strip.cols; ++k) {
+    const int vb = border.vertex[k];
+    const double speed = n.dot(dir2[k]);
+    const double t_end = speed > 0 ? std::max(0.0, (target - n.dot(flat[vb])) / speed) : 0;
+    for (int j = 0; j < strip.rows; ++j) {
+      // Band rows run back over the mesh, towards the inner vertex.
+      const double t = j < band ? -double(depth) * (band - j) / band
+                                : t_end * (j - band) / (strip.rows - band - 1);
+      strip.mesh3d[size_t(j) * strip.cols + k] = meshes.mesh3d[vb] + t * dir3[k];
+      strip.flat[size_t(j) * strip.cols + k] = flat[vb] + t * dir2[k];
+    }
+  }
+}
+
 }  // namespace
 
 std::array<CutSideEdge, 4> FindCutSideEdges(const MeshPair& meshes,
@@ -79,94 +223,17 @@ std::array<CutSideEdge, 4> FindCutSideEdges(const MeshPair& meshes,
     const bool vertical_axis = side == 0 || side == 2;  // the bound is a y
     const double extent =
         vertical_axis ? visible_box[3] - visible_box[1] : visible_box[2] - visible_box[0];
-    // The grid border lying farthest out on this side of M'.
-    int best = 0;
-    double best_out = -1e300;
-    for (int b = 0; b < 4; ++b) {
-      const Border border = GridBorder(g, b, 0);
-      double sum = 0;
-      for (int v : border.vertex) sum += n.dot(flat[v]);
-      if (sum / border.vertex.size() > best_out) {
-        best_out = sum / border.vertex.size();
-        best = b;
-      }
-    }
+    const int best = OutermostBorder(g, flat, n);
     const int rows_inward = (best == 0 || best == 2) ? g.ny - 1 : g.nx - 1;
     const int depth =
         std::clamp(int(std::lround(options.base_fraction * rows_inward)), 1, rows_inward);
     const Border border = GridBorder(g, best, depth);
-    constexpr int kStepsPerExtent = 400;
-    std::vector<double> crossings;
-    std::vector<double> seen_page;  // per column: the farthest page seen
-    // Per border column: the continuation's direction (per step of t).
-    std::vector<Eigen::Vector3d> dir3(border.vertex.size(), Eigen::Vector3d::Zero());
-    std::vector<Eigen::Vector2d> dir2(border.vertex.size(), Eigen::Vector2d::Zero());
-    std::vector<char> view_crossed(views.size(), 0);
-    for (size_t k = 0; k < border.vertex.size(); ++k) {
-      const int vb = border.vertex[k], vi = border.inner[k];
-      const Eigen::Vector3d d3 = (meshes.mesh3d[vb] - meshes.mesh3d[vi]) / depth;
-      const Eigen::Vector2d d2 = (flat[vb] - flat[vi]) / depth;
-      const double speed = n.dot(d2);  // outward M' distance per step of t
-      if (!(speed > 0)) continue;
-      dir3[k] = d3;
-      dir2[k] = d2;
-      const double dt = extent / (kStepsPerExtent * speed);
-      const int steps = int(std::ceil(options.max_extension * kStepsPerExtent));
-      double column_seen = std::nan("");  // farthest page any view sees here
-      for (size_t v = 0; v < views.size(); ++v) {
-        const ViewMask& view = views[v];
-        const double m = options.frame_margin * std::hypot(view.camera.width, view.camera.height);
-        // -1 unseen (behind the camera or off the photo), 0 table, 1 page.
-        auto state_at = [&](int j, Eigen::Vector2d* px) {
-          const auto projected =
-              ProjectDistorted(view.camera, view.distortion, meshes.mesh3d[vb] + j * dt * d3);
-          if (!projected) return -1;
-          *px = *projected;
-          if (!(px->x() >= m && px->y() >= m && px->x() <= view.camera.width - 1 - m &&
-                px->y() <= view.camera.height - 1 - m))
-            return -1;
-          return view.mask(int(std::lround(px->y())), int(std::lround(px->x()))) ? 1 : 0;
-        };
-        // Out from the border for as long as the view sees page there.
-        Eigen::Vector2d px;
-        if (state_at(0, &px) != 1) continue;
-        int last_page = 0;
-        for (int j = 1; j <= steps; ++j) {
-          const int state = state_at(j, &px);
-          if (state == 1) {
-            last_page = j;
-            continue;
-          }
-          if (state == -1) break;  // off the photo: page at least to last_page
-          // Table from here on for confirm_px in the photo: a notch in the
-          // mask or a dark print blob is not the page edge.
-          int l = j + 1, ahead = 0;
-          Eigen::Vector2d px_ahead = px;
-          for (; l <= steps && (px_ahead - px).norm() < options.confirm_px; ++l)
-            if ((ahead = state_at(l, &px_ahead)) != 0) break;
-          if (ahead == 0 && (px_ahead - px).norm() >= options.confirm_px) {
-            const Eigen::Vector2d q = flat[vb] + (j - 0.5) * dt * d2;
-            crossings.push_back(vertical_axis ? q.y() : q.x());
-            view_crossed[v] = 1;
-            last_page = 0;  // the edge says more than a lower bound
-            break;
-          }
-          if (ahead != 1) break;
-          last_page = j = l;
-        }
-        if (last_page > 0) {
-          const Eigen::Vector2d q = flat[vb] + last_page * dt * d2;
-          const double c = vertical_axis ? q.y() : q.x();
-          column_seen = std::isnan(column_seen)  ? c
-                        : side == 0 || side == 3 ? std::min(column_seen, c)
-                                                 : std::max(column_seen, c);
-        }
-      }
-      if (!std::isnan(column_seen)) seen_page.push_back(column_seen);
-    }
+    const BorderScan scan = ScanBorder(meshes, flat, border, depth, side, extent, views, options);
+    const std::vector<double>& crossings = scan.crossings;
+    const std::vector<double>& seen_page = scan.seen_page;
     edge.crossings = int(crossings.size());
     edge.columns_seen = int(seen_page.size());
-    edge.views = int(std::count(view_crossed.begin(), view_crossed.end(), 1));
+    edge.views = int(std::count(scan.view_crossed.begin(), scan.view_crossed.end(), 1));
     if (edge.crossings >= options.min_crossings) {
       edge.bound = Median(crossings);
       edge.edge_seen = true;
@@ -192,28 +259,7 @@ std::array<CutSideEdge, 4> FindCutSideEdges(const MeshPair& meshes,
       edge.extension = 0;
     }
     edge.measured = true;
-    if (edge.extension > 0) {
-      // Each column continues until it reaches the bound's line in M'.
-      ExtensionStrip& strip = edge.strip;
-      strip.cols = int(border.vertex.size());
-      const int band = std::max(0, options.band_rows);
-      strip.rows = band + std::max(2, options.strip_rows);
-      strip.mesh3d.resize(size_t(strip.cols) * strip.rows);
-      strip.flat.resize(strip.mesh3d.size());
-      const double target = (side == 0 || side == 3) ? -edge.bound : edge.bound;
-      for (int k = 0; k < strip.cols; ++k) {
-        const int vb = border.vertex[k];
-        const double speed = n.dot(dir2[k]);
-        const double t_end = speed > 0 ? std::max(0.0, (target - n.dot(flat[vb])) / speed) : 0;
-        for (int j = 0; j < strip.rows; ++j) {
-          // Band rows run back over the mesh, towards the inner vertex.
-          const double t = j < band ? -double(depth) * (band - j) / band
-                                    : t_end * (j - band) / (strip.rows - band - 1);
-          strip.mesh3d[size_t(j) * strip.cols + k] = meshes.mesh3d[vb] + t * dir3[k];
-          strip.flat[size_t(j) * strip.cols + k] = flat[vb] + t * dir2[k];
-        }
-      }
-    }
+    if (edge.extension > 0) BuildStrip(meshes, flat, border, depth, side, scan, options, &edge);
   }
   return edges;
 }
@@ -469,174 +515,6 @@ cv::Mat1b TextureStrips(const std::vector<const ExtensionStrip*>& strips,
         if (!fillable(y, x) || !(d > best(y, x))) continue;
         best(y, x) = d;
         (*image)(y, x) = r.colour(y, x);
-        done(y, x) = 255;
-      }
-  }
-  return done;
-}
-
-namespace {
-
-// Smaller singular value of a 2x2 map (how finely it resolves the page in
-// its worst direction), capped at 1: finer than the output tells nothing.
-double Resolution(const Eigen::Matrix2d& J) {
-  const Eigen::Matrix2d G = J.transpose() * J;
-  const double half_trace = 0.5 * G.trace();
-  const double d = std::sqrt(std::max(0.0, half_trace * half_trace - G.determinant()));
-  return std::min(1.0, std::sqrt(std::max(0.0, half_trace - d)));
-}
-
-// Per triangle: +1 when its projection winds the way it does in M', else -1.
-std::vector<signed char> Winding(const std::vector<Eigen::Vector2d>& pixels,
-                                 const std::vector<Eigen::Vector2d>& flat,
-                                 const std::vector<Triangle>& tris) {
-  auto cross = [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
-    return a.x() * b.y() - a.y() * b.x();
-  };
-  std::vector<signed char> w(tris.size());
-  for (size_t f = 0; f < tris.size(); ++f) {
-    const Triangle& t = tris[f];
-    const double a = cross(pixels[t[1]] - pixels[t[0]], pixels[t[2]] - pixels[t[0]]);
-    const double a2 = cross(flat[t[1]] - flat[t[0]], flat[t[2]] - flat[t[0]]);
-    w[f] = (a2 >= 0) == (a >= 0) ? 1 : -1;
-  }
-  return w;
-}
-
-// Per channel, the median ratio of `reference` to `view` over `where`; 1
-// with fewer than 500 pixels.
-cv::Vec3f MedianGain(const cv::Mat3b& reference, const cv::Mat3b& view, const cv::Mat1b& where) {
-  cv::Vec3f gain(1, 1, 1);
-  if (cv::countNonZero(where) < 500) return gain;
-  std::vector<double> ratios[3];
-  for (int y = 0; y < where.rows; ++y)
-    for (int x = 0; x < where.cols; ++x) {
-      if (!where(y, x)) continue;
-      const cv::Vec3b a = reference(y, x), b = view(y, x);
-      for (int k = 0; k < 3; ++k) ratios[k].push_back(a[k] / std::max(1.0, double(b[k])));
-    }
-  for (int k = 0; k < 3; ++k) gain[k] = float(Median(ratios[k]));
-  return gain;
-}
-
-}  // namespace
-
-cv::Mat1b TextureFromBetterViews(const MeshPair& meshes, const std::vector<Eigen::Vector2d>& flat,
-                                 const RasterResult& out_raster,
-                                 const PinholeCamera& reference_camera, double scale,
-                                 const std::vector<ViewMask>& views,
-                                 const std::vector<cv::Mat>& photos, bool antialias,
-                                 const cv::Mat1b& replaceable, const BetterViewOptions& options,
-                                 cv::Mat3b* image, std::vector<ViewRegistration>* registrations) {
-  const int W = image->cols, H = image->rows;
-  cv::Mat1b done(H, W, uchar(0));
-  if (!(options.min_gain > 0)) return done;
-  const std::vector<Triangle> tris = meshes.grid.Triangles();
-  const std::vector<Eigen::Vector3d>& world = meshes.mesh3d;
-  // Per triangle: d(world point)/d(output pixel).
-  const std::vector<Eigen::Matrix<double, 3, 2>> dx_dpix =
-      SurfacePerOutputPixel(world, flat, tris, scale);
-  // d(pixel)/d(world point) of `camera` at X.
-  auto projection_jacobian = [](const PinholeCamera& camera, const Eigen::Vector3d& X) {
-    return Eigen::Matrix<double, 2, 3>(camera.ProjectCamJacobian(camera.CamFromWorld(X)) *
-                                       camera.R);
-  };
-  auto point = [&](int y, int x, int* face) -> Eigen::Vector3d {
-    *face = out_raster.face(y, x);
-    const Triangle& t = tris[*face];
-    const cv::Vec2f b = out_raster.bary(y, x);
-    return (1 - b[0] - b[1]) * world[t[0]] + b[0] * world[t[1]] + b[1] * world[t[2]];
-  };
-  // The reference's resolution per output pixel; a view must beat it by
-  // min_gain.
-  cv::Mat1f reference_resolution(H, W, 0.0f);
-  for (int y = 0; y < H; ++y)
-    for (int x = 0; x < W; ++x) {
-      if (!replaceable(y, x) || out_raster.face(y, x) < 0) continue;
-      int f;
-      const Eigen::Vector3d X = point(y, x, &f);
-      reference_resolution(y, x) =
-          float(Resolution(projection_jacobian(reference_camera, X) * dx_dpix[f]));
-    }
-  cv::Mat1f best = reference_resolution * options.min_gain;
-  // The printed side: the winding most triangles have in the reference view.
-  std::vector<Eigen::Vector2d> reference_pixels(world.size());
-  for (size_t i = 0; i < world.size(); ++i)
-    reference_pixels[i] = reference_camera.Project(world[i]);
-  long majority = 0;
-  for (signed char w : Winding(reference_pixels, flat, tris)) majority += w;
-  const signed char printed = majority >= 0 ? 1 : -1;
-  Eigen::Vector3d lo = world[0], hi = world[0];
-  for (const auto& v : world) {
-    lo = lo.cwiseMin(v);
-    hi = hi.cwiseMax(v);
-  }
-  const double depth_tolerance = options.depth_tolerance * (hi - lo).norm();
-
-  const cv::Mat3b reference_image = image->clone();
-  const ReferenceRendering reference = PrepareReference(reference_image, replaceable);
-  for (size_t v = 0; v < views.size(); ++v) {
-    if (photos[v].empty()) continue;
-    const ViewMask& view = views[v];
-    const PinholeCamera& cam = view.camera;
-    // The view's depth buffer of M and the winding of each triangle in it.
-    std::vector<Eigen::Vector3d> screen(world.size());
-    std::vector<Eigen::Vector2d> pixels(world.size());
-    bool in_front = true;
-    for (size_t i = 0; i < world.size() && in_front; ++i) {
-      const auto p = ProjectDistorted(cam, view.distortion, world[i]);
-      in_front = p.has_value();
-      if (!in_front) break;
-      pixels[i] = *p;
-      screen[i] = {p->x(), p->y(), cam.CamFromWorld(world[i]).z()};
-    }
-    if (!in_front) continue;
-    const std::vector<signed char> winding = Winding(pixels, flat, tris);
-    const RasterResult depth = Rasterize(screen, tris, cam.width, cam.height);
-    const TextureSampler sampler(photos[v]);
-    ViewRendering r{cv::Mat3b(H, W, cv::Vec3b(0, 0, 0)), cv::Mat1f(H, W, 0.0f)};
-    cv::parallel_for_(cv::Range(0, H), [&](const cv::Range& range) {
-      for (int y = range.start; y < range.end; ++y)
-        for (int x = 0; x < W; ++x) {
-          if (!replaceable(y, x) || out_raster.face(y, x) < 0) continue;
-          int f;
-          const Eigen::Vector3d X = point(y, x, &f);
-          if (winding[f] != printed) continue;
-          const auto p = ProjectDistorted(cam, view.distortion, X);
-          if (!p || p->x() < 0 || p->y() < 0 || p->x() > cam.width - 1 || p->y() > cam.height - 1)
-            continue;
-          const int u = int(std::lround(p->x())), w = int(std::lround(p->y()));
-          if (!view.mask(w, u)) continue;
-          const float nearest = depth.depth(w, u);
-          if (std::isfinite(nearest) && cam.CamFromWorld(X).z() > nearest + depth_tolerance)
-            continue;
-          const Eigen::Matrix2d J = projection_jacobian(cam, X) * dx_dpix[f];
-          const float Jf[4] = {float(J(0, 0)), float(J(0, 1)), float(J(1, 0)), float(J(1, 1))};
-          float colour[3];
-          sampler.Sample(float(p->x()), float(p->y()), Jf, antialias, colour);
-          r.colour(y, x) =
-              cv::Vec3b(cv::saturate_cast<uchar>(colour[0]), cv::saturate_cast<uchar>(colour[1]),
-                        cv::saturate_cast<uchar>(colour[2]));
-          r.density(y, x) = float(std::max(1e-6, Resolution(J)));
-        }
-    });
-    if (cv::countNonZero(r.density > best) == 0) continue;  // nowhere better
-    // Registered with the reference's rendering as the cut sides' strips are.
-    const ViewRegistration reg = RegisterWithReference(reference, int(v), &r);
-    if (registrations) registrations->push_back(reg);
-    if (!reg.used) continue;
-    // Another exposure: the view's colours scaled to the reference's where
-    // both resolve the page well.
-    const cv::Vec3f gain =
-        MedianGain(reference_image, r.colour, (reference_resolution >= 0.7f) & (r.density >= 0.7f));
-    for (int y = 0; y < H; ++y)
-      for (int x = 0; x < W; ++x) {
-        const float d = r.density(y, x);
-        if (!replaceable(y, x) || !(d > best(y, x))) continue;
-        best(y, x) = d;
-        const cv::Vec3b c = r.colour(y, x);
-        cv::Vec3b& out = (*image)(y, x);
-        for (int k = 0; k < 3; ++k) out[k] = cv::saturate_cast<uchar>(c[k] * gain[k]);
         done(y, x) = 255;
       }
   }

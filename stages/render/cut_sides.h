@@ -4,9 +4,7 @@
 // the mesh border (straight on, in M and M' alike), projected into each
 // other view, and the page edge is where it leaves that view's page mask.
 // The same continuation, projected into the reference's own outline, reaches
-// a real side that M stops short of (render.cc). And the other photos'
-// texture where they see the page more squarely than the reference
-// (TextureFromBetterViews).
+// a real side that M stops short of (render_crop.cc).
 #pragma once
 
 #include <Eigen/Core>
@@ -18,7 +16,6 @@
 
 #include "common/camera.h"
 #include "common/grid_mesh.h"
-#include "common/raster.h"
 
 namespace docunfold::render {
 
@@ -100,7 +97,8 @@ struct CutSideEdge {
   double extension = 0;
   // True: the bound is where the other views see the page edge (median of
   // the crossings); false: no view sees the edge, and the bound is how far
-  // they see page (median over the border's columns of the farthest).
+  // they see page (CutSideOptions::seen_quantile over the border's columns
+  // of the farthest).
   bool edge_seen = false;
   int crossings = 0;     // border columns (in all views) that saw the edge
   int columns_seen = 0;  // border columns some view sees page past
@@ -137,34 +135,5 @@ cv::Mat1b TextureStrips(const std::vector<const ExtensionStrip*>& strips,
                         const cv::Mat3b& reference_render, const cv::Mat1b& reference_valid,
                         const cv::Mat1b& fillable, cv::Mat3b* image,
                         std::vector<ViewRegistration>* registrations, bool own_photo = false);
-
-// Where the reference view sees the page at a grazing angle (a fold's steep
-// panel, a curl's far side), another photo may see it squarely.
-struct BetterViewOptions {
-  // A photo replaces the reference's texture at an output pixel where it
-  // resolves the page at least this many times better: the smaller singular
-  // value of the map from output pixels to its pixels, each capped at 1
-  // (finer than the output tells nothing). 0 = off.
-  double min_gain = 0;
-  // A point is seen by a view when no part of M lies nearer to it along the
-  // ray by more than this fraction of M's diagonal.
-  double depth_tolerance = 0.005;
-};
-
-// Retextures the pixels of `image` in `replaceable` (the reference's own
-// samples) from the photos that resolve them at least
-// BetterViewOptions::min_gain times better than the reference camera does.
-// `out_raster` maps output pixels to triangles of `meshes` (output pixel
-// (x, y) is the point (x0 + (x + 0.5) / scale, y0 + (y + 0.5) / scale) of
-// `flat`). Each view's rendering is registered with `image` first (as in
-// TextureStrips) and its colours scaled to the reference's where both
-// resolve the page well. Returns the pixels retextured (255).
-cv::Mat1b TextureFromBetterViews(const MeshPair& meshes, const std::vector<Eigen::Vector2d>& flat,
-                                 const RasterResult& out_raster,
-                                 const PinholeCamera& reference_camera, double scale,
-                                 const std::vector<ViewMask>& views,
-                                 const std::vector<cv::Mat>& photos, bool antialias,
-                                 const cv::Mat1b& replaceable, const BetterViewOptions& options,
-                                 cv::Mat3b* image, std::vector<ViewRegistration>* registrations);
 
 }  // namespace docunfold::render

@@ -1,5 +1,5 @@
-// render: the flat page out of the pipeline (DESIGN §5, paper §"Image
-// generation of rectified document"). M' is texture-mapped with the
+// render: the flat page out of the pipeline (the paper's "Image generation
+// of rectified document"). M' is texture-mapped with the
 // reference image through M: every output pixel is a point of M' (triangle
 // and barycentrics), the same point of M is projected by the reference
 // camera and the reference image is sampled there (bicubic, filtered over
@@ -19,6 +19,7 @@
 #include "common/camera.h"
 #include "common/grid_mesh.h"
 #include "common/json_io.h"
+#include "common/option_table.h"
 #include "common/page_files.h"
 #include "common/shading.h"
 #include "stages/render/cut_sides.h"
@@ -32,8 +33,15 @@ inline constexpr double kIsoAspect = 1.4142135623730951;  // ISO 216: A4, A5, ..
 inline constexpr double kLetterAspect = 11.0 / 8.5;       // US Letter
 inline constexpr double kLegalAspect = 14.0 / 8.5;        // US Legal
 
+// Which lines the deskew turn follows (RenderOptions::deskew_by).
+enum class DeskewBy { kLines, kSides };
+
+// What becomes of the light's shading (RenderOptions::shading).
+enum class Shading { kKeep, kRemove };
+
 // How the output size is chosen. At most one of width, height, dpi and
-// scale may be set (main enforces it; Run throws UsageError otherwise).
+// scale may be set (their flags exclude each other; Run throws UsageError
+// otherwise).
 struct RenderOptions {
   // Output width or height in pixels (0 = not set); the other side follows
   // the crop's aspect ratio, pixels are square.
@@ -63,24 +71,14 @@ struct RenderOptions {
   // measure what it buys.
   bool antialias = true;
   // Turn M' by the small angle that makes the page's lines axis aligned (at
-  // most max_deskew_deg; larger tilts are left alone and logged). "lines":
+  // most max_deskew_deg; larger tilts are left alone and logged). kLines:
   // the direction most of the length of optimize's lines (lines.json beside
   // the meshes: text rows, rules and the real sides) follows, when at least
-  // deskew_min_lines agree on it; else, and with "sides", the lines fitted
+  // deskew_min_lines agree on it; else, and with kSides, the lines fitted
   // to the real boundary sides mapped onto M'.
   bool deskew = true;
   double max_deskew_deg = 20;
-  std::string deskew_by = "lines";
-  // The crop: inscribed in the lines of the real sides, or ("middle")
-  // through the middle of those within crop_middle_max_deg of their axis
-  // (see ChooseCrop). Inscribing a slanted line moves the crop into the page
-  // by half its run; through the middle, page cut off at one end and table
-  // left at the other even out. Measured, middle against inscribed on the 12
-  // benchmark sets: mean +0.013 MS-SSIM on one sfm run, -0.003 on another,
-  // with swings of +-0.2 on single sets (a table page's rows misalign when
-  // the crop's height is 1 % off): no better on average, so not the default.
-  std::string crop_rule = "inscribed";
-  double crop_middle_max_deg = 3;
+  DeskewBy deskew_by = DeskewBy::kLines;
   int deskew_min_lines = 8;
   // Sample the reference image even where the page is hidden from the
   // reference view by the page itself or seen from behind (by default such
@@ -92,8 +90,6 @@ struct RenderOptions {
   // keeps a margin); farther samples are dropped. Fraction of the reference
   // image's diagonal (0.006: 12 px at 1600x1200, 30 px at 4000x3000).
   double side_snap = 0.006;
-  // Grid overlay colour (BGR) and minimum spacing of drawn grid lines in
-  // output pixels (denser grids are drawn every k-th line).
   // Turn the result by quarter turns so that its text reads upright
   // (Tesseract reads it each way; see orientation.h). The boundary cannot
   // tell a page's top from its sides, so without this the page may come out
@@ -108,15 +104,11 @@ struct RenderOptions {
   // across the cut to the page of this long-to-short side ratio
   // (ExtendToPageFormat in crop.h), the part no photo shows in the fill
   // colour: the whole page at its proportions, not the part seen. 0 (the
-  // default): the crop stops where the photos do. Measured on set08 (A4,
-  // its top unseen) with kIsoAspect over eight sfm runs: MS-SSIM higher on
-  // every one (+0.02 to +0.16), LD higher on seven (up to +4.9: the flow
-  // has nothing to follow in a flat fill), so not the default.
+  // default): the crop stops where the photos do. Not the default: it helps
+  // only a page of the format given, and a flat fill gives the evaluation's
+  // flow nothing to follow (see docs/decisions/render.md, "A cut-off page
+  // completed to its format").
   double page_aspect = 0;
-  // A real side whose samples scatter about their line (a fold on the
-  // outline, M far off there) bounds the crop by the median of its samples
-  // ("median") or not at all ("box": the part of M' the reference sees).
-  std::string scattered_sides = "median";
   // Texture the page found past cut sides from the other photos that see
   // it (RenderInputs::views[].photo); off: the fill colour.
   bool texture_cut_sides = true;
@@ -130,15 +122,14 @@ struct RenderOptions {
   // and the reached edge (0: only sides too short to fit).
   double reach_partial_below = 0.6;
   CutSideOptions cut_sides;
-  // Texture from another photo where it sees the page much more squarely
-  // than the reference (cut_sides.h); off by default.
-  BetterViewOptions better_views;
-  // "remove": divide out the light's shading (folds, curls, shadows) so the
-  // paper comes out one even colour, as a scan (common/shading.h); "keep":
+  // kRemove: divide out the light's shading (folds, curls, shadows) so the
+  // paper comes out one even colour, as a scan (common/shading.h); kKeep:
   // the reference photo's brightness, as the paper's method renders it (and
   // as the benchmark's oracle does).
-  std::string shading = "keep";
+  Shading shading = Shading::kKeep;
   ShadingOptions shading_removal;
+  // Grid overlay colour (BGR) and minimum spacing of drawn grid lines in
+  // output pixels (denser grids are drawn every k-th line).
   cv::Scalar grid_color = cv::Scalar(40, 40, 230);
   double grid_min_spacing_px = 12;
 };
@@ -191,7 +182,7 @@ struct SideFit {
   std::string note;                                      // why a real side was not used
   // A real side whose samples scatter about their line: the median of their
   // coordinate across it (y for top and bottom, x for left and right, M'
-  // after the deskew turn), which then bounds the crop (scattered_sides).
+  // after the deskew turn), which then bounds the crop.
   bool scattered = false;
   double median_bound = 0;
 };
@@ -216,11 +207,10 @@ struct RenderResult {
   PageFormatFit page_format;                    // the crop lengthened past unseen cut sides
   std::vector<ViewRegistration> registrations;  // of the views textured from
   cv::Vec3b fill;
-  double page_fraction = 0;         // output pixels showing the page
-  double hidden_fraction = 0;       // output pixels on M' but not seen
-  double minified_fraction = 0;     // output pixels that needed pre-filtering
-  double other_view_fraction = 0;   // output pixels from another view's photo
-  double better_view_fraction = 0;  // of the reference's, retextured (better_views)
+  double page_fraction = 0;        // output pixels showing the page
+  double hidden_fraction = 0;      // output pixels on M' but not seen
+  double minified_fraction = 0;    // output pixels that needed pre-filtering
+  double other_view_fraction = 0;  // output pixels from another view's photo
   bool shading_removed = false;
   double shading_paper_fraction = 0;  // of the image taken as paper (shading = remove)
   int grid_line_step = 1;
@@ -228,8 +218,19 @@ struct RenderResult {
   // and pixels_per_unit above refer to the unturned image).
   int quarter_turns = 0;
   std::vector<std::pair<std::string, double>> timings;  // seconds per step
-  Json report;                                          // render.json (docunfold.render)
+  Json orientation;  // how the page was turned upright (render.json's "orientation")
 };
+
+// Declares every option of render (all but the paths) in `table`, bound to
+// the fields of `o`; their values when called are the defaults.
+void DeclareOptions(OptionTable& table, RenderOptions* o);
+
+// --page-format's text: iso, letter, legal, none (0) or a long-to-short side
+// ratio between 1 and 10, into *aspect. Returns "" when it took the text,
+// else what is wrong with it.
+std::string ParsePageFormat(const std::string& text, double* aspect);
+// The text ParsePageFormat reads as `aspect`: a format's name or the ratio.
+std::string PageFormatText(double aspect);
 
 // Reads and validates everything render needs; InputError naming the file
 // and the problem otherwise.
@@ -245,8 +246,13 @@ RenderInputs ReadRenderInputs(const fs::path& sfm_dir, const fs::path& boundary_
 // contradictory size options.
 RenderResult Run(const RenderOptions& options, const RenderInputs& inputs);
 
-// Writes rectified.png, rectified_grid.png and render.json into `out_dir`:
-// all three or none (OutputError).
-void WriteRenderOutputs(const fs::path& out_dir, const RenderResult& result);
+// render.json (docunfold.render) for `result`, with `options_record` (the
+// option table's record) as its producer's options.
+Json RenderReport(const RenderOptions& options, const RenderInputs& inputs,
+                  const RenderResult& result, const Json& options_record);
+
+// Writes rectified.png, rectified_grid.png and `report` as render.json into
+// `out_dir`: all three or none (OutputError).
+void WriteRenderOutputs(const fs::path& out_dir, const RenderResult& result, const Json& report);
 
 }  // namespace docunfold::render

@@ -1,4 +1,5 @@
-// Reading render's inputs and writing its outputs (all or nothing).
+// Reading render's inputs, render.json, and writing the outputs (all or
+// nothing).
 #include <cmath>
 #include <memory>
 #include <opencv2/imgcodecs.hpp>
@@ -89,7 +90,114 @@ RenderInputs ReadRenderInputs(const fs::path& sfm_dir, const fs::path& boundary_
   return in;
 }
 
-void WriteRenderOutputs(const fs::path& out_dir, const RenderResult& result) {
+namespace {
+
+Json Vec2(const Eigen::Vector2d& v) { return Json::array({v.x(), v.y()}); }
+
+}  // namespace
+
+Json RenderReport(const RenderOptions& options, const RenderInputs& in, const RenderResult& r,
+                  const Json& options_record) {
+  Json doc = MakeHeader("docunfold.render", 1, "render", options_record);
+  doc["inputs"] = {{"meshes", in.meshes_dir.string()},
+                   {"reference", in.reference_file.string()},
+                   {"boundary", in.boundary.file.string()},
+                   {"grid", {in.meshes.grid.nx, in.meshes.grid.ny}}};
+  Json view_masks = Json::array();
+  for (const ViewMask& v : in.views) view_masks.push_back(v.file.string());
+  doc["inputs"]["view_masks"] = view_masks;
+  doc["width"] = r.rectified.cols;
+  doc["height"] = r.rectified.rows;
+  doc["pixels_per_unit"] = r.pixels_per_unit;
+  doc["reference_pixels_per_unit"] = r.reference_pixels_per_unit;
+  doc["size_rule"] = r.size_rule;
+  doc["capped"] = r.capped;
+  doc["rotation_deg"] = r.rotation_deg;
+  doc["deskew_source"] = r.deskew_source;
+  doc["crop"] = {{"x0", r.crop_x0},
+                 {"y0", r.crop_y0},
+                 {"x1", r.crop_x1},
+                 {"y1", r.crop_y1},
+                 {"rule", r.crop_rule}};
+  Json sides = Json::object();
+  for (int i = 0; i < 4; ++i) {
+    const SideFit& s = r.sides[i];
+    Json j = {{"real", s.real}, {"used", s.used}, {"samples", s.samples}, {"mapped", s.mapped}};
+    if (s.used) {
+      j["point"] = Vec2(s.point);
+      j["direction"] = Vec2(s.direction);
+      j["rms"] = s.rms;
+    }
+    if (!s.note.empty()) j["note"] = s.note;
+    if (s.scattered) j["median_bound"] = s.median_bound;
+    if (const CutSideEdge& e = r.reached_sides[i]; e.measured)
+      j["reached_past_mesh"] = {
+          {"bound", e.bound}, {"extension", e.extension}, {"crossings", e.crossings}};
+    if (!s.real && options.extend_cut_sides) {
+      const CutSideEdge& e = r.cut_edges[i];
+      Json c = {{"measured", e.measured},
+                {"edge_seen", e.edge_seen},
+                {"crossings", e.crossings},
+                {"columns_seen", e.columns_seen},
+                {"views", e.views}};
+      if (e.measured) {
+        c["bound"] = e.bound;
+        c["extension"] = e.extension;
+      }
+      if (!e.note.empty()) c["note"] = e.note;
+      j["page_edge_in_other_views"] = c;
+    }
+    sides[kSideNames[i]] = j;
+  }
+  doc["sides"] = sides;
+  if (const PageFormatFit& f = r.page_format;
+      options.page_aspect > 0 && (f.axis >= 0 || !f.note.empty())) {
+    // axis -1 with a note: sides of both axes are cut off unseen.
+    Json j = {{"aspect", options.page_aspect},
+              {"applied", f.applied},
+              {"axis", f.axis < 0    ? "both"
+                       : f.axis == 0 ? "x"
+                                     : "y"}};
+    if (f.axis >= 0) {
+      j["seen"] = f.seen;
+      j["across"] = f.across;
+    }
+    if (f.applied) j["length"] = f.length;
+    if (!f.note.empty()) j["note"] = f.note;
+    doc["page_format"] = j;
+  }
+  doc["fill_rgb"] = {r.fill[2], r.fill[1], r.fill[0]};
+  doc["page_fraction"] = r.page_fraction;
+  doc["hidden_fraction"] = r.hidden_fraction;
+  doc["minified_fraction"] = r.minified_fraction;
+  doc["other_view_fraction"] = r.other_view_fraction;
+  doc["shading"] = {{"removed", r.shading_removed}};
+  if (r.shading_removed) doc["shading"]["paper_fraction"] = r.shading_paper_fraction;
+  Json regs = Json::array();
+  for (const ViewRegistration& g : r.registrations)
+    regs.push_back({{"view", in.views[g.view].camera.image},
+                    {"affine",
+                     {{g.affine(0, 0), g.affine(0, 1), g.affine(0, 2)},
+                      {g.affine(1, 0), g.affine(1, 1), g.affine(1, 2)}}},
+                    {"inliers", g.inliers},
+                    {"moved", g.moved},
+                    {"agreement", g.agreement},
+                    {"used", g.used}});
+  doc["other_views"] = regs;
+  doc["grid_line_step"] = r.grid_line_step;
+  Json timing = Json::object();
+  double total = 0;
+  for (const auto& [step, seconds] : r.timings) {
+    timing[step] = seconds;
+    total += seconds;
+  }
+  timing["total"] = total;
+  doc["timing_s"] = timing;
+  doc["orientation"] = r.orientation;
+  return doc;
+}
+
+void WriteRenderOutputs(const fs::path& out_dir, const RenderResult& result, const Json& report) {
   if (result.rectified.empty() || result.rectified_grid.empty())
     throw OutputError(out_dir.string() + ": nothing to write");
   EnsureDirectory(out_dir);
@@ -105,7 +213,7 @@ void WriteRenderOutputs(const fs::path& out_dir, const RenderResult& result) {
   // complete are they renamed into place.
   AtomicOutput rectified(out_dir / "rectified.png");
   AtomicOutput grid(out_dir / "rectified_grid.png");
-  AtomicOutput report(out_dir / "render.json");
+  AtomicOutput report_file(out_dir / "render.json");
   // Light PNG compression: the files are large and written on every run.
   const std::vector<int> png = {cv::IMWRITE_PNG_COMPRESSION, 3};
   auto write_image = [&](const AtomicOutput& out, const cv::Mat& image) {
@@ -121,15 +229,16 @@ void WriteRenderOutputs(const fs::path& out_dir, const RenderResult& result) {
   write_image(grid, result.rectified_grid);
   {
     // WriteJsonAtomic would commit on its own; write the text by hand.
-    FILE* f = std::fopen(report.temp_path().c_str(), "wb");
-    if (!f) throw OutputError(report.target().string() + ": cannot open for writing");
-    const std::string text = result.report.dump(1) + "\n";
+    FILE* f = std::fopen(report_file.temp_path().c_str(), "wb");
+    if (!f) throw OutputError(report_file.target().string() + ": cannot open for writing");
+    const std::string text = report.dump(1) + "\n";
     const bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();
-    if (std::fclose(f) != 0 || !ok) throw OutputError(report.target().string() + ": write failed");
+    if (std::fclose(f) != 0 || !ok)
+      throw OutputError(report_file.target().string() + ": write failed");
   }
   rectified.Commit();
   grid.Commit();
-  report.Commit();
+  report_file.Commit();
 }
 
 }  // namespace docunfold::render

@@ -97,6 +97,17 @@ TEST_F(RenderCli, WidthFlagSetsTheOutputWidth) {
   const Json report = ReadJsonFile(out / "render.json");
   EXPECT_EQ(report["size_rule"], "width");
   EXPECT_EQ(report["fill_rgb"], Json::array({255, 255, 255}));
+  // The record lists every option as the run had it.
+  const Json& options = report["producer"]["options"];
+  EXPECT_EQ(options["width"], 150);
+  EXPECT_EQ(options["fill"], "white");
+  EXPECT_EQ(options["deskew"], false);
+  EXPECT_EQ(options["orient"], true);
+  EXPECT_EQ(options["reach_real_sides"], true);
+  EXPECT_EQ(options["reach_partial_below"], 0.6);
+  EXPECT_EQ(options["page_format"], "none");
+  EXPECT_EQ(options["deskew_by"], "lines");
+  EXPECT_FALSE(options.contains("crop"));
 }
 
 // optimize's lines.json beside the meshes turns the page: its lines, 3
@@ -217,6 +228,10 @@ TEST_F(RenderCli, ContradictoryFlagsAreUsageErrors) {
   ExpectFailure(Render(scene(), out, "--shading dim"), 2, "--shading", out);
   ExpectFailure(Render(scene(), out, "--page-format a3"), 2, "--page-format", out);
   ExpectFailure(Render(scene(), out, "--page-format 0.7"), 2, "--page-format", out);
+  // Switches tried and not kept are gone.
+  ExpectFailure(Render(scene(), out, "--crop middle"), 2, "--crop", out);
+  ExpectFailure(Render(scene(), out, "--better-views 2"), 2, "--better-views", out);
+  ExpectFailure(Render(scene(), out, "--scattered-sides box"), 2, "--scattered-sides", out);
 }
 
 // --shading remove divides the light out (common/shading.h, tested there):

@@ -263,8 +263,9 @@ TEST(RenderScene, APageCutOffUnseenIsCompletedToItsFormat) {
   EXPECT_NEAR(r.crop_y0, 0, px);
   EXPECT_NEAR(r.crop_y1, s.page_h, px);
   EXPECT_EQ(r.rectified.at<cv::Vec3b>(r.rectified.rows / 2, 2), r.fill);
-  EXPECT_EQ(r.report["page_format"]["applied"], true);
-  EXPECT_EQ(r.report["page_format"]["axis"], "x");
+  const Json report = render::RenderReport(options, InputsOf(s), r, Json::object());
+  EXPECT_EQ(report["page_format"]["applied"], true);
+  EXPECT_EQ(report["page_format"]["axis"], "x");
   // ISO: the part seen is narrower than 0.56 / 1.414, so the page is taken
   // to be that wide (its long side up).
   ASSERT_LT(r.page_format.seen, s.page_h / render::kIsoAspect);
@@ -288,10 +289,32 @@ TEST(RenderScene, APageCutOffOnBothAxesKeepsItsCropAndSaysWhy) {
   EXPECT_FALSE(r.page_format.applied);
   EXPECT_EQ(r.crop_x0, plain.crop_x0);
   EXPECT_EQ(r.crop_y0, plain.crop_y0);
-  ASSERT_TRUE(r.report.contains("page_format"));
-  EXPECT_EQ(r.report["page_format"]["axis"], "both");
-  EXPECT_EQ(r.report["page_format"]["applied"], false);
-  EXPECT_FALSE(r.report["page_format"]["note"].get<std::string>().empty());
+  const Json report = render::RenderReport(options, InputsOf(s), r, Json::object());
+  ASSERT_TRUE(report.contains("page_format"));
+  EXPECT_EQ(report["page_format"]["axis"], "both");
+  EXPECT_EQ(report["page_format"]["applied"], false);
+  EXPECT_FALSE(report["page_format"]["note"].get<std::string>().empty());
+}
+
+TEST(RenderOptions, PageFormatIsANameOrARatio) {
+  double aspect = -1;
+  EXPECT_EQ(render::ParsePageFormat("iso", &aspect), "");
+  EXPECT_EQ(aspect, render::kIsoAspect);
+  EXPECT_EQ(render::ParsePageFormat("letter", &aspect), "");
+  EXPECT_EQ(aspect, render::kLetterAspect);
+  EXPECT_EQ(render::ParsePageFormat("legal", &aspect), "");
+  EXPECT_EQ(aspect, render::kLegalAspect);
+  EXPECT_EQ(render::ParsePageFormat("1.5", &aspect), "");
+  EXPECT_EQ(aspect, 1.5);
+  EXPECT_EQ(render::ParsePageFormat("none", &aspect), "");
+  EXPECT_EQ(aspect, 0);
+  for (const char* bad : {"a3", "0.7", "11", "1.5x", ""})
+    EXPECT_NE(render::ParsePageFormat(bad, &aspect), "") << bad;
+  EXPECT_EQ(aspect, 0);  // left as it was
+  for (const char* text : {"iso", "letter", "legal", "none", "1.5"}) {
+    ASSERT_EQ(render::ParsePageFormat(text, &aspect), "");
+    EXPECT_EQ(render::PageFormatText(aspect), text);
+  }
 }
 
 TEST(RenderCrop, TheFormatLengthensOnlyUnseenSidesOfOneAxis) {
@@ -407,10 +430,8 @@ TEST(RenderScene, ScatteredSideBoundsTheCropByItsMedian) {
   const double px = 1 / r.pixels_per_unit;
   EXPECT_NEAR(r.crop_x0, edge, 2 * px);
   EXPECT_NEAR(r.crop_x1, o.page_w, px);
-  render::RenderOptions box;
-  box.scattered_sides = "box";
-  const render::RenderResult b = render::Run(box, InputsOf(s));
-  EXPECT_NEAR(b.crop_x0, 0.0, px);  // the mesh's border
+  EXPECT_NEAR(r.sides[3].median_bound, edge, 2 * px);
+  EXPECT_GT(r.crop_x0, 0.5 * edge);  // not the mesh's border (x = 0)
 }
 
 TEST(RenderScene, TiltedFlatMeshIsTurnedUpright) {
@@ -424,18 +445,11 @@ TEST(RenderScene, TiltedFlatMeshIsTurnedUpright) {
   EXPECT_NEAR(r.crop_y1 - r.crop_y0, s.page_h, 2 / r.pixels_per_unit);
   render::RenderOptions keep;
   keep.deskew = false;
-  keep.crop_rule = "inscribed";
   const render::RenderResult tilted = render::Run(keep, InputsOf(s));
   EXPECT_EQ(tilted.rotation_deg, 0);
   // Inscribed in the tilted page: smaller on both axes.
   EXPECT_LT(tilted.crop_x1 - tilted.crop_x0, s.page_w * 0.97);
   EXPECT_LT(tilted.crop_y1 - tilted.crop_y0, s.page_h * 0.97);
-  // Through the middle of the tilted sides: the page's size.
-  keep.crop_rule = "middle";
-  keep.crop_middle_max_deg = 5;
-  const render::RenderResult middle = render::Run(keep, InputsOf(s));
-  EXPECT_NEAR(middle.crop_x1 - middle.crop_x0, s.page_w, 0.01 * s.page_w);
-  EXPECT_NEAR(middle.crop_y1 - middle.crop_y0, s.page_h, 0.01 * s.page_h);
 }
 
 TEST(RenderInputs, InconsistentInputsAreRejected) {
@@ -512,7 +526,7 @@ TEST(RenderCrop, SideLinesIgnoreOutliersAndWrongOrderIsDropped) {
   EXPECT_NEAR(render::TiltOfSides(good), std::atan(0.001) * 100 / 201, 1e-9);
 }
 
-TEST(RenderCrop, SlightlySlantedSidesBoundTheCropThroughTheirMiddle) {
+TEST(RenderCrop, SlantedSidesBoundTheCropInscribed) {
   // The unit square's sides in M'; the right one slanted by `deg` about its
   // middle (0.5, 0.5).
   auto sides_with_right_slant = [](double deg) {
@@ -533,15 +547,16 @@ TEST(RenderCrop, SlightlySlantedSidesBoundTheCropThroughTheirMiddle) {
     return sides;
   };
   const Eigen::Vector4d box(-0.2, -0.2, 1.2, 1.2);
-  const double limit = 3 * M_PI / 180;
   auto slight = sides_with_right_slant(2);
   EXPECT_NEAR(render::SlantOf(slight[1], 1), -2 * M_PI / 180, 1e-9);
-  EXPECT_NEAR(render::ChooseCrop(&slight, box, limit).x1, 1.0, 1e-9);  // through the middle
-  slight = sides_with_right_slant(2);
-  const double inscribed = 1 - 0.5 * std::tan(2 * M_PI / 180);
-  EXPECT_NEAR(render::ChooseCrop(&slight, box).x1, inscribed, 1e-9);  // the default: inscribed
-  auto steep = sides_with_right_slant(5);                             // beyond the limit: inscribed
-  EXPECT_NEAR(render::ChooseCrop(&steep, box, limit).x1, 1 - 0.5 * std::tan(5 * M_PI / 180), 1e-9);
+  const render::CropRect crop = render::ChooseCrop(&slight, box);
+  EXPECT_EQ(crop.rule, "boundary-lines");
+  EXPECT_NEAR(crop.x1, 1 - 0.5 * std::tan(2 * M_PI / 180), 1e-9);  // inscribed
+  EXPECT_NEAR(crop.x0, 0, 1e-9);
+  EXPECT_NEAR(crop.y0, 0, 1e-9);
+  EXPECT_NEAR(crop.y1, 1, 1e-9);
+  auto steep = sides_with_right_slant(5);
+  EXPECT_NEAR(render::ChooseCrop(&steep, box).x1, 1 - 0.5 * std::tan(5 * M_PI / 180), 1e-9);
 }
 
 // The columns of a scene's grid that the reference view sees whole: M and M'
@@ -784,54 +799,6 @@ TEST(RenderScene, APartlyMappedSideIsReachedWhenItLiesPastItsLine) {
   // A mesh that reaches its sides is left as it was.
   const render::RenderResult whole = render::Run({}, InputsOf(full));
   for (const auto& e : whole.reached_sides) EXPECT_FALSE(e.measured);
-}
-
-TEST(RenderScene, BetterViewTexturesWhatTheReferenceSeesAtAGrazingAngle) {
-  TempDir dir;
-  SceneOptions o;
-  o.radius = 0;
-  o.tilt_deg = 72;  // the reference sees the page nearly edge-on
-  o.page_origin = {-0.21, -0.12, 0.9};
-  const SyntheticScene s = MakeScene(o);
-  ASSERT_TRUE(s.real[0] && s.real[1] && s.real[2] && s.real[3]);
-  // Another photo square on to the page: the page's own frame moved to
-  // `square.page_origin` in front of that camera.
-  SceneOptions square = o;
-  square.tilt_deg = 0;
-  square.page_origin = {-0.21, -0.28, 0.8};
-  const SyntheticScene s2 = MakeScene(square);
-  const Eigen::Matrix3d tilt =
-      Eigen::AngleAxisd(o.tilt_deg * M_PI / 180, Eigen::Vector3d::UnitX()).toRotationMatrix();
-  render::ViewMask view;
-  view.camera = s2.camera;
-  view.camera.image = "view_01.png";
-  view.camera.R = tilt.transpose();
-  view.camera.t = square.page_origin - tilt.transpose() * o.page_origin;
-  ASSERT_LT(
-      (view.camera.Project(s.meshes.mesh3d[0]) - s2.camera.Project(s2.meshes.mesh3d[0])).norm(),
-      1e-6);
-  view.mask = RasterizeMesh(s2.camera, s2.meshes.mesh3d, s2.meshes.grid.Triangles()).face >= 0;
-  view.photo = dir / "view_01.png";
-  WriteImageAtomic(view.photo, s2.photo);
-  render::RenderInputs in = InputsOf(s);
-  in.views = {view};
-
-  const render::RenderResult before = render::Run({}, in);  // off by default
-  EXPECT_EQ(before.better_view_fraction, 0);
-  render::RenderOptions better;
-  better.better_views.min_gain = 1.5;
-  const render::RenderResult r = render::Run(better, in);
-  Keep("better-view", r.rectified);
-  EXPECT_GT(r.better_view_fraction, 0.5);
-  ASSERT_EQ(r.registrations.size(), 1u);
-  EXPECT_TRUE(r.registrations[0].used);
-  // The same crop; the print comes out sharper where it belongs.
-  EXPECT_EQ(r.rectified.size(), before.rectified.size());
-  const cv::Mat1b mask = Inner(r.page_mask, 3);
-  const cv::Mat1f truth = Detail(ExpectedImage(s, r));
-  const double c_before = Correlation(truth, Detail(before.rectified), mask);
-  const double c_after = Correlation(truth, Detail(r.rectified), mask);
-  EXPECT_GT(c_after, c_before + 0.1) << c_before << " -> " << c_after;
 }
 
 }  // namespace
