@@ -1,6 +1,6 @@
 // densify: more 3D points on the page than COLMAP's sparse cloud, with the
-// cameras sfm found held fixed. Two sources, both measured against the
-// ground truth (README, "Choices we measured"):
+// cameras sfm found held fixed. Three sources, each measured against the
+// ground truth (see docs/decisions/densify.md):
 //  - texture: every `step_px`-th pixel of the reference view's document
 //    region with enough texture (text, print) is followed into each other
 //    photo by optical flow (DIS, after a homography that takes the page's
@@ -9,7 +9,9 @@
 //  - outline: samples of the real boundary sides of 20_boundary are matched
 //    along their epipolar segments in every other photo (the page's edge is
 //    a sharp, straight step there too); a depth that at least two other
-//    photos agree on, and no other depth does as well, is triangulated.
+//    photos agree on, and no other depth does as well, is triangulated;
+//  - shading steps: steps of blank paper (a fold's crease) on copies blurred
+//    so that print is gone, matched like the outline.
 // Blank paper gives SIFT nothing, so COLMAP's cloud leaves margins and flaps
 // empty; their outline points and the text's points fill most of that.
 //
@@ -18,7 +20,7 @@
 //                behind the page in the reference view (HiddenOptions), then
 //                the new ones; x y z, red green blue, track_length,
 //                reprojection_error (pixels of the working copies), source
-//                (0 sfm, 1 texture, 2 outline)
+//                (PointSource: 0 sfm, 1 texture, 2 outline, 3 step)
 //   points.json  docunfold.points: counts, per-view statistics, options, times
 //   overlay.png  the reference image with the points by source
 #pragma once
@@ -32,26 +34,27 @@
 
 #include "common/camera.h"
 #include "common/json_io.h"
+#include "common/option_table.h"
 #include "common/page_files.h"
 #include "common/ply.h"
+#include "common/point_source.h"
 
 namespace docunfold::densify {
 
 namespace fs = std::filesystem;
 
-enum PointSource : uint8_t { kSfm = 0, kTexture = 1, kOutline = 2, kStep = 3 };
-
 struct TextureOptions {
-  bool enabled = true;
-  double step_px = 4;  // grid spacing in working-copy pixels
+  bool enabled = true;  // texture points at all
+  double step_px = 4;   // grid spacing in working-copy pixels
   // Structure-tensor minimum eigenvalue (7x7 window) below this fraction of
   // its 95th percentile over the region: blank paper, where flow only
   // interpolates, is skipped.
   double min_texture = 0.05;
   double max_flow_disagreement_px = 0.5;  // forward + backward flow, |sum|
   double max_reprojection_px = 1.0;       // every view, working-copy pixels
-  // Photos a point needs, the reference included. Two-view points were 2-3x
-  // less accurate on our sets (median 0.10 vs 0.06 % of the page diagonal).
+  // Photos a point needs, the reference included: two-view points are much
+  // less accurate (see docs/decisions/densify.md, "Texture points need three
+  // photos").
   int min_views = 3;
   double min_triangulation_angle_deg = 2;
   // A second pass for the samples the first left without a point, each
@@ -59,28 +62,22 @@ struct TextureOptions {
   // far give every pixel (a planar fit of 1/depth to the
   // `surface_neighbours` nearest, on a grid of `surface_grid_px`) instead of
   // one homography of the page: a flap or the far side of a fold stands at
-  // another angle than the panel the homography fits. Its points are as
-  // close to the true surface as the first pass's. With the default hole
-  // gap (below) M came nearer the truth in every run measured; without one,
-  // set07's M moved away in 2 of 3, and the page did not always follow M
-  // (README, "A second texture pass").
+  // another angle than the panel the homography fits (see
+  // docs/decisions/densify.md, "A second texture pass").
   bool surface_prewarp = true;
   double surface_grid_px = 4;
   int surface_neighbours = 16;
   // The second pass tries only samples at least this far (working-copy
   // pixels) from every point the first pass made: the holes it left (a far
   // panel), not the ragged edges of what it found. 0: every sample left.
-  // With 150 only set08's far panel (800-3000 points) and set06 (300) get
-  // points among the 12 benchmark sets; set08's init M comes within
-  // 0.33-0.47 % of the true surface in 8 of 8 sfm runs (0.51-1.53 % without),
-  // MS-SSIM -0.003 on the mean of those 8, LD 6.5 -> 5.3. Smaller gaps reach
-  // set02's flap, seen at a grazing angle, whose points make M' too long there
-  // (N = 80: set02 0.829 -> 0.692).
+  // Smaller gaps reach flaps seen at a grazing angle, whose points make M'
+  // too long there (see docs/decisions/densify.md, "The second pass's hole
+  // gap").
   double surface_hole_px = 150;
 };
 
 struct OutlineOptions {
-  bool enabled = true;
+  bool enabled = true;        // outline points at all
   double step_px = 4;         // spacing of the samples along each real side
   double corner_gap_px = 12;  // no samples this close to a corner
   double min_contrast = 3;    // grey levels per pixel across the edge (after blur)
@@ -103,7 +100,8 @@ struct OutlineOptions {
   // `continuity_radius_px` of it (an affine fit of 1/depth, when at least 6
   // are there) to `max_depth_jump` of its depth. The silhouette of a curl
   // is matched across views like an edge, but its triangulation lies off
-  // the page (set02's curled corner: p90 4 % of the diagonal without this).
+  // the page (see docs/decisions/densify.md, "Outline points continue the
+  // surface").
   double continuity_radius_px = 24;
   double max_depth_jump = 0.02;
 };
@@ -113,13 +111,10 @@ struct OutlineOptions {
 // Under diffuse light a fold's shading step lies at the same place on the
 // paper in every photo, so steps found on copies blurred by `blur_px`
 // (print gone, folds not) are matched along epipolar segments like the
-// outline. Measured on four sfm runs of the 12 benchmark sets (rerun from
-// densify, with against without): mean MS-SSIM -0.014 to +0.011 (+0.002 on
-// average), M closer to the true surface in every run (0.291 -> 0.264 % of
-// the diagonal in the first), set08's init M 0.52-0.83 % against 0.74-1.21 %.
-// The safeguards were each added after a measured failure (see the README).
+// outline. The safeguards were each added after a measured failure (see
+// docs/decisions/densify.md, "Shading-step points").
 struct StepOptions {
-  bool enabled = true;
+  bool enabled = true;         // shading-step points at all
   double blur_px = 3;          // Gaussian sigma of the copies, working-copy pixels
   double step_px = 6;          // at most one sample per cell of this size
   double min_contrast = 1.5;   // grey levels per pixel across the step (after blur)
@@ -127,7 +122,8 @@ struct StepOptions {
   // Only blank paper: no samples within this distance of a point already
   // there (sfm, texture, outline). A blurred table's rules and text rows are
   // steps too; points on them, between the texture points, roughen M and
-  // lengthen M' (set02's page came out 0.6 % too tall with a gap of 8).
+  // lengthen M' (see docs/decisions/densify.md, "Shading steps only on blank
+  // paper").
   double min_point_gap_px = 20;
   // A point must lie on the surface of the known points on each side of its
   // step that has at least 6 within `side_radius_px` (an affine fit of
@@ -138,30 +134,24 @@ struct StepOptions {
   double max_depth_jump = 0.02;
   double min_side_cos = 0.25;
   // Points with no known points on either side (a panel without print or
-  // texture points: set08's far panel) are kept when `unsupported`, checked
-  // against the points within `unsupported_radius_factor` x the radius where
-  // there are any.
-  bool unsupported = true;
+  // texture points: set08's far panel) are checked against the points within
+  // `unsupported_radius_factor` x the radius where there are any.
   double unsupported_radius_factor = 3;
-  // Photos a point needs, the reference included. With 3, set02's flap,
-  // seen edge-on in the reference, gave 14-18 points 1-3 % of the diagonal
-  // off the page, where no side check reaches (-0.13 and -0.17 MS-SSIM);
-  // with 4, none. A data set of 3 photos gets no step points.
+  // Photos a point needs, the reference included. With 3, a flap seen
+  // edge-on in the reference gave points off the page where no side check
+  // reaches (see docs/decisions/densify.md, "Shading steps need four
+  // photos"). A data set of 3 photos gets no step points.
   int min_views = 4;
 };
 
 // SfM points of the document region that the reference view shows in another
 // colour are behind the page there: table seen past a raised flap by the other
-// photos, not page. They are left out of points.ply. set02: 93 of the 104 sfm
-// points in the region > 3 % of the page diagonal off the true surface, and 2
-// of its 291 within 1 %; set04: 77 of 82, and 1.
+// photos, not page. They are left out of points.ply (see
+// docs/decisions/densify.md, "Hidden sfm points").
 struct HiddenOptions {
-  bool enabled = true;
   // CIE76 colour difference on OpenCV's 8-bit Lab scale (L 0..255), after the
   // points' colours are brought to the reference's exposure (a per-channel
-  // gain, the median ratio over the region's points). On the 12 benchmark
-  // sets the points within 1 % of the true surface were below 30 but for
-  // 2-12 per set; those more than 3 % off mostly 60-140.
+  // gain, the median ratio over the region's points).
   double max_colour_distance = 40;
   int window_px = 1;  // nearest colour within this many pixels of the projection
 };
@@ -179,10 +169,15 @@ struct DensifyOptions {
   TextureOptions texture;
   OutlineOptions outline;
   StepOptions steps;
+  // Keep the sfm points the reference view shows in another colour
+  // (HiddenOptions) instead of leaving them out.
+  bool keep_hidden = false;
   HiddenOptions hidden;
-
-  Json ToJson() const;
 };
+
+// Declares every option of `o` but the paths (the flags of `densify`), bound
+// to its fields.
+void DeclareOptions(OptionTable& table, DensifyOptions* o);
 
 struct DensifyInputs {
   CameraSet cameras;                              // every registered view, reference frame (sfm)
@@ -232,9 +227,10 @@ DensifyInputs ReadInputs(const DensifyOptions& options);
 
 DensifyResult Run(const DensifyInputs& inputs, const DensifyOptions& options);
 
-// Writes points.ply, points.json and overlay.png (OutputError on failure).
+// Writes points.ply, points.json (with `options_record` as its producer's
+// options) and overlay.png into options.out_dir (OutputError on failure).
 void WriteOutputs(const DensifyInputs& inputs, const DensifyResult& result,
-                  const DensifyOptions& options);
+                  const DensifyOptions& options, const Json& options_record);
 
 // --- building blocks (exposed for tests) ----------------------------------
 

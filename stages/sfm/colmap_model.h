@@ -1,7 +1,7 @@
 // A sparse model in COLMAP's binary format (cameras.bin, images.bin,
 // points3D.bin, as COLMAP 3.x writes them) and the camera models we use.
 //
-// COLMAP's conventions differ from ours (DESIGN §4) in one place: its pixel
+// COLMAP's conventions differ from ours (camera.h) in one place: its pixel
 // coordinates put the centre of the top-left pixel at (0.5, 0.5), ours at
 // (0, 0). PinholeK() converts. Distortion is applied to normalized
 // coordinates x = K^-1 u exactly as OpenCV's radial model does, so

@@ -46,8 +46,8 @@ struct MatchCriteria {
 
 // How the dot products are computed; both give the same exact values.
 enum class DotKernel {
-  // AVX2 integer products where the CPU has them (set02's matching 2.4x
-  // faster), else kPortable.
+  // AVX2 integer products where the CPU has them (faster: see
+  // docs/decisions/sfm.md, "Exact matching"), else kPortable.
   kAuto,
   kPortable,  // Eigen's float matrix product (exact: integer sums below 2^24)
 };

@@ -4,26 +4,14 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
-#include <nanoflann.hpp>
 #include <opencv2/imgproc.hpp>
 #include <random>
 
+#include "common/point_index.h"
+#include "common/statistics.h"
+
 namespace docunfold::sfm {
 namespace {
-
-struct PointCloudAdaptor {
-  const std::vector<Eigen::Vector3d>& pts;
-  size_t kdtree_get_point_count() const { return pts.size(); }
-  double kdtree_get_pt(size_t i, size_t dim) const { return pts[i][int(dim)]; }
-  template <class Box>
-  bool kdtree_get_bbox(Box&) const {
-    return false;
-  }
-};
-
-using KdTree =
-    nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, PointCloudAdaptor>,
-                                        PointCloudAdaptor, 3, size_t>;
 
 // The weighted q-quantile of (value, weight) pairs; 0 when empty.
 double WeightedQuantile(std::vector<std::pair<double, double>> v, double q) {
@@ -47,20 +35,17 @@ std::vector<Eigen::Vector3d> EstimateNormals(const std::vector<Eigen::Vector3d>&
   if (spacing2) spacing2->assign(points.size(), 1.0);
   if (points.size() < 3) return normals;
   const size_t k = std::min(points.size(), size_t(std::max(3, neighbours)));
-  PointCloudAdaptor adaptor{points};
-  KdTree tree(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(10));
-  tree.buildIndex();
-  std::vector<size_t> idx(k);
-  std::vector<double> dist(k);
+  const PointIndex3d tree(points, 10);
   for (size_t i = 0; i < points.size(); ++i) {
-    const size_t found = tree.knnSearch(points[i].data(), k, idx.data(), dist.data());
-    if (spacing2 && found) (*spacing2)[i] = dist[found - 1];
+    const std::vector<PointIndex3d::Neighbour> near = tree.Nearest(points[i], int(k));
+    const size_t found = near.size();
+    if (spacing2 && found) (*spacing2)[i] = near[found - 1].second;
     Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-    for (size_t j = 0; j < found; ++j) mean += points[idx[j]];
+    for (size_t j = 0; j < found; ++j) mean += points[near[j].first];
     mean /= double(found);
     Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
     for (size_t j = 0; j < found; ++j) {
-      const Eigen::Vector3d d = points[idx[j]] - mean;
+      const Eigen::Vector3d d = points[near[j].first] - mean;
       cov += d * d.transpose();
     }
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
@@ -277,9 +262,7 @@ std::vector<ViewScore> ScoreReferenceViews(const ColmapModel& model,
       EstimateNormals(xyz, options.normal_neighbours, &area);
   // Isolated points would stand for huge areas: cap at the 90th percentile.
   if (!area.empty()) {
-    std::vector<double> sorted = area;
-    std::nth_element(sorted.begin(), sorted.begin() + sorted.size() * 9 / 10, sorted.end());
-    const double cap = sorted[sorted.size() * 9 / 10];
+    const double cap = NthSmallest(area, area.size() * 9 / 10);
     for (double& a : area) a = std::min(a, cap);
   }
 

@@ -46,10 +46,8 @@ struct ReferenceOptions {
   // Each unit of ViewScore::hidden costs this much of the score (1 % hidden
   // = 10 % off). A part seen from behind cannot be textured from the view,
   // and the points understate it: a curled corner has few points where it
-  // turns away (set02 view_01: 1.5 % hidden by its points, while the truth
-  // has its worst-seen tenth not seen at all; it won in 1 of 81 stored sfm
-  // runs, 0.385 MS-SSIM against ~0.85 from view_00). Normal noise puts
-  // 0.1-0.4 % on every view.
+  // turns away (see docs/decisions/sfm.md, "Reference view: the hidden
+  // penalty"). Normal noise puts 0.1-0.4 % on every view.
   double hidden_penalty = 10.0;
 };
 
@@ -80,12 +78,10 @@ double ReferenceScore(const ViewScore& view, double max_resolution,
 // median frontality alone: a view square to one panel of a folded page often
 // sees the other panel nearly edge-on, and that panel's smeared texture and
 // thin sliver of image decide the result. Measured by running the pipeline
-// with every view as reference (README, "Reference view"). The frontality
-// factor settles near ties: the resolution is estimated only where there
-// are points, and a slanted view that alone sees a band of the page frontally
-// has no point there (set08 view_03: its score came within 3 % of view_00's,
-// above it in 6 of 13 sfm runs, and init-mesh's M was then 0.5-1.4 % of the
-// diagonal off the truth on the band).
+// with every view as reference (see docs/decisions/sfm.md, "Reference
+// view"). The frontality factor settles near ties: the resolution is
+// estimated only where there are points, and a slanted view that alone sees
+// a band of the page frontally has no point there.
 std::vector<ViewScore> ScoreReferenceViews(const ColmapModel& model,
                                            const std::map<std::string, cv::Mat1b>& masks = {},
                                            const ReferenceOptions& options = {});

@@ -1,7 +1,7 @@
 // sfm: cameras and a sparse point cloud from the photos of a data set, by
 // COLMAP's command-line tools (CPU SIFT, every pair matched exactly by
-// matching.h and verified by COLMAP, incremental mapper), expressed in the frame of an
-// automatically chosen reference view (DESIGN §4-5).
+// matching.h and verified by COLMAP, incremental mapper), expressed in the
+// frame of an automatically chosen reference view (reference_view.h).
 //
 // Writes into options.out_dir (all or nothing: everything is made in a
 // temporary directory beside it and renamed into place at the end):
@@ -25,6 +25,7 @@
 
 #include "common/camera.h"
 #include "common/json_io.h"
+#include "common/option_table.h"
 #include "stages/sfm/reference_view.h"
 
 namespace docunfold::sfm {
@@ -43,7 +44,8 @@ struct SfmOptions {
   int max_num_features = 8192;  // per image
   // COLMAP camera model shared by all views: SIMPLE_PINHOLE, PINHOLE,
   // SIMPLE_RADIAL or RADIAL. The default SIMPLE_RADIAL with the tight
-  // reprojection filter below kept the shape best on our data (see sfm.cc).
+  // reprojection filter below kept the shape best on our data (see
+  // docs/decisions/sfm.md, "Camera model and mapper filter").
   std::string camera_model = "SIMPLE_RADIAL";
   // Refine the distortion parameters in bundle adjustment (otherwise they
   // stay 0 and a *_RADIAL model behaves as a pinhole one).
@@ -54,8 +56,8 @@ struct SfmOptions {
   double max_reprojection_error = 1.0;
   // Triangulate points seen by only two views too (COLMAP ignores them by
   // default, which suits large collections; with 3-6 photos they are a
-  // third of the data and pin the focal length down better: realistic r02
-  // 0.63 -> 0.25 %, r03 0.23 -> 0.12 % median point error).
+  // third of the data and pin the focal length down better: see
+  // docs/decisions/sfm.md, "Two-view tracks").
   bool two_view_tracks = true;
   // When the first reconstruction is implausible (views left out, a focal
   // length outside focal_range, too few points), retry with the other
@@ -78,11 +80,12 @@ struct SfmOptions {
   std::string colmap = "colmap";  // COLMAP executable (name in PATH or path)
   bool verbose = false;           // echo COLMAP's output lines on stderr
 
-  ReferenceOptions reference_options;
-
-  // The options as recorded in cameras.json's producer.
-  Json ToJson() const;
+  ReferenceOptions reference_options;  // not on the command line
 };
+
+// Declares the options of `o` that are flags of `sfm` (all but the paths,
+// the focal range and reference_options), bound to its fields.
+void DeclareOptions(OptionTable& table, SfmOptions* o);
 
 // One run of COLMAP's mapper.
 struct MapperAttempt {
@@ -124,10 +127,11 @@ struct SfmResult {
          seconds_total = 0;
 };
 
-// Runs the whole stage and writes the outputs. Throws InputError (bad data
-// set, image or --ref; too few views registered or points), OutputError
-// (cannot write), std::runtime_error (COLMAP missing or failing).
-SfmResult RunSfm(const SfmOptions& options);
+// Runs the whole stage and writes the outputs, `options_record` as
+// cameras.json's producer options. Throws InputError (bad data set, image or
+// --ref; too few views registered or points), OutputError (cannot write),
+// std::runtime_error (COLMAP missing or failing).
+SfmResult RunSfm(const SfmOptions& options, const Json& options_record);
 
 // --- building blocks (exposed for tests) ----------------------------------
 
@@ -150,6 +154,6 @@ double ToReferenceFrame(const ColmapModel& model, const std::string& reference, 
 cv::Mat UndistortPhoto(const cv::Mat& photo, const ColmapCamera& camera);
 
 // The cameras.json document of a result.
-Json CamerasJson(const SfmResult& result, const SfmOptions& options);
+Json CamerasJson(const SfmResult& result, const Json& options_record);
 
 }  // namespace docunfold::sfm

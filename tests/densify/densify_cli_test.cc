@@ -75,7 +75,7 @@ TEST_F(DensifyCli, SurfacePrewarpIsASecondPassCountedApart) {
   ASSERT_EQ(plain.exit_code, 0) << plain.output;
   const Json before = ReadJsonFile(dir_ / "25_points/points.json");
   EXPECT_EQ(before["points"]["texture_surface_prewarp"].get<int>(), 0);
-  EXPECT_FALSE(before["producer"]["options"]["texture"]["surface_prewarp"].get<bool>());
+  EXPECT_FALSE(before["producer"]["options"]["surface_prewarp"].get<bool>());
   const CommandResult r = Run(Out());  // on by default
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("through the points' surface"), std::string::npos) << r.output;
@@ -84,7 +84,7 @@ TEST_F(DensifyCli, SurfacePrewarpIsASecondPassCountedApart) {
   EXPECT_EQ(
       after["points"]["texture"].get<int>() - after["points"]["texture_surface_prewarp"].get<int>(),
       before["points"]["texture"].get<int>());
-  EXPECT_TRUE(after["producer"]["options"]["texture"]["surface_prewarp"].get<bool>());
+  EXPECT_TRUE(after["producer"]["options"]["surface_prewarp"].get<bool>());
   const CommandResult v = RunCommand(Quote((SourceDir() / "scripts/validate-json").string()) + " " +
                                      Quote((dir_ / "25_points/points.json").string()));
   EXPECT_EQ(v.exit_code, 0) << v.output;

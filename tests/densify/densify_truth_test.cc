@@ -7,6 +7,7 @@
 #include <cstdio>
 
 #include "common/isometry/mesh_index.h"
+#include "common/point_source.h"
 #include "tests/init-mesh/work_fixture.h"
 #include "tests/isometry/test_meshes.h"
 #include "tests/support/test_support.h"
@@ -50,9 +51,9 @@ TEST(DensifyOnTruth, PointsLieOnTheTrueSurface) {
     std::vector<double> texture, outline, steps;
     for (size_t i = 0; i < cloud.vertices.size(); ++i) {
       const double d = surface.Closest(cloud.vertices[i])->distance / diagonal;
-      if (source->values[i] == 1) texture.push_back(d);
-      if (source->values[i] == 2) outline.push_back(d);
-      if (source->values[i] == 3) steps.push_back(d);
+      if (source->values[i] == double(PointSource::kTexture)) texture.push_back(d);
+      if (source->values[i] == double(PointSource::kOutline)) outline.push_back(d);
+      if (source->values[i] == double(PointSource::kStep)) steps.push_back(d);
     }
     const Json report = ReadJsonFile(dir / "25_points/points.json");
     const Json boundary = ReadJsonFile(dir / "20_boundary/boundary.json");

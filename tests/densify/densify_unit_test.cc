@@ -242,9 +242,9 @@ TEST(Densify, PointsLieOnTheRenderedPageAndItsOutline) {
   EXPECT_EQ(r.sfm_points, 150);
   std::vector<double> on_page, on_outline;
   for (size_t i = 0; i < r.points.vertices.size(); ++i) {
-    if (source[i] == densify::kTexture)
+    if (source[i] == double(PointSource::kTexture))
       on_page.push_back(DistanceToPage(scene, r.points.vertices[i]));
-    if (source[i] == densify::kOutline)
+    if (source[i] == double(PointSource::kOutline))
       on_outline.push_back(DistanceToOutline(scene, r.points.vertices[i]));
   }
   ASSERT_EQ(int(on_page.size()), r.texture_points);
@@ -354,7 +354,7 @@ TEST(Densify, TheFarSideOfAFoldGetsPointsThroughTheSurfaceOfTheFirst) {
     const Eigen::Vector3d hinge = scene.Point(0, scene.fold);
     int n = 0;
     for (size_t i = 0; i < result.points.vertices.size(); ++i) {
-      if (source[i] != densify::kTexture) continue;
+      if (source[i] != double(PointSource::kTexture)) continue;
       const Eigen::Vector3d& X = result.points.vertices[i];
       errors->push_back(scene.Distance(X));
       if ((X - hinge).dot(scene.down2.normalized()) > 0.02) ++n;  // 20 mm past the fold
@@ -412,7 +412,7 @@ TEST(Densify, ShadingStepsOfBlankPaperGetPointsOnThePage) {
   const std::vector<double>& source = r.points.properties[2].values;
   const Eigen::Vector3d n = scene.along.cross(scene.down).normalized();
   for (size_t i = 0; i < r.points.vertices.size(); ++i) {
-    if (source[i] != densify::kStep) continue;
+    if (source[i] != double(PointSource::kStep)) continue;
     const Eigen::Vector3d& X = r.points.vertices[i];
     // Measured up to 1.6 mm (0.3 % of the diagonal): a step blurred by 3 px
     // is found less exactly than print.

@@ -70,7 +70,10 @@ TEST_P(SfmAccuracy, MatchesGroundTruth) {
   } else if (fs::is_regular_file(e2e / "cameras.json")) {
     options.out_dir = e2e;
   } else {
-    ASSERT_NO_THROW(sfm::RunSfm(options)) << name;
+    CLI::App app;
+    OptionTable table(app);
+    sfm::DeclareOptions(table, &options);  // the defaults, as the record of cameras.json
+    ASSERT_NO_THROW(sfm::RunSfm(options, table.Record())) << name;
   }
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

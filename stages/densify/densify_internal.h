@@ -1,0 +1,124 @@
+// What the parts of densify share: the working copies of the photos, the
+// triangulation helpers, and the steps Run takes (texture points in
+// texture_points.cc; outline and shading-step points, which share the
+// epipolar matcher, in edge_points.cc).
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <opencv2/core.hpp>
+#include <vector>
+
+#include "common/camera.h"
+#include "common/image_sampling.h"
+#include "common/page_files.h"
+#include "common/ply.h"
+#include "common/point_source.h"
+#include "stages/densify/densify.h"
+
+namespace docunfold::densify::detail {
+
+// Bilinear sample of a float image; 0 outside its pixel centres.
+inline float SampleOrZero(const cv::Mat1f& m, double x, double y) {
+  return InsideImage(m, x, y) ? SampleBilinear(m, x, y) : 0.f;
+}
+
+// A photo as the stage works on it: undistorted, resized, with its camera
+// and the gradient of a slightly blurred copy (grey levels per pixel).
+struct View {
+  int index = -1;  // in the camera set
+  PinholeCamera camera;
+  cv::Mat1b grey;
+  cv::Mat1f gx, gy;
+
+  Eigen::Vector2d Gradient(const Eigen::Vector2d& p) const {
+    return {SampleOrZero(gx, p.x(), p.y()), SampleOrZero(gy, p.x(), p.y())};
+  }
+  bool Inside(const Eigen::Vector2d& p, double border = 1) const {
+    return p.x() >= border && p.y() >= border && p.x() <= grey.cols - 1 - border &&
+           p.y() <= grey.rows - 1 - border;
+  }
+};
+
+// The working copy of a photo: resized by `scale`, undistorted.
+View MakeView(int index, const PinholeCamera& camera, const cv::Mat& grey_photo,
+              const std::array<double, 4>& distortion, double scale);
+
+// A pixel of an image in a copy resized by `scale` (cv::resize's centres).
+Eigen::Vector2d ScalePixel(const Eigen::Vector2d& p, double scale);
+
+// Point of the reference camera's ray through `pixel` at camera depth `depth`.
+Eigen::Vector3d RayPoint(const PinholeCamera& camera, const Eigen::Vector2d& pixel, double depth);
+
+struct Observation {
+  const PinholeCamera* camera;
+  Eigen::Vector2d pixel;
+};
+
+// Sub-pixel position of the local maximum g[i] (a parabola through it and
+// its neighbours), as an offset in samples from i.
+double ParabolaPeak(const std::vector<double>& g, int i);
+
+// Appends a point made by densify with its PLY properties (Run sets up
+// track_length, reprojection_error and source, in that order).
+void AppendPoint(const Eigen::Vector3d& X, const std::array<uint8_t, 3>& rgb, int views,
+                 double reprojection_error, PointSource source, PlyData* points);
+
+// Triangulates and checks: in front of every camera, every reprojection
+// within `max_error`, rays at least `min_angle` apart. Returns false when not.
+bool TriangulateChecked(const std::vector<Observation>& obs, double max_error, double min_angle_rad,
+                        Eigen::Vector3d* point, double* mean_error);
+
+// --- texture points (texture_points.cc) -------------------------------------
+
+// A textured sample of the reference view and where the flow found it in
+// the other views; `done` once it is triangulated.
+struct Track {
+  Eigen::Vector2d pixel;
+  std::vector<Observation> obs;
+  bool done = false;
+};
+
+// First pass: the textured samples of `region` followed into every other
+// view through the homography of the page's SfM points (`region_points`),
+// triangulated where enough views have them; appends the points (colour
+// from the full-size `reference_bgr`) and counts them in `result`. Returns
+// the samples, for the second pass.
+std::vector<Track> AddTexturePoints(const View& ref, const std::vector<View>& others,
+                                    const cv::Mat1b& region,
+                                    const std::vector<Eigen::Vector3d>& region_points,
+                                    const cv::Mat& reference_bgr, const TextureOptions& o,
+                                    DensifyResult* result);
+
+// Second pass: the samples the first left without a point, in the holes it
+// left (TextureOptions::surface_hole_px), followed again with every view
+// brought onto the reference through the surface of the `known` points.
+void AddSurfaceTexturePoints(const View& ref, const std::vector<View>& others,
+                             const cv::Mat1b& region, const std::vector<Eigen::Vector3d>& known,
+                             const cv::Mat& reference_bgr, const TextureOptions& o,
+                             std::vector<Track>* tracks, DensifyResult* result);
+
+// --- outline and shading-step points (edge_points.cc) ------------------------
+
+// Pixels and depths in `camera` of `page_points` and of the points made so far
+// (`points` from `first_new` on): what the edge matching searches around.
+void KnownPoints(const PinholeCamera& camera, const std::vector<Eigen::Vector3d>& page_points,
+                 const PlyData& points, size_t first_new, std::vector<Eigen::Vector2d>* pixels,
+                 std::vector<double>* depths);
+
+// Points on the real sides of `boundary` (reference pixels; `page` is the
+// document region in working-copy pixels), matched in the other views.
+void AddOutlinePoints(const View& ref, const std::vector<View>& others, int num_views,
+                      const Boundary& boundary, const cv::Mat1b& page,
+                      const std::vector<Eigen::Vector2d>& known_pixels,
+                      const std::vector<double>& known_depths, const OutlineOptions& o,
+                      DensifyResult* result);
+
+// Points on the shading steps of blank paper inside `page`, matched like the
+// outline (whose matching options `outline` gives) on blurred copies.
+void AddStepPoints(const View& ref, const std::vector<View>& others, int num_views,
+                   const cv::Mat1b& page, const std::vector<Eigen::Vector2d>& known_pixels,
+                   const std::vector<double>& known_depths, const StepOptions& so,
+                   const OutlineOptions& outline, DensifyResult* result);
+
+}  // namespace docunfold::densify::detail

@@ -1,0 +1,333 @@
+// The steps of sfm that run COLMAP, and the staging directory they work in.
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <fstream>
+#include <random>
+#include <regex>
+
+#include "common/atomic_file.h"
+#include "common/cli.h"
+#include "common/errors.h"
+#include "stages/sfm/matching.h"
+#include "stages/sfm/sfm_internal.h"
+
+namespace docunfold::sfm::detail {
+
+StagingDir::StagingDir(const fs::path& target) : target_(target) {
+  const fs::path parent = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  EnsureDirectory(parent);
+  std::random_device rd;
+  path_ = parent / ("." + target.filename().string() + ".tmp-" + std::to_string(::getpid()) + "-" +
+                    std::to_string(rd() % 100000));
+  std::error_code ec;
+  fs::remove_all(path_, ec);
+  fs::create_directories(path_, ec);
+  if (ec) throw OutputError(path_.string() + ": cannot create: " + ec.message());
+}
+
+StagingDir::~StagingDir() {
+  if (committed_) return;
+  std::error_code ec;
+  fs::remove_all(path_, ec);
+}
+
+void StagingDir::Commit() {
+  std::error_code ec;
+  fs::path old;
+  if (fs::exists(target_, ec)) {
+    old = path_;
+    old += ".old";
+    fs::remove_all(old, ec);
+    fs::rename(target_, old, ec);
+    if (ec)
+      throw OutputError(target_.string() + ": cannot move the old output aside: " + ec.message());
+  }
+  fs::rename(path_, target_, ec);
+  if (ec) {
+    std::error_code ignored;
+    if (!old.empty()) fs::rename(old, target_, ignored);
+    throw OutputError(target_.string() + ": cannot rename into place: " + ec.message());
+  }
+  committed_ = true;
+  if (!old.empty()) fs::remove_all(old, ec);
+}
+
+void CheckOutputDir(const fs::path& out) {
+  std::error_code ec;
+  if (!fs::exists(out, ec)) return;
+  if (!fs::is_directory(out, ec))
+    throw OutputError(out.string() + ": exists and is not a directory");
+  if (fs::is_empty(out, ec)) return;
+  for (const char* marker : {"cameras.json", "colmap", "points.ply", "reference.png"})
+    if (fs::exists(out / marker, ec)) return;
+  throw OutputError(out.string() +
+                    ": exists and is not an sfm output folder (no cameras.json or "
+                    "colmap/); remove it or choose another --out");
+}
+
+SubprocessResult Colmap::Run(const std::string& command, std::vector<std::string> args,
+                             const std::string& log,
+                             const std::function<void(const std::string&)>& on_line,
+                             bool throw_on_failure) const {
+  args.insert(args.begin(), {exe.string(), command});
+  std::string last;
+  SubprocessOptions sub;
+  sub.log_file = dir / log;
+  sub.timeout_seconds = options->timeout_seconds;
+  sub.on_line = [&](const std::string& line) {
+    if (options->verbose && !line.empty()) Log("colmap: " + line);
+    if (line.find_first_not_of(" =\t") != std::string::npos) last = line;
+    if (on_line) on_line(line);
+  };
+  SubprocessResult r = RunSubprocess(args, sub);
+  if (r.not_found) throw std::runtime_error(NotFoundMessage(exe.string()));
+  if (throw_on_failure && (r.timed_out || r.exit_code != 0)) {
+    std::string why = r.timed_out
+                          ? "stopped after " + Fixed(options->timeout_seconds, 0) + " s (--timeout)"
+                      : r.signal ? "killed by signal " + std::to_string(r.signal)
+                                 : "exit code " + std::to_string(r.exit_code);
+    throw std::runtime_error("COLMAP " + command + " failed (" + why + ")" +
+                             (last.empty() ? "" : ": " + last) +
+                             "; run with --verbose to see its output");
+  }
+  return r;
+}
+
+std::string Colmap::NotFoundMessage(const std::string& program) {
+  return "COLMAP not found (" + program +
+         "): install it with `apt-get install colmap` (Debian/Ubuntu) or "
+         "scripts/install-deps.sh, or give its path with --colmap";
+}
+
+void ExtractFeatures(const Colmap& colmap, const Photos& photos) {
+  const SfmOptions& o = *colmap.options;
+  Progress progress("extracting features", long(photos.names.size()));
+  const std::regex processed(R"(Processed file \[(\d+)/(\d+)\])");
+  colmap.Run(
+      "feature_extractor",
+      {"--database_path", colmap.database.string(), "--image_path", colmap.image_dir.string(),
+       "--image_list_path", (colmap.dir / "image_list.txt").string(), "--ImageReader.single_camera",
+       "1", "--ImageReader.camera_model", o.camera_model, "--SiftExtraction.use_gpu", "0",
+       "--SiftExtraction.max_image_size", std::to_string(o.max_image_size),
+       "--SiftExtraction.max_num_features", std::to_string(o.max_num_features),
+       "--SiftExtraction.num_threads", colmap.threads},
+      "feature_extractor.log", [&](const std::string& line) {
+        std::smatch m;
+        if (std::regex_search(line, m, processed)) progress.Update(std::stol(m[1]));
+      });
+  progress.Done();
+}
+
+namespace {
+
+// Every pair's exact matches (matching.h) into a raw match list, imported by
+// COLMAP's matches_importer, which verifies them.
+void MatchExactly(const Colmap& colmap, int pairs) {
+  NumberImagesByName(colmap.database);
+  const std::vector<ImageDescriptors> images = ReadDatabaseDescriptors(colmap.database);
+  const fs::path list_file = colmap.dir / "matches_raw.txt";
+  std::ofstream list(list_file);
+  Progress progress("matching features", pairs);
+  const auto matches = MatchAllPairs(images, MatchCriteria{}, colmap.options->threads,
+                                     [&](int done) { progress.Update(done); });
+  long total = 0, k = 0;
+  for (size_t a = 0; a < images.size(); ++a)
+    for (size_t b = a + 1; b < images.size(); ++b, ++k) {
+      list << images[a].name << ' ' << images[b].name << '\n';
+      for (const auto& [i, j] : matches[k]) list << i << ' ' << j << '\n';
+      list << '\n';
+      total += long(matches[k].size());
+    }
+  list.close();
+  if (!list) throw OutputError(list_file.string() + ": write failed");
+  progress.Done();
+  Log("matching features: " + std::to_string(total) + " matches before geometric verification");
+  colmap.Run("matches_importer",
+             {"--database_path", colmap.database.string(), "--match_list_path", list_file.string(),
+              "--match_type", "raw", "--SiftMatching.use_gpu", "0", "--SiftMatching.num_threads",
+              colmap.threads},
+             "matches_importer.log", nullptr);
+}
+
+}  // namespace
+
+void MatchFeatures(const Colmap& colmap, const Photos& photos) {
+  const SfmOptions& o = *colmap.options;
+  const int n = int(photos.names.size());
+  const int pairs = n * (n - 1) / 2;
+  // matches_importer's list names a pair by its two names split at a space.
+  const bool spaced_names = std::any_of(
+      photos.names.begin(), photos.names.end(),
+      [](const std::string& name) { return name.find_first_of(" \t") != std::string::npos; });
+  const bool exact = o.matcher == "exact" && !spaced_names;
+  if (o.matcher == "exact" && spaced_names)
+    Log("an image name has a space, which COLMAP's match list cannot carry: COLMAP's "
+        "exhaustive matcher is used instead (its matches differ a little between runs)");
+  Log("matching features: " + std::to_string(pairs) + " pairs of views (" +
+      (exact ? std::string("exact, ") + AutoDotKernelName() : std::string("colmap")) + ")");
+  if (exact) {
+    MatchExactly(colmap, pairs);
+  } else {
+    colmap.Run("exhaustive_matcher",
+               {"--database_path", colmap.database.string(), "--SiftMatching.use_gpu", "0",
+                "--SiftMatching.num_threads", colmap.threads},
+               "exhaustive_matcher.log", nullptr);
+  }
+}
+
+namespace {
+
+// Largest model (most registered images, then most points) among
+// <dir>/0, <dir>/1, ...
+bool ReadBestModel(const fs::path& dir, ColmapModel* best, fs::path* best_dir) {
+  bool found = false;
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) return false;
+  for (const auto& entry : fs::directory_iterator(dir, ec)) {
+    if (!entry.is_directory() || !fs::exists(entry.path() / "points3D.bin")) continue;
+    ColmapModel m = ReadColmapModel(entry.path());
+    if (!found || m.images.size() > best->images.size() ||
+        (m.images.size() == best->images.size() && m.points.size() > best->points.size())) {
+      *best = std::move(m);
+      *best_dir = entry.path();
+      found = true;
+    }
+  }
+  return found;
+}
+
+// Ranks attempts: plausible ones first (in the order they were tried, i.e.
+// by preference), then by views registered and points.
+bool Better(const MapperAttempt& a, const MapperAttempt& b) {
+  if (a.produced_model != b.produced_model) return a.produced_model;
+  if (a.plausible != b.plausible) return a.plausible;
+  if (a.plausible) return false;  // keep the earlier (preferred) one
+  if (a.registered != b.registered) return a.registered > b.registered;
+  return a.points > b.points;
+}
+
+struct MapperSetting {
+  bool refine;
+  double filter;  // px at matching resolution
+};
+
+// Judges the model an attempt made: every view registered, a plausible
+// focal length, enough points.
+void JudgeModel(const ColmapModel& m, const Photos& photos, const SfmOptions& o,
+                MapperAttempt* attempt) {
+  const int n = int(photos.names.size());
+  attempt->produced_model = true;
+  attempt->registered = int(m.images.size());
+  attempt->points = int(m.points.size());
+  attempt->mean_reprojection_error = m.MeanReprojectionError();
+  const ColmapCamera& cam = m.cameras.begin()->second;
+  attempt->focal = cam.MeanFocal();
+  attempt->params = cam.params;
+  const double factor = attempt->focal / photos.long_side;
+  std::vector<std::string> problems;
+  if (attempt->registered < n)
+    problems.push_back(std::to_string(n - attempt->registered) + " of " + std::to_string(n) +
+                       " views not registered");
+  if (factor < o.min_focal_factor || factor > o.max_focal_factor)
+    problems.push_back("implausible focal length " + Fixed(attempt->focal, 0) + " px");
+  if (attempt->points < o.min_points)
+    problems.push_back("only " + std::to_string(attempt->points) + " points");
+  attempt->plausible = problems.empty();
+  for (size_t i = 0; i < problems.size(); ++i) attempt->problem += (i ? "; " : "") + problems[i];
+}
+
+// One run of the mapper with setting `s` into `dir`; the largest model it
+// made into *m and *m_dir.
+MapperAttempt RunMapper(const Colmap& colmap, const Photos& photos, const MapperSetting& s,
+                        const fs::path& dir, ColmapModel* m, fs::path* m_dir) {
+  const SfmOptions& o = *colmap.options;
+  const int n = int(photos.names.size());
+  const int model_id = CameraModelId(o.camera_model);
+  MapperAttempt attempt;
+  attempt.description =
+      o.camera_model +
+      (model_id >= 2 ? (s.refine ? ", distortion refined" : ", distortion fixed at 0")
+                     : std::string()) +
+      ", filter " + Fixed(s.filter, 1) + " px";
+  EnsureDirectory(dir);
+  Log("mapping (" + attempt.description + ")");
+  const std::regex registering(R"(Registering image #\d+ \((\d+)\))");
+  long registered_so_far = 2;
+  auto last_log = std::chrono::steady_clock::now();
+  const SubprocessResult run = colmap.Run(
+      "mapper",
+      {"--database_path", colmap.database.string(), "--image_path", colmap.image_dir.string(),
+       "--output_path", dir.string(), "--Mapper.num_threads", colmap.threads,
+       "--Mapper.ba_refine_extra_params", s.refine ? "1" : "0", "--Mapper.filter_max_reproj_error",
+       Fixed(s.filter * photos.matching_scale, 3), "--Mapper.tri_ignore_two_view_tracks",
+       o.two_view_tracks ? "0" : "1"},
+      "mapper.log",
+      [&](const std::string& line) {
+        std::smatch match;
+        if (!std::regex_search(line, match, registering)) return;
+        registered_so_far = std::stol(match[1]);
+        const auto now = std::chrono::steady_clock::now();
+        if (now - last_log < std::chrono::seconds(1)) return;
+        last_log = now;
+        Log("mapping: " + std::to_string(registered_so_far) + "/" + std::to_string(n) +
+            " views registered");
+      },
+      /*throw_on_failure=*/false);
+  attempt.seconds = run.seconds;
+  if (ReadBestModel(dir, m, m_dir)) {
+    JudgeModel(*m, photos, o, &attempt);
+  } else {
+    attempt.problem = run.timed_out ? "stopped after the time limit"
+                                    : "no model (no initial pair of views found)";
+  }
+  Log("mapping (" + attempt.description + "): " +
+      (attempt.produced_model
+           ? std::to_string(attempt.registered) + "/" + std::to_string(n) + " views, " +
+                 std::to_string(attempt.points) + " points, focal " + Fixed(attempt.focal, 1) +
+                 " px, reprojection error " + Fixed(attempt.mean_reprojection_error, 2) + " px"
+           : std::string("failed")) +
+      (attempt.plausible ? "" : " (" + attempt.problem + ")") + ", " + Fixed(run.seconds, 1) +
+      " s");
+  return attempt;
+}
+
+}  // namespace
+
+Mapping MapWithRetries(const Colmap& colmap, const Photos& photos) {
+  const SfmOptions& o = *colmap.options;
+  const int model_id = CameraModelId(o.camera_model);
+  std::vector<MapperSetting> settings = {{o.refine_distortion, o.max_reprojection_error}};
+  if (o.retry) {
+    if (model_id >= 2) settings.push_back({!o.refine_distortion, o.max_reprojection_error});
+    if (o.max_reprojection_error < 4) settings.push_back({o.refine_distortion, 4.0});
+  }
+  Mapping mapping;
+  int best = -1;
+  for (size_t a = 0; a < settings.size(); ++a) {
+    ColmapModel m;
+    fs::path m_dir;
+    const MapperAttempt attempt = RunMapper(
+        colmap, photos, settings[a], colmap.dir / "attempts" / std::to_string(a), &m, &m_dir);
+    mapping.attempts.push_back(attempt);
+    if (attempt.produced_model && (best < 0 || Better(attempt, mapping.attempts[best]))) {
+      best = int(a);
+      mapping.model = std::move(m);
+      mapping.model_dir = m_dir;
+    }
+    if (attempt.plausible) break;
+  }
+  mapping.found = best >= 0;
+  return mapping;
+}
+
+void KeepModel(const Colmap& colmap, const fs::path& model_dir) {
+  std::error_code ec;
+  fs::create_directories(colmap.dir / "sparse", ec);
+  fs::rename(model_dir, colmap.dir / "sparse" / "0", ec);
+  if (ec) throw OutputError((colmap.dir / "sparse/0").string() + ": " + ec.message());
+  fs::remove_all(colmap.dir / "attempts", ec);
+}
+
+}  // namespace docunfold::sfm::detail

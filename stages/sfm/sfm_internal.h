@@ -1,0 +1,92 @@
+// The steps of RunSfm that run COLMAP (colmap_steps.cc): the staging
+// directory the outputs are made in, and feature extraction, matching and
+// mapping with retries.
+#pragma once
+
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "stages/sfm/colmap_model.h"
+#include "stages/sfm/sfm.h"
+#include "stages/sfm/subprocess.h"
+
+namespace docunfold::sfm::detail {
+
+// A directory beside the output that becomes the output when Commit() is
+// called, and disappears otherwise.
+class StagingDir {
+ public:
+  explicit StagingDir(const fs::path& target);
+  ~StagingDir();
+  StagingDir(const StagingDir&) = delete;
+  StagingDir& operator=(const StagingDir&) = delete;
+  const fs::path& path() const { return path_; }
+
+  // Replaces the target (an earlier sfm output) with the staging directory.
+  void Commit();
+
+ private:
+  fs::path target_;
+  fs::path path_;
+  bool committed_ = false;
+};
+
+// An existing --out must be a folder sfm wrote (or an empty one): we replace
+// it as a whole and must not wipe anything else.
+void CheckOutputDir(const fs::path& out);
+
+// COLMAP's command-line tools on one workspace.
+struct Colmap {
+  fs::path exe;
+  const SfmOptions* options;
+  fs::path dir;         // colmap/ workspace
+  fs::path database;    // <dir>/database.db
+  fs::path image_dir;   // the data set's images/, absolute
+  std::string threads;  // --threads as COLMAP takes it
+
+  // Runs one COLMAP command, its output into <dir>/<log>; throws when it
+  // fails (except for the mapper, whose failure the caller judges).
+  SubprocessResult Run(const std::string& command, std::vector<std::string> args,
+                       const std::string& log,
+                       const std::function<void(const std::string&)>& on_line,
+                       bool throw_on_failure = true) const;
+
+  static std::string NotFoundMessage(const std::string& program);
+};
+
+// The photos as the COLMAP steps see them.
+struct Photos {
+  std::vector<std::string> names;  // every image of the data set, sorted
+  int long_side = 0;               // pixels
+  // Keypoints come back at full resolution: a pixel at matching resolution
+  // is this many photo pixels.
+  double matching_scale = 1;
+};
+
+// SIFT features of every photo into the database (feature_extractor).
+void ExtractFeatures(const Colmap& colmap, const Photos& photos);
+
+// Matches between every pair of photos: exact nearest neighbours
+// (matching.h) verified by COLMAP, or COLMAP's own exhaustive matcher.
+void MatchFeatures(const Colmap& colmap, const Photos& photos);
+
+// What the mapper made, over its attempts.
+struct Mapping {
+  std::vector<MapperAttempt> attempts;  // in the order tried
+  bool found = false;                   // some attempt made a model
+  ColmapModel model;                    // the best attempt's
+  fs::path model_dir;                   // where it is
+};
+
+// Incremental mapping into <dir>/attempts/<i>/, retried with other settings
+// (SfmOptions::retry) while the result is implausible; the best attempt
+// (plausible first, in the order tried) wins.
+Mapping MapWithRetries(const Colmap& colmap, const Photos& photos);
+
+// Keeps the chosen model as <dir>/sparse/0 (what `colmap model_analyzer` and
+// the GUI expect) and drops the other attempts.
+void KeepModel(const Colmap& colmap, const fs::path& model_dir);
+
+}  // namespace docunfold::sfm::detail
