@@ -1,5 +1,6 @@
 // A data set on disk: images/ with the photos and, optionally,
-// ground_truth/ (DESIGN.md §3).
+// ground_truth/ (the true flat page, surface and cameras: flat.png,
+// mesh.ply, cameras.json, page.json, ...).
 #pragma once
 
 #include <filesystem>

@@ -1,7 +1,7 @@
 // The pair of meshes every later stage exchanges: M (mesh3d.ply, the page in
 // the world frame) and M' (mesh2d.ply, its flat twin in z = 0), quad grids
-// with the same connectivity (DESIGN §4), and the map from reference-image
-// pixels onto them.
+// with the same connectivity, and the map from reference-image pixels onto
+// them.
 //
 // File contract (40_init/, 50_optimize/, 50_optimize/roundK/):
 //  - vertices row-major, `comment grid NX NY` (NX vertices per row, NY rows);

@@ -273,160 +273,207 @@ void WritePly(const fs::path& path, const PlyData& ply, PlyEncoding encoding) {
   WriteTextAtomic(path, out);
 }
 
-PlyData ReadPly(const fs::path& path) {
-  std::ifstream f(path, std::ios::binary);
-  if (!f) throw InputError(path.string() + ": cannot open file");
-  auto fail = [&](const std::string& what) -> void {
-    throw InputError(path.string() + ": " + what);
-  };
-  std::string line;
-  if (!std::getline(f, line) || line.rfind("ply", 0) != 0)
-    fail(line.empty() && f.eof() ? "empty file" : "not a PLY file");
+namespace {
 
-  struct Prop {
-    std::string name;
-    FileType type;
-    bool is_list = false;
-    FileType count_type;
-  };
-  struct Element {
-    std::string name;
-    size_t count = 0;
-    std::vector<Prop> props;
-  };
-  std::vector<Element> elements;
+[[noreturn]] void Fail(const fs::path& path, const std::string& what) {
+  throw InputError(path.string() + ": " + what);
+}
+
+// What a PLY header declares.
+struct HeaderProperty {
+  std::string name;
+  FileType type;
+  bool is_list = false;
+  FileType count_type;
+};
+struct HeaderElement {
+  std::string name;
+  size_t count = 0;
+  std::vector<HeaderProperty> props;
+};
+struct Header {
+  std::vector<HeaderElement> elements;
   std::string format;
-  PlyData ply;
+};
+
+// A "property ..." line (after the word "property") of the last element.
+HeaderProperty ReadPropertyLine(std::istringstream& s, const std::string& line,
+                                const fs::path& path) {
+  HeaderProperty p;
+  std::string type;
+  s >> type;
+  bool ok = true;
+  if (type == "list") {
+    std::string count_type, item_type;
+    s >> count_type >> item_type >> p.name;
+    bool ok2 = true;
+    p.is_list = true;
+    p.count_type = ToFileType(count_type, &ok);
+    p.type = ToFileType(item_type, &ok2);
+    ok = ok && ok2;
+  } else {
+    s >> p.name;
+    p.type = ToFileType(type, &ok);
+  }
+  if (!ok) Fail(path, "unsupported property type in: " + line);
+  return p;
+}
+
+// The header after the "ply" line, up to and including end_header; its
+// comments go to `comments`.
+Header ReadHeader(std::istream& f, const fs::path& path, std::vector<std::string>* comments) {
+  Header header;
+  std::string line;
   while (true) {
-    if (!std::getline(f, line)) fail("header ends before end_header");
+    if (!std::getline(f, line)) Fail(path, "header ends before end_header");
     if (!line.empty() && line.back() == '\r') line.pop_back();
     std::istringstream s(line);
     std::string word;
     s >> word;
     if (word == "end_header") break;
     if (word == "format") {
-      s >> format;
+      s >> header.format;
     } else if (word == "comment" || word == "obj_info") {
-      ply.comments.push_back(line.size() > word.size() + 1 ? line.substr(word.size() + 1) : "");
+      comments->push_back(line.size() > word.size() + 1 ? line.substr(word.size() + 1) : "");
     } else if (word == "element") {
-      Element e;
+      HeaderElement e;
       long long count = -1;
       s >> e.name >> count;
-      if (count < 0) fail("bad element line: " + line);
+      if (count < 0) Fail(path, "bad element line: " + line);
       e.count = size_t(count);
-      elements.push_back(e);
+      header.elements.push_back(e);
     } else if (word == "property") {
-      if (elements.empty()) fail("property before any element");
-      Prop p;
-      std::string type;
-      s >> type;
-      bool ok = true;
-      if (type == "list") {
-        std::string count_type, item_type;
-        s >> count_type >> item_type >> p.name;
-        bool ok2 = true;
-        p.is_list = true;
-        p.count_type = ToFileType(count_type, &ok);
-        p.type = ToFileType(item_type, &ok2);
-        ok = ok && ok2;
-      } else {
-        s >> p.name;
-        p.type = ToFileType(type, &ok);
-      }
-      if (!ok) fail("unsupported property type in: " + line);
-      elements.back().props.push_back(p);
+      if (header.elements.empty()) Fail(path, "property before any element");
+      header.elements.back().props.push_back(ReadPropertyLine(s, line, path));
     } else if (!word.empty()) {
-      fail("unexpected header line: " + line);
+      Fail(path, "unexpected header line: " + line);
     }
   }
-  const bool ascii = format == "ascii";
-  const bool swap = (format == "binary_little_endian") != HostIsLittleEndian();
-  if (!ascii && format != "binary_little_endian" && format != "binary_big_endian")
-    fail("unknown format '" + format + "'");
+  return header;
+}
 
-  // Reads one scalar of the given type from the body.
-  auto read_value = [&](const FileType& ft) -> double {
-    if (ascii) {
+// Reads the scalars of the body one by one, ASCII or binary.
+class BodyReader {
+ public:
+  BodyReader(std::istream& f, const fs::path& path, bool ascii, bool swap)
+      : f_(f), path_(path), ascii_(ascii), swap_(swap) {}
+
+  double Read(const FileType& ft) {
+    if (ascii_) {
       // strtod, unlike operator>>, accepts "nan" and "inf", which are then
       // reported as non-finite coordinates rather than as garbage.
       std::string token;
-      if (!(f >> token)) fail("truncated data");
+      if (!(f_ >> token)) Fail(path_, "truncated data");
       char* end = nullptr;
       double v = std::strtod(token.c_str(), &end);
-      if (end == token.c_str() || *end != '\0') fail("malformed number '" + token + "'");
+      if (end == token.c_str() || *end != '\0') Fail(path_, "malformed number '" + token + "'");
       return v;
     }
     unsigned char buf[8];
-    if (!f.read(reinterpret_cast<char*>(buf), ft.bytes)) fail("truncated data");
-    return DecodeBinary(buf, ft, swap);
-  };
+    if (!f_.read(reinterpret_cast<char*>(buf), ft.bytes)) Fail(path_, "truncated data");
+    return DecodeBinary(buf, ft, swap_);
+  }
 
-  for (const Element& e : elements) {
-    if (e.name == "vertex") {
-      int ix = -1, iy = -1, iz = -1, ir = -1, ig = -1, ib = -1;
-      for (size_t k = 0; k < e.props.size(); ++k) {
-        const std::string& nm = e.props[k].name;
-        if (nm == "x")
-          ix = int(k);
-        else if (nm == "y")
-          iy = int(k);
-        else if (nm == "z")
-          iz = int(k);
-        else if (nm == "red")
-          ir = int(k);
-        else if (nm == "green")
-          ig = int(k);
-        else if (nm == "blue")
-          ib = int(k);
-        else if (!e.props[k].is_list)
-          ply.properties.push_back({nm, e.props[k].type.t, {}});
+ private:
+  std::istream& f_;
+  const fs::path& path_;
+  bool ascii_, swap_;
+};
+
+// The vertex element: x, y, z, optional red, green, blue, and every other
+// scalar property as an extra one (lists are skipped).
+void ReadVertices(const HeaderElement& e, BodyReader& body, const fs::path& path, PlyData* ply) {
+  int ix = -1, iy = -1, iz = -1, ir = -1, ig = -1, ib = -1;
+  for (size_t k = 0; k < e.props.size(); ++k) {
+    const std::string& nm = e.props[k].name;
+    if (nm == "x")
+      ix = int(k);
+    else if (nm == "y")
+      iy = int(k);
+    else if (nm == "z")
+      iz = int(k);
+    else if (nm == "red")
+      ir = int(k);
+    else if (nm == "green")
+      ig = int(k);
+    else if (nm == "blue")
+      ib = int(k);
+    else if (!e.props[k].is_list)
+      ply->properties.push_back({nm, e.props[k].type.t, {}});
+  }
+  if (ix < 0 || iy < 0 || iz < 0) Fail(path, "vertex element lacks x, y or z");
+  const bool has_color = ir >= 0 && ig >= 0 && ib >= 0;
+  ply->vertices.resize(e.count);
+  if (has_color) ply->colors.resize(e.count);
+  for (PlyProperty& p : ply->properties) p.values.resize(e.count);
+  std::vector<double> row(e.props.size());
+  for (size_t i = 0; i < e.count; ++i) {
+    size_t extra = 0;
+    for (size_t k = 0; k < e.props.size(); ++k) {
+      if (e.props[k].is_list) {
+        int m = int(body.Read(e.props[k].count_type));
+        for (int j = 0; j < m; ++j) body.Read(e.props[k].type);
+        continue;
       }
-      if (ix < 0 || iy < 0 || iz < 0) fail("vertex element lacks x, y or z");
-      const bool has_color = ir >= 0 && ig >= 0 && ib >= 0;
-      ply.vertices.resize(e.count);
-      if (has_color) ply.colors.resize(e.count);
-      for (PlyProperty& p : ply.properties) p.values.resize(e.count);
-      std::vector<double> row(e.props.size());
-      for (size_t i = 0; i < e.count; ++i) {
-        size_t extra = 0;
-        for (size_t k = 0; k < e.props.size(); ++k) {
-          if (e.props[k].is_list) {
-            int m = int(read_value(e.props[k].count_type));
-            for (int j = 0; j < m; ++j) read_value(e.props[k].type);
-            continue;
-          }
-          row[k] = read_value(e.props[k].type);
-          if (int(k) != ix && int(k) != iy && int(k) != iz && int(k) != ir && int(k) != ig &&
-              int(k) != ib)
-            ply.properties[extra++].values[i] = row[k];
-        }
-        ply.vertices[i] = {row[ix], row[iy], row[iz]};
-        if (!ply.vertices[i].allFinite())
-          fail("vertex " + std::to_string(i) + " has a non-finite coordinate");
-        if (has_color) ply.colors[i] = {uint8_t(row[ir]), uint8_t(row[ig]), uint8_t(row[ib])};
+      row[k] = body.Read(e.props[k].type);
+      if (int(k) != ix && int(k) != iy && int(k) != iz && int(k) != ir && int(k) != ig &&
+          int(k) != ib)
+        ply->properties[extra++].values[i] = row[k];
+    }
+    ply->vertices[i] = {row[ix], row[iy], row[iz]};
+    if (!ply->vertices[i].allFinite())
+      Fail(path, "vertex " + std::to_string(i) + " has a non-finite coordinate");
+    if (has_color) ply->colors[i] = {uint8_t(row[ir]), uint8_t(row[ig]), uint8_t(row[ib])};
+  }
+}
+
+// Any other element: the faces' vertex_indices (or vertex_index) lists are
+// kept, everything else read and dropped.
+void ReadOtherElement(const HeaderElement& e, BodyReader& body, const fs::path& path,
+                      PlyData* ply) {
+  const bool is_face = e.name == "face";
+  for (size_t i = 0; i < e.count; ++i) {
+    for (const HeaderProperty& p : e.props) {
+      if (!p.is_list) {
+        body.Read(p.type);
+        continue;
       }
-    } else {
-      const bool is_face = e.name == "face";
-      for (size_t i = 0; i < e.count; ++i) {
-        for (const Prop& p : e.props) {
-          if (!p.is_list) {
-            read_value(p.type);
-            continue;
-          }
-          double m = read_value(p.count_type);
-          if (m < 0 || m > 1e6) fail("bad list length in element " + e.name);
-          std::vector<int> idx(static_cast<size_t>(m));
-          for (int& v : idx) v = int(read_value(p.type));
-          if (is_face && (p.name == "vertex_indices" || p.name == "vertex_index")) {
-            for (int v : idx)
-              if (v < 0 || size_t(v) >= ply.vertices.size())
-                fail("face " + std::to_string(i) + " indexes a missing vertex " +
-                     std::to_string(v));
-            ply.faces.push_back(std::move(idx));
-          }
-        }
+      double m = body.Read(p.count_type);
+      if (m < 0 || m > 1e6) Fail(path, "bad list length in element " + e.name);
+      std::vector<int> idx(static_cast<size_t>(m));
+      for (int& v : idx) v = int(body.Read(p.type));
+      if (is_face && (p.name == "vertex_indices" || p.name == "vertex_index")) {
+        for (int v : idx)
+          if (v < 0 || size_t(v) >= ply->vertices.size())
+            Fail(path,
+                 "face " + std::to_string(i) + " indexes a missing vertex " + std::to_string(v));
+        ply->faces.push_back(std::move(idx));
       }
     }
+  }
+}
+
+}  // namespace
+
+PlyData ReadPly(const fs::path& path) {
+  std::ifstream f(path, std::ios::binary);
+  if (!f) throw InputError(path.string() + ": cannot open file");
+  std::string line;
+  if (!std::getline(f, line) || line.rfind("ply", 0) != 0)
+    Fail(path, line.empty() && f.eof() ? "empty file" : "not a PLY file");
+  PlyData ply;
+  const Header header = ReadHeader(f, path, &ply.comments);
+  const bool ascii = header.format == "ascii";
+  const bool swap = (header.format == "binary_little_endian") != HostIsLittleEndian();
+  if (!ascii && header.format != "binary_little_endian" && header.format != "binary_big_endian")
+    Fail(path, "unknown format '" + header.format + "'");
+
+  BodyReader body(f, path, ascii, swap);
+  for (const HeaderElement& e : header.elements) {
+    if (e.name == "vertex")
+      ReadVertices(e, body, path, &ply);
+    else
+      ReadOtherElement(e, body, path, &ply);
   }
   return ply;
 }

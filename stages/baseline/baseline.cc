@@ -3,16 +3,18 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
-#include <cstring>
+#include <limits>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
 #include "common/atomic_file.h"
+#include "common/cli.h"
 #include "common/errors.h"
 #include "common/json_io.h"
 #include "common/raster.h"
 #include "common/shading.h"
+#include "common/statistics.h"
 
 namespace docunfold::baseline {
 namespace {
@@ -94,9 +96,8 @@ double MapFootprint(const cv::Mat2f& map) {
       if (std::isfinite(fx) && std::isfinite(fy)) sizes.push_back(std::max(fx, fy));
     }
   if (sizes.empty()) return 1;
-  auto it = sizes.begin() + long(0.95 * double(sizes.size() - 1));
-  std::nth_element(sizes.begin(), it, sizes.end());
-  return *it;
+  const size_t rank = size_t(0.95 * double(sizes.size() - 1));
+  return NthSmallest(std::move(sizes), rank);
 }
 
 fs::path MustExist(const fs::path& p, const std::string& why) {
@@ -240,93 +241,134 @@ cv::Rect SeenPageRect(const std::vector<PinholeCamera>& cameras, const PlyData& 
   return cv::Rect(x0, y0, x1 - x0, y1 - y0);
 }
 
+namespace {
+
+// The reference view warped by its four page corners (BaselineOptions).
+BaselineResult Homography(const BaselineInputs& in, const BaselineOptions& options,
+                          const CameraSet& cameras) {
+  const fs::path gt = in.data / "ground_truth";
+  std::error_code ec;
+  const bool has_flat = fs::is_regular_file(gt / "flat.png", ec);
+  const cv::Mat reference =
+      ReadImage(MustExist(in.work / "10_sfm" / "reference.png", "run sfm first"));
+  const Corners labelled = ReadCorners(
+      MustExist(in.work / "20_boundary" / "boundary.json", "run segment-boundary first"));
+  // Turned clockwise k times, the page's new top-left is its old corner k
+  // places back (TL, TR, BR, BL order).
+  const int turns = ((options.quarter_turns % 4) + 4) % 4;
+  Corners corners;
+  for (int i = 0; i < 4; ++i) corners[i] = labelled[(i - turns + 4) % 4];
+  double aspect;
+  const char* aspect_from;
+  if (fs::is_regular_file(gt / "page.json", ec)) {
+    aspect = PageAspect(gt / "page.json");
+    aspect_from = "page.json";
+  } else if (const PinholeCamera* cam = cameras.Find(cameras.reference)) {
+    aspect = AspectFromCorners(corners, cam->K);
+    aspect_from = "corners and K";
+  } else {
+    aspect = AspectFromCorners(corners, Eigen::Matrix3d::Identity());
+    aspect_from = "corners";
+  }
+  // flat.png has the page's aspect: by default compare at exactly its size.
+  cv::Size size;
+  if (options.width > 0) {
+    size = cv::Size(options.width, int(std::lround(options.width / aspect)));
+  } else if (has_flat) {
+    size = FlatSize(gt / "flat.png");
+  } else {
+    const int width =
+        int(std::lround(0.5 * (SideLength(corners, 0, 1) + SideLength(corners, 3, 2))));
+    size = cv::Size(width, int(std::lround(width / aspect)));
+  }
+  size = cv::Size(std::max(1, size.width), std::max(1, size.height));
+  BaselineResult out;
+  out.image = WarpByCorners(reference, corners, size);
+  out.summary = "homography of " + cameras.reference + " by its 4 corners, " +
+                std::to_string(size.width) + "x" + std::to_string(size.height) + ", aspect " +
+                Fixed(aspect, 4) + " (" + aspect_from + "), " + std::to_string(turns) +
+                " quarter turns";
+  return out;
+}
+
+// The photo of the reference view textured through the true surface and
+// camera (BaselineOptions), cropped to what the photos see if asked.
+BaselineResult Oracle(const BaselineInputs& in, const BaselineOptions& options,
+                      const CameraSet& cameras, const fs::path& sfm_cameras) {
+  const fs::path gt = in.data / "ground_truth";
+  std::error_code ec;
+  if (!fs::is_regular_file(gt / "flat.png", ec))
+    throw InputError((gt / "flat.png").string() + ": no such file (the oracle needs ground truth)");
+  const CameraSet truth = ReadCameras(MustExist(gt / "cameras.json", "oracle"));
+  const PinholeCamera* camera = truth.Find(cameras.reference);
+  if (!camera)
+    throw InputError((gt / "cameras.json").string() + ": no view named " + cameras.reference +
+                     " (the reference of " + sfm_cameras.string() + ")");
+  const fs::path photo_path = MustExist(in.data / "images" / cameras.reference, "oracle");
+  const cv::Mat photo = ReadImage(photo_path, cv::IMREAD_COLOR | cv::IMREAD_IGNORE_ORIENTATION);
+  if (photo.cols != camera->width || photo.rows != camera->height)
+    throw InputError(photo_path.string() + ": size " + std::to_string(photo.cols) + "x" +
+                     std::to_string(photo.rows) + " differs from its true camera");
+  const PlyData mesh = ReadPly(MustExist(gt / "mesh.ply", "oracle"));
+  if (!mesh.FindProperty("s") || !mesh.FindProperty("t"))
+    throw InputError((gt / "mesh.ply").string() + ": no per-vertex s, t");
+  cv::Size size = FlatSize(gt / "flat.png");
+  if (options.width > 0)
+    size =
+        cv::Size(options.width,
+                 std::max(1, int(std::lround(double(options.width) * size.height / size.width))));
+  BaselineResult out;
+  out.image = TextureFromTruth(photo, *camera, mesh, size);
+  out.summary = "oracle: " + cameras.reference + " through the true surface and camera, " +
+                std::to_string(size.width) + "x" + std::to_string(size.height);
+  if (options.crop_to_seen) {
+    const cv::Rect seen = SeenPageRect(truth.views, mesh, size);
+    if (seen.empty())
+      throw InputError((gt / "cameras.json").string() + ": no photo sees the true page");
+    out.image = out.image(seen).clone();
+    out.summary += ", cropped to the part the photos see: x " + std::to_string(seen.x) + ".." +
+                   std::to_string(seen.x + seen.width) + ", y " + std::to_string(seen.y) + ".." +
+                   std::to_string(seen.y + seen.height) + " of " + std::to_string(size.width) +
+                   "x" + std::to_string(size.height);
+  }
+  return out;
+}
+
+}  // namespace
+
+void DeclareOptions(OptionTable& table, BaselineOptions* o) {
+  table
+      .Choice("method", &o->method,
+              {{"homography", Method::kHomography}, {"oracle", Method::kOracle}},
+              "the reference method")
+      ->required();
+  table.Value("width", &o->width, 0, std::numeric_limits<int>::max(),
+              "output width in pixels, height from the page aspect (0: the size of flat.png, "
+              "else the page's width in the reference view)");
+  table.Value("quarter-turns", &o->quarter_turns, 0, 3,
+              "homography: turn the page clockwise this many quarter turns first (bench passes "
+              "60_render/render.json's orientation.quarter_turns_clockwise, so it reads the same "
+              "way up as docunfold's result)");
+  table.Switch("crop-to-seen", &o->crop_to_seen,
+               "oracle: keep the smallest rectangle of the page that holds all of it any photo "
+               "sees (ground_truth/cameras.json): the ceiling for a method that cannot know "
+               "where a page cut off in every photo ends; the plain oracle where the page is "
+               "seen whole");
+  table.Choice("shading", &o->remove_shading, {{"keep", false}, {"remove", true}},
+               "remove: divide out the light's shading afterwards, as render --shading remove "
+               "does (the ceiling for such results); keep: as photographed");
+}
+
 BaselineResult Run(const BaselineInputs& in, const BaselineOptions& options) {
+  if (options.crop_to_seen && options.method != Method::kOracle)
+    throw UsageError("--crop-to-seen applies to --method oracle only");
   const fs::path sfm_cameras = MustExist(in.work / "10_sfm" / "cameras.json", "run sfm first");
   const CameraSet cameras = ReadCameras(sfm_cameras);
   if (cameras.reference.empty())
     throw InputError(sfm_cameras.string() + ":/reference: no reference view named");
-  const fs::path gt = in.data / "ground_truth";
-  std::error_code ec;
-  const bool has_flat = fs::is_regular_file(gt / "flat.png", ec);
-  char buf[256];
-  BaselineResult out;
-
-  if (options.method == Method::kHomography) {
-    const cv::Mat reference =
-        ReadImage(MustExist(in.work / "10_sfm" / "reference.png", "run sfm first"));
-    const Corners labelled = ReadCorners(
-        MustExist(in.work / "20_boundary" / "boundary.json", "run segment-boundary first"));
-    // Turned clockwise k times, the page's new top-left is its old corner k
-    // places back (TL, TR, BR, BL order).
-    const int turns = ((options.quarter_turns % 4) + 4) % 4;
-    Corners corners;
-    for (int i = 0; i < 4; ++i) corners[i] = labelled[(i - turns + 4) % 4];
-    double aspect;
-    const char* aspect_from;
-    if (fs::is_regular_file(gt / "page.json", ec)) {
-      aspect = PageAspect(gt / "page.json");
-      aspect_from = "page.json";
-    } else if (const PinholeCamera* cam = cameras.Find(cameras.reference)) {
-      aspect = AspectFromCorners(corners, cam->K);
-      aspect_from = "corners and K";
-    } else {
-      aspect = AspectFromCorners(corners, Eigen::Matrix3d::Identity());
-      aspect_from = "corners";
-    }
-    // flat.png has the page's aspect: by default compare at exactly its size.
-    cv::Size size;
-    if (options.width > 0) {
-      size = cv::Size(options.width, int(std::lround(options.width / aspect)));
-    } else if (has_flat) {
-      size = FlatSize(gt / "flat.png");
-    } else {
-      const int width =
-          int(std::lround(0.5 * (SideLength(corners, 0, 1) + SideLength(corners, 3, 2))));
-      size = cv::Size(width, int(std::lround(width / aspect)));
-    }
-    size = cv::Size(std::max(1, size.width), std::max(1, size.height));
-    out.image = WarpByCorners(reference, corners, size);
-    std::snprintf(buf, sizeof buf,
-                  "homography of %s by its 4 corners, %dx%d, aspect %.4f (%s), %d quarter "
-                  "turns",
-                  cameras.reference.c_str(), size.width, size.height, aspect, aspect_from, turns);
-  } else {
-    if (!has_flat)
-      throw InputError((gt / "flat.png").string() +
-                       ": no such file (the oracle needs ground truth)");
-    const CameraSet truth = ReadCameras(MustExist(gt / "cameras.json", "oracle"));
-    const PinholeCamera* camera = truth.Find(cameras.reference);
-    if (!camera)
-      throw InputError((gt / "cameras.json").string() + ": no view named " + cameras.reference +
-                       " (the reference of " + sfm_cameras.string() + ")");
-    const fs::path photo_path = MustExist(in.data / "images" / cameras.reference, "oracle");
-    const cv::Mat photo = ReadImage(photo_path, cv::IMREAD_COLOR | cv::IMREAD_IGNORE_ORIENTATION);
-    if (photo.cols != camera->width || photo.rows != camera->height)
-      throw InputError(photo_path.string() + ": size " + std::to_string(photo.cols) + "x" +
-                       std::to_string(photo.rows) + " differs from its true camera");
-    const PlyData mesh = ReadPly(MustExist(gt / "mesh.ply", "oracle"));
-    if (!mesh.FindProperty("s") || !mesh.FindProperty("t"))
-      throw InputError((gt / "mesh.ply").string() + ": no per-vertex s, t");
-    cv::Size size = FlatSize(gt / "flat.png");
-    if (options.width > 0)
-      size =
-          cv::Size(options.width,
-                   std::max(1, int(std::lround(double(options.width) * size.height / size.width))));
-    out.image = TextureFromTruth(photo, *camera, mesh, size);
-    std::snprintf(buf, sizeof buf, "oracle: %s through the true surface and camera, %dx%d",
-                  cameras.reference.c_str(), size.width, size.height);
-    if (options.crop_to_seen) {
-      const cv::Rect seen = SeenPageRect(truth.views, mesh, size);
-      if (seen.empty())
-        throw InputError((gt / "cameras.json").string() + ": no photo sees the true page");
-      out.image = out.image(seen).clone();
-      const size_t n = std::strlen(buf);
-      std::snprintf(buf + n, sizeof buf - n,
-                    ", cropped to the part the photos see: x %d..%d, y %d..%d of %dx%d", seen.x,
-                    seen.x + seen.width, seen.y, seen.y + seen.height, size.width, size.height);
-    }
-  }
-  out.summary = buf;
+  BaselineResult out = options.method == Method::kHomography
+                           ? Homography(in, options, cameras)
+                           : Oracle(in, options, cameras, sfm_cameras);
   if (options.remove_shading) {
     out.image = RemoveShading(out.image).image;
     out.summary += ", shading removed";

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "common/camera.h"
+#include "common/option_table.h"
 #include "common/ply.h"
 
 namespace docunfold::baseline {
@@ -62,8 +63,9 @@ struct BaselineOptions {
   // (homography only) the mean length of the page's top and bottom sides in
   // the reference view.
   int width = 0;
-  // Divide out the light's shading afterwards (common/shading.h), as render
-  // --shading remove does: the ceiling for results rendered that way.
+  // --shading remove: divide out the light's shading afterwards
+  // (common/shading.h), as render --shading remove does: the ceiling for
+  // results rendered that way.
   bool remove_shading = false;
   // Oracle: keep only SeenPageRect over all true cameras. Where no photo
   // sees some part of the page (cut-off pages), no method working from the
@@ -77,6 +79,9 @@ struct BaselineOptions {
   // from down only when it can read the text.
   int quarter_turns = 0;
 };
+
+// Declares every option of BaselineOptions (--method is required).
+void DeclareOptions(OptionTable& table, BaselineOptions* options);
 
 struct BaselineInputs {
   fs::path data;  // data set (images/, ground_truth/)

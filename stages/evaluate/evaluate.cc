@@ -210,7 +210,26 @@ bool HasGroundTruth(const fs::path& data) {
   return fs::is_regular_file(data / "ground_truth" / "flat.png", ec);
 }
 
-EvaluateResult Run(const EvaluateInputs& in, const EvaluateOptions& options) {
+void DeclareOptions(OptionTable& table, EvaluateOptions* o) {
+  table.Switch("front-end", &o->front_end,
+               "measure 20_boundary/ and 30_features/ of --work against the ground truth "
+               "instead of a rectified image");
+  table.Value("method", &o->method, "label of this result (row name)");
+  table.Switch("ocr", &o->ocr, "CER, ED and WER (Tesseract)");
+  table.Switch("flow", &o->flow, "LD and Li-D (DeepFlow)");
+  table.Switch("geometry", &o->geometry, "surface distance and isometry error");
+  table.Switch("ocr-cache", &o->ocr_cache,
+               "cache the OCR text of flat.png in <work>/70_eval/ocr-cache/ (off: always OCR "
+               "it)");
+  table.Switch("ocr-at-truth-size", &o->ocr_at_truth_size,
+               "OCR the result resized to flat.png's size (bicubic up, area down), so that CER "
+               "does not depend on the output resolution (off: OCR the result as it is, as the "
+               "literature does)");
+  table.Value("lang", &o->ocr_language, "Tesseract language");
+}
+
+EvaluateResult Run(const EvaluateInputs& in, const EvaluateOptions& options,
+                   const Json& options_record) {
   const auto start = Clock::now();
   const fs::path flat_path = in.data / "ground_truth" / "flat.png";
   const cv::Mat flat = ReadImage(flat_path);
@@ -271,15 +290,7 @@ EvaluateResult Run(const EvaluateInputs& in, const EvaluateOptions& options) {
   }
   seconds["total"] = SecondsSince(start);
 
-  Json opts{{"method", options.method},
-            {"ocr", options.ocr},
-            {"flow", options.flow},
-            {"geometry", options.geometry},
-            {"mesh_dir", options.mesh_dir.string()},
-            {"ocr_cache", options.ocr_cache},
-            {"ocr_language", options.ocr_language},
-            {"ocr_at_truth_size", options.ocr_at_truth_size}};
-  Json doc = MakeHeader("docunfold.metrics", 1, "evaluate", opts);
+  Json doc = MakeHeader("docunfold.metrics", 1, "evaluate", options_record);
   doc["method"] = options.method;
   doc["data_set"] = fs::absolute(in.data).lexically_normal().string();
   doc["result"] = in.result.string();
@@ -305,6 +316,17 @@ EvaluateResult Run(const EvaluateInputs& in, const EvaluateOptions& options) {
   doc["seconds"] = seconds;
   out.document = std::move(doc);
   return out;
+}
+
+std::string Summary(const EvaluateResult& r, const std::string& method) {
+  const Metrics& m = r.metrics;
+  auto figure = [](const char* name, double v, int decimals) {
+    return std::isfinite(v) ? std::string(", ") + name + " " + Fixed(v, decimals) : std::string();
+  };
+  return method + ": MS-SSIM " + Fixed(m.ms_ssim, 4) + figure("LD", m.ld, 2) +
+         figure("Li-D", m.li_d, 2) + figure("CER", m.cer, 4) + figure("WER", m.wer, 4) +
+         figure("surface mean %", m.surface_mean_pct, 3) + figure("isometry", m.isometry_mean, 4) +
+         " (" + Fixed(r.document["seconds"]["total"].get<double>(), 1) + " s)";
 }
 
 }  // namespace docunfold::evaluate

@@ -1,7 +1,7 @@
 // evaluate: compares a rectified image with the data set's flat scan
 // (ground_truth/flat.png) by the metrics of the document-dewarping
-// literature (DESIGN.md §7), and, when the work directory has meshes and the
-// data set a true surface, measures the geometry too.
+// literature (MS-SSIM, LD and Li-D, CER/ED/WER), and, when the work directory
+// has meshes and the data set a true surface, measures the geometry too.
 #pragma once
 
 #include <cmath>
@@ -10,12 +10,16 @@
 #include <string>
 
 #include "common/json_io.h"
+#include "common/option_table.h"
 
 namespace docunfold::evaluate {
 
 namespace fs = std::filesystem;
 
 struct EvaluateOptions {
+  // Judge the front end (20_boundary/, 30_features/ of the work directory,
+  // front_end.h) instead of a rectified image.
+  bool front_end = false;
   std::string method = "docunfold";  // label of the row in the benchmark
   bool ocr = true;                   // CER, ED, WER with Tesseract (the slowest part, ~seconds)
   bool flow = true;                  // LD, Li-D with DeepFlow (~seconds)
@@ -33,6 +37,10 @@ struct EvaluateOptions {
   // default: the literature OCRs results as they are.
   bool ocr_at_truth_size = false;
 };
+
+// Declares every option of EvaluateOptions but mesh_dir (a path, declared
+// with the other paths by main).
+void DeclareOptions(OptionTable& table, EvaluateOptions* options);
 
 struct EvaluateInputs {
   fs::path data;    // data set folder (with ground_truth/flat.png)
@@ -59,9 +67,15 @@ struct EvaluateResult {
   Json document;  // the whole docunfold.metrics file, header included
 };
 
-// Computes every metric the options and inputs allow. Throws InputError for
-// a missing or unreadable input (result, flat.png, meshes named by the
-// options, malformed ground truth).
-EvaluateResult Run(const EvaluateInputs& inputs, const EvaluateOptions& options);
+// Computes every metric the options and inputs allow; the document's
+// producer records `options_record`. Throws InputError for a missing or
+// unreadable input (result, flat.png, meshes named by the options, malformed
+// ground truth).
+EvaluateResult Run(const EvaluateInputs& inputs, const EvaluateOptions& options,
+                   const Json& options_record);
+
+// One line for the log: the method and its figures (those computed) and the
+// time taken.
+std::string Summary(const EvaluateResult& result, const std::string& method);
 
 }  // namespace docunfold::evaluate

@@ -5,16 +5,11 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "common/statistics.h"
 #include "stages/evaluate/ground_truth.h"
 
 namespace docunfold::evaluate {
 namespace {
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::nth_element(v.begin(), v.begin() + long(v.size() / 2), v.end());
-  return v[v.size() / 2];
-}
 
 // Rules along x (or, transposed, along y): runs of ink at least `min_length`
 // long and at most `max_width` thick.

@@ -9,6 +9,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "common/cli.h"
 #include "common/errors.h"
 
 namespace docunfold::evaluate {
@@ -283,7 +284,7 @@ Json ToJson(const LineFigures& f) {
           {"edge_segments", f.edge_segments}};
 }
 
-FrontEndResult RunFrontEnd(const FrontEndInputs& in) {
+FrontEndResult RunFrontEnd(const FrontEndInputs& in, const Json& options_record) {
   const auto start = std::chrono::steady_clock::now();
   const fs::path cameras_file = in.work / "10_sfm" / "cameras.json";
   const Json cameras_doc = ReadJsonFile(cameras_file);
@@ -320,7 +321,7 @@ FrontEndResult RunFrontEnd(const FrontEndInputs& in) {
   FrontEndResult result;
   result.reference = cameras.reference;
   result.recall_required = LineRecallRequired(gt);
-  Json doc = MakeHeader("docunfold.front-end-metrics", 1, "evaluate");
+  Json doc = MakeHeader("docunfold.front-end-metrics", 1, "evaluate", options_record);
   doc["data"] = fs::absolute(in.data).lexically_normal().string();
   doc["reference"] = cameras.reference;
   doc["reference_undistorted"] = lens.Any();
@@ -357,6 +358,18 @@ FrontEndResult RunFrontEnd(const FrontEndInputs& in) {
   doc["seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   result.document = std::move(doc);
   return result;
+}
+
+std::string Summary(const FrontEndResult& r) {
+  std::string summary = "front end in " + r.reference + ":";
+  if (r.has_boundary)
+    summary += " boundary IoU " + Fixed(r.boundary.iou, 4) + ", worst corner " +
+               Fixed(100 * r.boundary.WorstCornerFraction(), 2) + " % of the diagonal, " +
+               std::to_string(r.boundary.sides_not_real) + " side(s) not real;";
+  if (r.has_lines)
+    summary += " features precision " + Fixed(r.lines.precision, 3) + ", recall " +
+               Fixed(r.lines.recall, 3);
+  return summary;
 }
 
 }  // namespace docunfold::evaluate

@@ -22,7 +22,8 @@
 
 namespace docunfold::evaluate {
 
-// Issue 3's figures: what the front end must reach in the reference view.
+// What the front end must reach in the reference view (the thresholds the
+// accuracy tests assert and front_end.json's `holds` reports).
 inline constexpr double kMinBoundaryIou = 0.97;
 inline constexpr double kCornerTolerance = 0.01;  // of the projected page diagonal
 inline constexpr double kLineTolerancePx = 2.0;   // a segment point this close is on a line
@@ -128,7 +129,11 @@ struct FrontEndResult {
   Json document;                 // docunfold.front-end-metrics
 };
 // Measures whatever of 20_boundary/ and 30_features/ the work directory
-// holds. Throws InputError for a missing or malformed input (naming it).
-FrontEndResult RunFrontEnd(const FrontEndInputs& inputs);
+// holds; the document's producer records `options_record`. Throws
+// InputError for a missing or malformed input (naming it).
+FrontEndResult RunFrontEnd(const FrontEndInputs& inputs, const Json& options_record);
+
+// One line for the log: the reference view and the figures measured.
+std::string Summary(const FrontEndResult& result);
 
 }  // namespace docunfold::evaluate

@@ -3,7 +3,7 @@
 #include <Eigen/Geometry>
 #include <Eigen/SVD>
 #include <algorithm>
-#include <nanoflann.hpp>
+#include <limits>
 #include <set>
 #include <utility>
 
@@ -76,50 +76,24 @@ double PointTriangleDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
   return (p - (a + ab * v + ac * w)).norm();
 }
 
-// nanoflann adaptor over the vertex array.
-struct SurfaceDistance::Index {
-  struct Cloud {
-    const std::vector<Eigen::Vector3d>* points;
-    size_t kdtree_get_point_count() const { return points->size(); }
-    double kdtree_get_pt(size_t i, size_t dim) const { return (*points)[i][dim]; }
-    template <class Box>
-    bool kdtree_get_bbox(Box&) const {
-      return false;
-    }
-  };
-  using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, Cloud>,
-                                                   Cloud, 3, size_t>;
-  Cloud cloud;
-  Tree tree;
-  explicit Index(const std::vector<Eigen::Vector3d>* points)
-      : cloud{points}, tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16)) {
-    tree.buildIndex();
-  }
-};
-
 SurfaceDistance::SurfaceDistance(std::vector<Eigen::Vector3d> vertices,
                                  std::vector<std::array<int, 3>> triangles)
-    : vertices_(std::move(vertices)),
+    : vertices_(std::move(vertices), 16),
       triangles_(std::move(triangles)),
       triangles_of_vertex_(vertices_.size()) {
   for (size_t f = 0; f < triangles_.size(); ++f)
     for (int v : triangles_[f]) triangles_of_vertex_.at(v).push_back(int(f));
-  index_ = std::make_unique<Index>(&vertices_);
 }
 
-SurfaceDistance::~SurfaceDistance() = default;
-
 double SurfaceDistance::operator()(const Eigen::Vector3d& point) const {
-  constexpr size_t kNeighbours = 12;
-  std::array<size_t, kNeighbours> ids{};
-  std::array<double, kNeighbours> sq{};
-  const size_t found = index_->tree.knnSearch(point.data(), kNeighbours, ids.data(), sq.data());
-  double best = found > 0 ? std::sqrt(sq[0]) : std::numeric_limits<double>::infinity();
-  for (size_t k = 0; k < found; ++k) {
-    for (int f : triangles_of_vertex_[ids[k]]) {
+  constexpr int kNeighbours = 12;
+  const std::vector<Eigen::Vector3d>& v = vertices_.points();
+  const std::vector<PointIndex3d::Neighbour> near = vertices_.Nearest(point, kNeighbours);
+  double best = !near.empty() ? std::sqrt(near[0].second) : std::numeric_limits<double>::infinity();
+  for (const PointIndex3d::Neighbour& n : near) {
+    for (int f : triangles_of_vertex_[n.first]) {
       const auto& t = triangles_[f];
-      best = std::min(
-          best, PointTriangleDistance(point, vertices_[t[0]], vertices_[t[1]], vertices_[t[2]]));
+      best = std::min(best, PointTriangleDistance(point, v[t[0]], v[t[1]], v[t[2]]));
     }
   }
   return best;

@@ -5,13 +5,13 @@
 
 #include <Eigen/Core>
 #include <array>
-#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "common/camera.h"
 #include "common/ply.h"
+#include "common/point_index.h"
 
 namespace docunfold::evaluate {
 
@@ -42,15 +42,12 @@ std::optional<CameraAlignment> AlignCameras(const CameraSet& sfm, const CameraSe
 class SurfaceDistance {
  public:
   SurfaceDistance(std::vector<Eigen::Vector3d> vertices, std::vector<std::array<int, 3>> triangles);
-  ~SurfaceDistance();
   double operator()(const Eigen::Vector3d& point) const;
 
  private:
-  struct Index;
-  std::vector<Eigen::Vector3d> vertices_;
+  PointIndex3d vertices_;  // the mesh's vertices (leaf size 16)
   std::vector<std::array<int, 3>> triangles_;
   std::vector<std::vector<int>> triangles_of_vertex_;
-  std::unique_ptr<Index> index_;
 };
 
 // Distance from a point to a triangle (Ericson, Real-Time Collision Detection).

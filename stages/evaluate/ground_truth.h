@@ -1,4 +1,5 @@
-// Ground truth of a data set (DESIGN §3) and what is derived from it to judge
+// Ground truth of a data set (ground_truth/: flat.png, page.json, mesh.ply,
+// cameras.json, features.json) and what is derived from it to judge
 // the pipeline: the true page region, corners, outline and straight lines as
 // a camera sees them. evaluate's front-end figures and the accuracy tests of
 // every stage share these.
@@ -103,8 +104,9 @@ std::vector<TrueLine> LinesFromFlatScan(const GroundTruth& gt);
 std::vector<TrueLine> TruthLines(const GroundTruth& gt);
 
 // Whether the page is a text page or a table, on which a detector must
-// cover half the lines (issue 3); receipts and posters (short lines, few of
-// them) are only measured. From synth.json's kind, else from the lines.
+// cover half the lines (kMinLineRecall, front_end.h); receipts and posters
+// (short lines, few of them) are only measured. From synth.json's kind, else
+// from the lines.
 bool LineRecallRequired(const GroundTruth& gt);
 
 }  // namespace docunfold::evaluate

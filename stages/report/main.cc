@@ -5,17 +5,17 @@
 
 int main(int argc, char** argv) {
   using namespace docunfold;
-  report::ReportOptions o;
   CLI::App app{
       "report: one HTML page with every stage's output for a data set (photos, reference "
       "view, boundary, feature segments, point cloud and meshes, convergence, the rectified "
       "page, metrics, stage times and flags). Self-contained: opens from disk, offline."};
-  app.add_option("--data", o.data, "data-set folder (images/, optional ground_truth/)")->required();
-  app.add_option("--work", o.work, "its work directory")->required();
-  app.add_option("--out", o.out, "HTML file to write (default <work>/report.html)");
-  app.add_option("--thumbnail-width", o.thumbnail_width, "photo thumbnails, pixels")
-      ->capture_default_str();
-  return RunStage("report", app, argc, argv, [&] {
+  OptionTable table(app);
+  report::ReportOptions o;
+  table.Path("data", &o.data, "data-set folder (images/, optional ground_truth/)")->required();
+  table.Path("work", &o.work, "its work directory")->required();
+  table.Path("out", &o.out, "HTML file to write (default <work>/report.html)");
+  report::DeclareOptions(table, &o);
+  return RunStage("report", table, argc, argv, [&] {
     if (o.out.empty()) o.out = o.work / "report.html";
     report::ReportResult r = report::Run(o);
     WriteTextAtomic(o.out, r.html);

@@ -22,7 +22,9 @@
 namespace docunfold::report {
 namespace {
 
-std::string Fmt(double v, const char* format = "%.3f") {
+// `v` by a printf format other than fixed-point ("%.3g", "%+.0f", ...);
+// fixed-point numbers go through Fixed (common/cli.h).
+std::string Fmt(double v, const char* format) {
   char buf[64];
   std::snprintf(buf, sizeof buf, format, v);
   return buf;
@@ -293,7 +295,7 @@ void ConvergenceSection(const ReportOptions& o, Page* page) {
              std::to_string(round["grid"][1].get<int>());
     table += "<tr><td class=l>" + std::to_string(r) + "</td><td>" + grid + "</td><td>" +
              std::to_string(round.value("iterations", Json::array()).size()) + "</td><td>" +
-             Fmt(last_f, "%.3e") + "</td><td>" + Fmt(last_t, "%.2f") + "</td><td class=l>" +
+             Fmt(last_f, "%.3e") + "</td><td>" + Fixed(last_t, 2) + "</td><td class=l>" +
              Escape(round.value("stop_reason", "")) + "</td></tr>";
   }
   table += "</table>";
@@ -308,21 +310,41 @@ void ConvergenceSection(const ReportOptions& o, Page* page) {
 
 std::string MetricsRow(const Json& m) {
   const Json& v = m.at("metrics");
-  auto cell = [&](const char* key, const char* format) {
+  auto cell = [&](const char* key, int decimals) {
     return "<td>" +
-           (v.contains(key) && v[key].is_number() ? Fmt(v[key].get<double>(), format)
+           (v.contains(key) && v[key].is_number() ? Fixed(v[key].get<double>(), decimals)
                                                   : std::string("–")) +
            "</td>";
   };
-  return "<tr><td class=l>" + Escape(m.value("method", "?")) + "</td>" + cell("ms_ssim", "%.4f") +
-         cell("ld", "%.2f") + cell("li_d", "%.2f") + cell("cer", "%.3f") + cell("wer", "%.3f") +
-         cell("surface_mean_pct", "%.2f") + cell("isometry_mean", "%.4f") + "</tr>";
+  return "<tr><td class=l>" + Escape(m.value("method", "?")) + "</td>" + cell("ms_ssim", 4) +
+         cell("ld", 2) + cell("li_d", 2) + cell("cer", 3) + cell("wer", 3) +
+         cell("surface_mean_pct", 2) + cell("isometry_mean", 4) + "</tr>";
+}
+
+// What ✗ means after a figure of FrontEndParagraph, with the thresholds
+// front_end.json holds.
+std::string FrontEndLegend(const Json& thresholds) {
+  auto value = [&](const char* key, double scale = 1) {
+    return thresholds.contains(key) && thresholds[key].is_number()
+               ? Fmt(scale * thresholds[key].get<double>(), "%g")
+               : std::string("?");
+  };
+  return "✗ = short of its threshold (evaluate --front-end): boundary IoU with the true page "
+         "region at least " +
+         value("boundary_iou") + "; every visible true corner within " +
+         value("corner_fraction_of_diagonal", 100) +
+         " % of the page diagonal of a detected corner; a side flagged cut when the page is "
+         "cut off in the photo, none when it is seen whole; feature precision: at least " +
+         value("line_precision", 100) + " % of the segments' length within " +
+         value("line_tolerance_px") +
+         " px of a true line; recall (on text pages and tables): segments along at least " +
+         value("line_recall", 100) + " % of the true lines' length.";
 }
 
 // evaluate --front-end's figures in one sentence, misses marked.
 std::string FrontEndParagraph(const Json& f) {
-  auto number = [](const Json& o, const char* key, const char* format, double scale = 1) {
-    return o.contains(key) && o[key].is_number() ? Fmt(scale * o[key].get<double>(), format)
+  auto number = [](const Json& o, const char* key, int decimals, double scale = 1) {
+    return o.contains(key) && o[key].is_number() ? Fixed(scale * o[key].get<double>(), decimals)
                                                  : std::string("–");
   };
   auto miss = [](const Json& o, const char* key) {
@@ -332,17 +354,17 @@ std::string FrontEndParagraph(const Json& f) {
       "<p>Front end against the ground truth in " + Escape(f.value("reference", "?")) + ": ";
   const Json& b = f.value("boundary", Json::object());
   if (b.contains("iou"))
-    p += "boundary IoU " + number(b, "iou", "%.4f") + miss(b, "iou") + ", worst visible corner " +
-         number(b, "worst_corner_fraction", "%.2f", 100) + " % of the page diagonal" +
+    p += "boundary IoU " + number(b, "iou", 4) + miss(b, "iou") + ", worst visible corner " +
+         number(b, "worst_corner_fraction", 2, 100) + " % of the page diagonal" +
          miss(b, "corners") + ", " + std::to_string(b.value("sides_not_real", 0)) +
          " side(s) flagged cut" + (b.value("page_cut", false) ? " (the page is cut)" : "") +
          miss(b, "cut_flags") + "; ";
   const Json& l = f.value("features", Json::object());
   if (l.contains("precision"))
-    p += "feature segments: precision " + number(l, "precision", "%.3f") + miss(l, "precision") +
-         ", recall " + number(l, "recall", "%.3f") + miss(l, "recall") +
+    p += "feature segments: precision " + number(l, "precision", 3) + miss(l, "precision") +
+         ", recall " + number(l, "recall", 3) + miss(l, "recall") +
          (l.value("recall_required", false) ? "" : " (not required on this kind of page)");
-  return p + ". ✗ = short of issue 3's threshold (evaluate --front-end).</p>";
+  return p + ". " + FrontEndLegend(f.value("thresholds", Json::object())) + "</p>";
 }
 
 // The final feature lines of 50_optimize/lines.json (polylines in M') drawn
@@ -492,15 +514,15 @@ void StagesSection(const ReportOptions& o, Page* page) {
     auto it = timings.find(stage);
     std::string secs = "–", mem = "–";
     if (it != timings.end()) {
-      secs = Fmt(it->second.value("seconds", 0.0), "%.1f");
-      mem = Fmt(it->second.value("max_rss_mb", 0.0), "%.0f");
+      secs = Fixed(it->second.value("seconds", 0.0), 1);
+      mem = Fixed(it->second.value("max_rss_mb", 0.0), 0);
       total += it->second.value("seconds", 0.0);
     }
     t += "<tr><td class=l>" + stage + "</td><td>" + secs + "</td><td>" + mem +
          "</td><td class=l><code>" + Escape(flags.empty() ? "(defaults)" : flags) +
          "</code></td></tr>";
   }
-  t += "<tr><th class=l>total</th><th>" + Fmt(total, "%.1f") + "</th><th></th><th></th></tr>";
+  t += "<tr><th class=l>total</th><th>" + Fixed(total, 1) + "</th><th></th><th></th></tr>";
   page->Add(t +
             "</table><p>Times are those of each stage's last run (work/&lt;name&gt;/"
             "timings.jsonl). To rerun a stage with other flags: <code>make -f pipeline.mk "
@@ -509,6 +531,10 @@ void StagesSection(const ReportOptions& o, Page* page) {
 }
 
 }  // namespace
+
+void DeclareOptions(OptionTable& table, ReportOptions* o) {
+  table.Value("thumbnail-width", &o->thumbnail_width, "photo thumbnails (pixels)");
+}
 
 ReportResult Run(const ReportOptions& o) {
   const DataSet data = OpenDataSet(o.data);

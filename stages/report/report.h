@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <string>
 
+#include "common/option_table.h"
+
 namespace docunfold::report {
 
 namespace fs = std::filesystem;
@@ -17,6 +19,9 @@ struct ReportOptions {
   int thumbnail_width = 220;  // pixels
   int figure_width = 900;     // pixels, large pictures
 };
+
+// Declares the options of ReportOptions but the paths (data, work, out).
+void DeclareOptions(OptionTable& table, ReportOptions* options);
 
 struct ReportResult {
   std::string html;

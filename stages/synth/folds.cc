@@ -156,7 +156,8 @@ std::vector<Fold> RandomFolds(double W, double H, const FoldOptions& options, st
           (uni(*rng) < 0.5 ? -1 : 1) * (is_curl ? range(0.45, 0.7) : range(0.1, 0.6)) * extent;
       f.point = centre + n * offset;
       f.width = is_curl ? range(options.curl_width_min, options.curl_width_max)
-                        : range(options.crease_width_min, options.crease_width_max);
+                        : range(options.crease_width_min,
+                                std::max(options.crease_width_min, options.crease_width_max));
       const double deg = is_curl ? range(options.curl_angle_min, options.curl_angle_max)
                                  : range(options.crease_angle_min, options.crease_angle_max);
       f.angle = deg * kPi / 180 * (uni(*rng) < 0.5 ? -1 : 1);

@@ -1,5 +1,6 @@
 // An exact isometry of a flat sheet: non-crossing fold lines, each a
-// cylindrical bend of width w by an angle a (DESIGN §8). A narrow bend is a
+// cylindrical bend of width w by an angle a (the strip of width w is bent
+// into a circular arc, the panels either side stay flat). A narrow bend is a
 // crease, a wide one a curl.
 #pragma once
 
@@ -42,12 +43,13 @@ class FoldedSheet {
 };
 
 struct FoldOptions {
-  int creases = 1;                                            // number of narrow folds
-  double crease_width_min = 0.003, crease_width_max = 0.008;  // metres
-  double crease_angle_min = 30, crease_angle_max = 120;       // degrees
-  bool curl = false;                                          // one extra wide bend
-  double curl_width_min = 0.04, curl_width_max = 0.09;        // metres
-  double curl_angle_min = 30, curl_angle_max = 70;            // degrees
+  int creases = 1;  // number of narrow folds
+  // Metres; a crease_width_max below crease_width_min counts as that.
+  double crease_width_min = 0.003, crease_width_max = 0.008;
+  double crease_angle_min = 30, crease_angle_max = 120;  // degrees
+  bool curl = false;                                     // one extra wide bend
+  double curl_width_min = 0.04, curl_width_max = 0.09;   // metres
+  double curl_angle_min = 30, curl_angle_max = 70;       // degrees
   double max_total_angle = 125;  // |sum of signed angles| on any path, degrees
 };
 

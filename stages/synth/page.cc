@@ -9,8 +9,6 @@
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 
-#include "common/errors.h"
-
 namespace docunfold::synth {
 namespace {
 
@@ -395,14 +393,6 @@ void DrawPoster(Typesetter& ts, Page& page, std::mt19937* rng) {
 }
 
 }  // namespace
-
-PageKind ParsePageKind(const std::string& name) {
-  if (name == "text") return PageKind::kText;
-  if (name == "table") return PageKind::kTable;
-  if (name == "receipt") return PageKind::kReceipt;
-  if (name == "poster") return PageKind::kPoster;
-  throw UsageError("unknown page kind '" + name + "' (text, table, receipt, poster)");
-}
 
 std::string PageKindName(PageKind kind) {
   switch (kind) {

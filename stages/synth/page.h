@@ -12,7 +12,6 @@ namespace docunfold::synth {
 
 enum class PageKind { kText, kTable, kReceipt, kPoster };
 
-PageKind ParsePageKind(const std::string& name);  // throws UsageError
 std::string PageKindName(PageKind kind);
 
 struct PageLine {

@@ -4,8 +4,6 @@
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 
-#include "common/errors.h"
-
 namespace docunfold::synth {
 namespace {
 
@@ -83,14 +81,6 @@ Extent Measure(const PageSurface& page, const PinholeCamera& cam) {
 }
 
 }  // namespace
-
-Background ParseBackground(const std::string& name) {
-  if (name == "plain") return Background::kPlain;
-  if (name == "wood") return Background::kWood;
-  if (name == "cloth") return Background::kCloth;
-  if (name == "granite") return Background::kGranite;
-  throw UsageError("unknown background '" + name + "' (plain, wood, cloth, granite)");
-}
 
 std::string BackgroundName(Background b) {
   switch (b) {
@@ -308,6 +298,8 @@ cv::Mat RenderView(const PageSurface& page, const cv::Mat& page_texture, const T
   cv::remap(table.image, albedo_table, table_ch[0], table_ch[1], cv::INTER_LINEAR,
             cv::BORDER_REFLECT);
   const cv::Vec3b paper_back = page_texture.at<cv::Vec3b>(2, 2);
+  // K^-1 once per view (the same numbers as camera.CamRay, which inverts K
+  // at every pixel: measurably slower over a supersampled photo).
   const Eigen::Matrix3d K_inv = camera.K.inverse();
 
   cv::Mat3f out(H, W);

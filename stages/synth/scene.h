@@ -25,7 +25,6 @@ struct PageSurface {
 };
 
 enum class Background { kPlain, kWood, kCloth, kGranite };
-Background ParseBackground(const std::string& name);  // throws UsageError
 std::string BackgroundName(Background b);
 
 struct CameraOptions {

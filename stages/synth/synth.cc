@@ -4,8 +4,11 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <limits>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <utility>
 
 #include "common/atomic_file.h"
 #include "common/cli.h"
@@ -62,32 +65,200 @@ Json PointsJson(const std::vector<Eigen::Vector2d>& points) {
   return a;
 }
 
-}  // namespace
-
-Json OptionsToJson(const SynthOptions& o) {
-  return {{"seed", o.seed},
-          {"kind", PageKindName(o.kind)},
-          {"page_width_m", o.page_width_m},
-          {"page_height_m", o.page_height_m},
-          {"creases", o.folds.creases},
-          {"crease_width_mm", {o.folds.crease_width_min * 1000, o.folds.crease_width_max * 1000}},
-          {"crease_angle_deg", {o.folds.crease_angle_min, o.folds.crease_angle_max}},
-          {"curl", o.folds.curl},
-          {"views", o.cameras.views},
-          {"width", o.cameras.width},
-          {"height", o.cameras.height},
-          {"hfov_deg", {o.cameras.hfov_min_deg, o.cameras.hfov_max_deg}},
-          {"elevation_deg", {o.cameras.elevation_min_deg, o.cameras.elevation_max_deg}},
-          {"cut_off", o.cameras.cut_off},
-          {"background", BackgroundName(o.render.background)},
-          {"noise_sigma", o.render.noise_sigma},
-          {"jpeg_quality", o.render.jpeg_quality},
-          {"flat_dpi", o.flat_dpi},
-          {"texture_dpi", o.texture_dpi},
-          {"mesh_spacing_mm", o.mesh_spacing_m * 1000}};
+// A length given in millimetres, kept in metres.
+std::string ParseMillimetres(const std::string& text, double* metres) {
+  double mm = 0;
+  if (!CLI::detail::lexical_cast(text, mm))
+    return "expected a length in millimetres, got '" + text + "'";
+  *metres = mm / 1000;
+  return "";
 }
 
-SynthResult Run(const SynthOptions& o) {
+std::string FormatMillimetres(const double& metres) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", metres * 1000);
+  return buf;
+}
+
+// WxH in millimetres, kept in metres.
+std::string ParsePageSize(const std::string& text, cv::Size2d* size_m) {
+  double w = 0, h = 0;
+  if (std::sscanf(text.c_str(), "%lfx%lf", &w, &h) != 2 || w <= 0 || h <= 0)
+    return "expected WxH in millimetres, e.g. 210x297";
+  size_m->width = w / 1000;
+  size_m->height = h / 1000;
+  return "";
+}
+
+std::string FormatPageSize(const cv::Size2d& size_m) {
+  if (size_m.width <= 0 || size_m.height <= 0) return "";
+  return FormatMillimetres(size_m.width) + "x" + FormatMillimetres(size_m.height);
+}
+
+// What the photos show: the printed page, folded, on the table, and the
+// cameras and light. Made in this order from one generator.
+struct Scene {
+  cv::Size2d size;  // of the page, metres
+  Page page;
+  std::vector<Fold> folds;
+  PageSurface surface;
+  std::vector<PinholeCamera> cameras;
+  Lighting light;
+  Table table;
+};
+
+Scene MakeScene(const SynthOptions& o, std::mt19937* rng) {
+  Scene scene;
+  cv::Size2d& size = scene.size;
+  size = DefaultPageSize(o.kind);
+  if (o.page_size_m.width > 0) size.width = o.page_size_m.width;
+  if (o.page_size_m.height > 0) size.height = o.page_size_m.height;
+
+  Log("printing a " + PageKindName(o.kind) + " page");
+  scene.page = MakePage(o.kind, size, o.texture_dpi, rng);
+  scene.folds = RandomFolds(size.width, size.height, o.folds, rng);
+  if (scene.folds.empty() && (o.folds.creases > 0 || o.folds.curl))
+    throw UsageError("cannot place " + std::to_string(o.folds.creases) +
+                     " non-crossing folds on this page; ask for fewer");
+  FoldedSheet sheet(size.width, size.height, scene.folds);
+  scene.surface = PlaceOnTable(sheet, o.mesh_spacing_m, rng);
+  scene.cameras = MakeCameras(scene.surface, o.cameras, rng);
+  scene.light = RandomLighting(rng);
+  scene.table = MakeTable(o.render.background, rng);
+  return scene;
+}
+
+// images/view_NN.jpg: every camera's photo, with sensor effects.
+void WritePhotos(const Scene& scene, const RenderOptions& render, const fs::path& dir,
+                 std::mt19937* rng) {
+  Progress progress("rendering views", long(scene.cameras.size()));
+  for (size_t i = 0; i < scene.cameras.size(); ++i) {
+    cv::Mat photo =
+        RenderView(scene.surface, scene.page.image, scene.table, scene.light, scene.cameras[i]);
+    AddSensorEffects(&photo, render, rng);
+    WriteImageAtomic(dir / "images" / scene.cameras[i].image, photo,
+                     {cv::IMWRITE_JPEG_QUALITY, render.jpeg_quality});
+    progress.Update(long(i + 1));
+  }
+  progress.Done();
+}
+
+// ground_truth/mesh.ply: the true surface with each vertex's s, t.
+void WriteTrueMesh(const PageSurface& surface, uint32_t seed, const fs::path& path) {
+  PlyData mesh;
+  mesh.comments = {"true page surface, world frame, metres",
+                   "s,t = column and row of flat.png as fractions, (0,0) top left",
+                   "made by docunfold synth seed " + std::to_string(seed)};
+  mesh.vertices = surface.vertices;
+  std::vector<double> s, t;
+  for (const auto& st : surface.st) {
+    s.push_back(st.x());
+    t.push_back(st.y());
+  }
+  mesh.SetProperty("s", s);
+  mesh.SetProperty("t", t);
+  mesh.faces = surface.quads;
+  mesh.SetGridSize(surface.nx, surface.ny);
+  WritePly(path, mesh);
+}
+
+// ground_truth/: flat.png, text.txt, page.json, cameras.json, mesh.ply,
+// features.json and synth.json.
+void WriteGroundTruth(const Scene& scene, const SynthOptions& o, const Json& options_record,
+                      const fs::path& dir) {
+  const cv::Size2d& size = scene.size;
+  const double flat_ppm = o.flat_dpi / 0.0254;
+  const cv::Size flat_size(int(std::lround(size.width * flat_ppm)),
+                           int(std::lround(size.height * flat_ppm)));
+  cv::Mat flat;
+  cv::resize(scene.page.image, flat, flat_size, 0, 0, cv::INTER_AREA);
+  WriteImageAtomic(dir / "flat.png", flat, {cv::IMWRITE_PNG_COMPRESSION, 9});
+
+  std::string text;
+  for (const std::string& line : scene.page.text) text += line + "\n";
+  WriteTextAtomic(dir / "text.txt", text);
+
+  Json page_json = MakeHeader("docunfold.gt-page", 1, "synth");
+  page_json["width_m"] = size.width;
+  page_json["height_m"] = size.height;
+  WriteJsonAtomic(dir / "page.json", page_json);
+
+  Json cams = MakeHeader("docunfold.gt-cameras", 1, "synth");
+  cams["convention"] =
+      "x_cam = R x_world + t; OpenCV axes (x right, y down, z forward); pixel centres at "
+      "integer coordinates; metres";
+  cams["views"] = Json::array();
+  for (const PinholeCamera& c : scene.cameras) cams["views"].push_back(CameraToJson(c));
+  WriteJsonAtomic(dir / "cameras.json", cams);
+
+  WriteTrueMesh(scene.surface, o.seed, dir / "mesh.ply");
+
+  // True lines in flat.png pixels (centres at integer coordinates).
+  Json features = MakeHeader("docunfold.gt-features", 1, "synth");
+  features["width"] = flat_size.width;
+  features["height"] = flat_size.height;
+  features["lines"] = Json::array();
+  for (const PageLine& l : scene.page.lines) {
+    std::vector<Eigen::Vector2d> px;
+    for (const Eigen::Vector2d& p : l.points)
+      px.emplace_back(p.x() / size.width * flat_size.width - 0.5,
+                      p.y() / size.height * flat_size.height - 0.5);
+    features["lines"].push_back({{"kind", l.kind}, {"points", PointsJson(px)}});
+  }
+  WriteJsonAtomic(dir / "features.json", features);
+
+  Json options = MakeHeader("docunfold.synth-options", 1, "synth", options_record);
+  options["folds"] = Json::array();
+  for (const Fold& f : scene.folds)
+    options["folds"].push_back({{"point_m", {f.point.x(), f.point.y()}},
+                                {"direction", {f.direction.x(), f.direction.y()}},
+                                {"width_mm", f.width * 1000},
+                                {"angle_deg", f.angle * 180 / 3.14159265358979}});
+  WriteJsonAtomic(dir / "synth.json", options);
+}
+
+}  // namespace
+
+void DeclareOptions(OptionTable& table, SynthOptions* o) {
+  table.Switch("force", &o->force, "replace an existing folder");
+  table.Value("seed", &o->seed, "random seed");
+  std::vector<std::pair<std::string, PageKind>> kinds;
+  for (PageKind k : {PageKind::kText, PageKind::kTable, PageKind::kReceipt, PageKind::kPoster})
+    kinds.emplace_back(PageKindName(k), k);
+  table.Choice("kind", &o->kind, kinds, "the page");
+  table.Parsed<cv::Size2d>("page-size", &o->page_size_m, "WxH", ParsePageSize, FormatPageSize,
+                           "page size in mm (default: A4, receipt 80x200)");
+  table.Value("creases", &o->folds.creases, "number of narrow folds");
+  table.Parsed<double>("crease-width-mm", &o->folds.crease_width_min, "MM", ParseMillimetres,
+                       FormatMillimetres, "narrowest crease (mm)");
+  table.Parsed<double>("crease-width-max-mm", &o->folds.crease_width_max, "MM", ParseMillimetres,
+                       FormatMillimetres,
+                       "widest crease (mm); below --crease-width-mm means that width");
+  table.Value("angle-min", &o->folds.crease_angle_min, "smallest crease angle (degrees)");
+  table.Value("angle-max", &o->folds.crease_angle_max, "largest crease angle (degrees)");
+  table.Switch("curl", &o->folds.curl, "add one wide bend (a curl of several cm)");
+  table.Value("views", &o->cameras.views, 1, 30, "number of photos");
+  table.Value("width", &o->cameras.width, 64, std::numeric_limits<int>::max(),
+              "image width (pixels)");
+  table.Value("height", &o->cameras.height, 64, std::numeric_limits<int>::max(),
+              "image height (pixels)");
+  table.Value("elevation-min", &o->cameras.elevation_min_deg, "lowest camera elevation (degrees)");
+  table.Value("elevation-max", &o->cameras.elevation_max_deg, "highest camera elevation (degrees)");
+  table.Switch("cut-off", &o->cameras.cut_off,
+               "frame every view so that part of the page is outside the image");
+  std::vector<std::pair<std::string, Background>> backgrounds;
+  for (Background b :
+       {Background::kPlain, Background::kWood, Background::kCloth, Background::kGranite})
+    backgrounds.emplace_back(BackgroundName(b), b);
+  table.Choice("background", &o->render.background, backgrounds, "the table");
+  table.Value("noise", &o->render.noise_sigma, "sensor noise (grey levels)");
+  table.Value("jpeg-quality", &o->render.jpeg_quality, "JPEG quality");
+  table.Value("flat-dpi", &o->flat_dpi, "resolution of flat.png (dpi)");
+  table.Parsed<double>("mesh-spacing-mm", &o->mesh_spacing_m, "MM", ParseMillimetres,
+                       FormatMillimetres, "vertex spacing of mesh.ply (mm)");
+}
+
+SynthResult Run(const SynthOptions& o, const Json& options_record) {
   const auto start = std::chrono::steady_clock::now();
   if (o.out.empty()) throw UsageError("--out is required");
   std::error_code ec;
@@ -97,21 +268,7 @@ SynthResult Run(const SynthOptions& o) {
     throw UsageError("--views must be between 1 and 30");
 
   std::mt19937 rng(o.seed);
-  cv::Size2d size = DefaultPageSize(o.kind);
-  if (o.page_width_m > 0) size.width = o.page_width_m;
-  if (o.page_height_m > 0) size.height = o.page_height_m;
-
-  Log("printing a " + PageKindName(o.kind) + " page");
-  Page page = MakePage(o.kind, size, o.texture_dpi, &rng);
-  std::vector<Fold> folds = RandomFolds(size.width, size.height, o.folds, &rng);
-  if (folds.empty() && (o.folds.creases > 0 || o.folds.curl))
-    throw UsageError("cannot place " + std::to_string(o.folds.creases) +
-                     " non-crossing folds on this page; ask for fewer");
-  FoldedSheet sheet(size.width, size.height, folds);
-  PageSurface surface = PlaceOnTable(sheet, o.mesh_spacing_m, &rng);
-  std::vector<PinholeCamera> cameras = MakeCameras(surface, o.cameras, &rng);
-  const Lighting light = RandomLighting(&rng);
-  const Table table = MakeTable(o.render.background, &rng);
+  const Scene scene = MakeScene(o, &rng);
 
   // Everything goes to a temporary folder first, renamed at the end.
   const fs::path out = fs::absolute(o.out);
@@ -128,79 +285,8 @@ SynthResult Run(const SynthOptions& o) {
   EnsureDirectory(tmp / "images");
   EnsureDirectory(tmp / "ground_truth");
 
-  Progress progress("rendering views", long(cameras.size()));
-  for (size_t i = 0; i < cameras.size(); ++i) {
-    cv::Mat photo = RenderView(surface, page.image, table, light, cameras[i]);
-    AddSensorEffects(&photo, o.render, &rng);
-    WriteImageAtomic(tmp / "images" / cameras[i].image, photo,
-                     {cv::IMWRITE_JPEG_QUALITY, o.render.jpeg_quality});
-    progress.Update(long(i + 1));
-  }
-  progress.Done();
-
-  // Ground truth.
-  const double flat_ppm = o.flat_dpi / 0.0254;
-  const cv::Size flat_size(int(std::lround(size.width * flat_ppm)),
-                           int(std::lround(size.height * flat_ppm)));
-  cv::Mat flat;
-  cv::resize(page.image, flat, flat_size, 0, 0, cv::INTER_AREA);
-  WriteImageAtomic(tmp / "ground_truth/flat.png", flat, {cv::IMWRITE_PNG_COMPRESSION, 9});
-
-  std::string text;
-  for (const std::string& line : page.text) text += line + "\n";
-  WriteTextAtomic(tmp / "ground_truth/text.txt", text);
-
-  Json page_json = MakeHeader("docunfold.gt-page", 1, "synth");
-  page_json["width_m"] = size.width;
-  page_json["height_m"] = size.height;
-  WriteJsonAtomic(tmp / "ground_truth/page.json", page_json);
-
-  Json cams = MakeHeader("docunfold.gt-cameras", 1, "synth");
-  cams["convention"] =
-      "x_cam = R x_world + t; OpenCV axes (x right, y down, z forward); pixel centres at "
-      "integer coordinates; metres";
-  cams["views"] = Json::array();
-  for (const PinholeCamera& c : cameras) cams["views"].push_back(CameraToJson(c));
-  WriteJsonAtomic(tmp / "ground_truth/cameras.json", cams);
-
-  PlyData mesh;
-  mesh.comments = {"true page surface, world frame, metres",
-                   "s,t = column and row of flat.png as fractions, (0,0) top left",
-                   "made by docunfold synth seed " + std::to_string(o.seed)};
-  mesh.vertices = surface.vertices;
-  std::vector<double> s, t;
-  for (const auto& st : surface.st) {
-    s.push_back(st.x());
-    t.push_back(st.y());
-  }
-  mesh.SetProperty("s", s);
-  mesh.SetProperty("t", t);
-  mesh.faces = surface.quads;
-  mesh.SetGridSize(surface.nx, surface.ny);
-  WritePly(tmp / "ground_truth/mesh.ply", mesh);
-
-  // True lines in flat.png pixels (centres at integer coordinates).
-  Json features = MakeHeader("docunfold.gt-features", 1, "synth");
-  features["width"] = flat_size.width;
-  features["height"] = flat_size.height;
-  features["lines"] = Json::array();
-  for (const PageLine& l : page.lines) {
-    std::vector<Eigen::Vector2d> px;
-    for (const Eigen::Vector2d& p : l.points)
-      px.emplace_back(p.x() / size.width * flat_size.width - 0.5,
-                      p.y() / size.height * flat_size.height - 0.5);
-    features["lines"].push_back({{"kind", l.kind}, {"points", PointsJson(px)}});
-  }
-  WriteJsonAtomic(tmp / "ground_truth/features.json", features);
-
-  Json options = MakeHeader("docunfold.synth-options", 1, "synth", OptionsToJson(o));
-  options["folds"] = Json::array();
-  for (const Fold& f : folds)
-    options["folds"].push_back({{"point_m", {f.point.x(), f.point.y()}},
-                                {"direction", {f.direction.x(), f.direction.y()}},
-                                {"width_mm", f.width * 1000},
-                                {"angle_deg", f.angle * 180 / 3.14159265358979}});
-  WriteJsonAtomic(tmp / "ground_truth/synth.json", options);
+  WritePhotos(scene, o.render, tmp, &rng);
+  WriteGroundTruth(scene, o, options_record, tmp / "ground_truth");
   if (!o.command_line.empty()) WriteTextAtomic(tmp / "COMMAND", o.command_line + "\n");
 
   if (fs::exists(out, ec)) fs::remove_all(out, ec);
@@ -210,9 +296,9 @@ SynthResult Run(const SynthOptions& o) {
   cleanup.dir.clear();
 
   SynthResult r;
-  r.views = int(cameras.size());
-  r.mesh_vertices = int(surface.vertices.size());
-  r.folds = int(folds.size());
+  r.views = int(scene.cameras.size());
+  r.mesh_vertices = int(scene.surface.vertices.size());
+  r.folds = int(scene.folds.size());
   r.seconds = SecondsSince(start);
   return r;
 }

@@ -1,12 +1,16 @@
-// synth: photographed creased pages with full ground truth (DESIGN §3, §8).
+// synth: photographed creased pages with full ground truth: a data set of
+// photos (images/) and the truth they were made from (ground_truth/: the flat
+// page, its text, size, surface, cameras and straight lines).
 #pragma once
 
 #include <cstdint>
 #include <filesystem>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
 
 #include "common/json_io.h"
+#include "common/option_table.h"
 #include "stages/synth/folds.h"
 #include "stages/synth/page.h"
 #include "stages/synth/scene.h"
@@ -20,8 +24,7 @@ struct SynthOptions {
   bool force = false;  // replace an existing folder
   uint32_t seed = 1;   // everything random derives from it
   PageKind kind = PageKind::kText;
-  double page_width_m = 0;  // 0: the kind's default (A4; 80 x 200 mm receipt)
-  double page_height_m = 0;
+  cv::Size2d page_size_m{0, 0};   // 0: the kind's default (DefaultPageSize)
   FoldOptions folds;              // creases, curl, widths and angles
   CameraOptions cameras;          // views, image size, field of view, elevation, cut-off
   RenderOptions render;           // background, noise, JPEG quality
@@ -38,10 +41,13 @@ struct SynthResult {
   double seconds = 0;
 };
 
-// Makes the data set in options.out (written to a temporary folder and
-// renamed into place). Throws UsageError, OutputError or std::runtime_error.
-SynthResult Run(const SynthOptions& options);
+// Declares every option of SynthOptions but out (a path) and command_line;
+// the lengths given in millimetres are kept in metres.
+void DeclareOptions(OptionTable& table, SynthOptions* options);
 
-Json OptionsToJson(const SynthOptions& options);
+// Makes the data set in options.out (written to a temporary folder and
+// renamed into place); ground_truth/synth.json records `options_record`.
+// Throws UsageError, OutputError or std::runtime_error.
+SynthResult Run(const SynthOptions& options, const Json& options_record);
 
 }  // namespace docunfold::synth

@@ -118,8 +118,9 @@ TEST(BaselineData, PresentOrSkipped) {
 }
 
 // --quarter-turns relabels the corners: a half turn gives the same page
-// upside down (the size of flat.png is kept). (MS-SSIM cannot be asked to
-// tell: on set01 the page upside down scores 0.479, upright 0.463.)
+// upside down (the size of flat.png is kept). The images are compared
+// directly: MS-SSIM cannot tell the page upside down from upright (see
+// docs/decisions/baseline.md, "MS-SSIM does not see which way up a page is").
 TEST(HomographyBaseline, QuarterTurnsTurnThePage) {
   std::vector<std::string> sets = DataSetsWithGroundTruth();
   if (sets.empty()) GTEST_SKIP() << "no data set with ground truth";
@@ -223,7 +224,7 @@ TEST(EvaluateGeometry, TrueMeshesAreOnTheSurfaceAndIsometric) {
   options.ocr = false;
   options.flow = false;
   const fs::path flat = data / "ground_truth" / "flat.png";
-  evaluate::EvaluateResult r = evaluate::Run({data, work, flat}, options);
+  evaluate::EvaluateResult r = evaluate::Run({data, work, flat}, options, Json::object());
   EXPECT_NEAR(r.metrics.ms_ssim, 1.0, 1e-12);
   EXPECT_LT(r.metrics.surface_mean_pct, 0.01) << r.document["geometry"].dump();
   EXPECT_LT(r.metrics.surface_max_pct, 0.05);
@@ -237,7 +238,7 @@ TEST(EvaluateGeometry, TrueMeshesAreOnTheSurfaceAndIsometric) {
   EnsureDirectory(work / "50_optimize");
   WritePly(work / "50_optimize" / "mesh3d.ply", meshes.mesh3d);
   WritePly(work / "50_optimize" / "mesh2d.ply", meshes.mesh2d);
-  r = evaluate::Run({data, work, flat}, options);  // 50_optimize is preferred
+  r = evaluate::Run({data, work, flat}, options, Json::object());  // 50_optimize is preferred
   EXPECT_EQ(r.document["geometry"]["mesh_dir"], (work / "50_optimize").string());
   EXPECT_GT(r.metrics.surface_mean_pct, 0.3) << r.document["geometry"].dump();
   EXPECT_LT(r.metrics.surface_max_pct, 1.0 + 1e-3);  // float32 PLY coordinates

@@ -105,6 +105,8 @@ TEST_F(EvaluateCli, ShiftOfSixPixelsIsThreeAtTheFlowResolution) {
   EXPECT_LT(j["metrics"]["ms_ssim"].get<double>(), 0.9);
   EXPECT_TRUE(j["metrics"]["cer"].is_null());
   EXPECT_EQ(j["ocr"]["skipped"], "--no-ocr");
+  EXPECT_EQ(j["producer"]["options"]["ocr"], false);
+  EXPECT_EQ(j["producer"]["options"]["flow"], true);
   EXPECT_EQ(j["flow"]["size"], Json::array({440, 340}));
 }
 

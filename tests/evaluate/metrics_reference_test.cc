@@ -1,5 +1,6 @@
 // evaluate reproduces MS-SSIM and CER computed independently by the
-// definitions of DESIGN.md §7 (../shared/metrics-reference/*/expected.json):
+// literature's definitions (DocUNet's MS-SSIM, CER as edit distance over
+// reference length; ../shared/metrics-reference/*/expected.json):
 // MS-SSIM within 0.003, CER within 0.01. Skips when the folder is absent.
 #include <gtest/gtest.h>
 

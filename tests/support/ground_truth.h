@@ -1,6 +1,6 @@
-// Ground truth of a data set (DESIGN §3) for tests: the library's
-// (stages/evaluate/ground_truth.h) under the tests' namespace, and a loader
-// that fails the current test instead of throwing.
+// Ground truth of a data set (ground_truth/ beside images/) for tests: the
+// library's (stages/evaluate/ground_truth.h) under the tests' namespace, and
+// a loader that fails the current test instead of throwing.
 #pragma once
 
 #include <filesystem>

@@ -1,6 +1,5 @@
 #include "tests/support/truth_frame.h"
 
-#include <algorithm>
 #include <opencv2/imgcodecs.hpp>
 #include <random>
 #include <stdexcept>
@@ -8,6 +7,7 @@
 #include "common/atomic_file.h"
 #include "common/json_io.h"
 #include "common/raster.h"
+#include "common/statistics.h"
 
 namespace docunfold::testing {
 namespace {
@@ -34,9 +34,8 @@ RefFromWorld ReferenceFrame(const GroundTruth& gt, const std::string& reference)
     depths.push_back(xc.z());
   }
   if (depths.empty()) throw std::runtime_error(reference + " sees no part of the page");
-  std::nth_element(depths.begin(), depths.begin() + depths.size() / 2, depths.end());
   RefFromWorld f;
-  f.scale = 1.0 / depths[depths.size() / 2];
+  f.scale = 1.0 / Median(std::move(depths));
   f.R = cam.R;
   f.t = cam.t;
   return f;

@@ -1,6 +1,6 @@
 // Ground truth expressed the way the pipeline sees a scene: in the frame of a
-// reference camera, scaled so that the median depth of the page is 1
-// (DESIGN §4). Lets tests of later stages run on true inputs (cameras,
+// reference camera, scaled so that the median depth of the page is 1 (the
+// frame sfm writes, stages/sfm/sfm.h). Lets tests of later stages run on true inputs (cameras,
 // points, meshes) without running sfm, and compare results with the truth.
 #pragma once
 

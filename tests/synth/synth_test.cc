@@ -1,5 +1,5 @@
-// synth: deterministic, self-consistent data sets in the ground-truth format
-// of DESIGN §3, and clear failures on bad requests.
+// synth: deterministic, self-consistent data sets in the ground-truth layout
+// (images/, ground_truth/), and clear failures on bad requests.
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -80,6 +80,13 @@ TEST(Synth, WritesTheGroundTruthLayoutAndItValidates) {
       EXPECT_GT(rule, 4);
     }
     EXPECT_GT(fs::file_size(out / "ground_truth/text.txt"), 100u) << kind;
+    // Readers of synth.json (evaluate's LineRecallRequired, the tests) take
+    // the page kind, curl and cut-off from its producer record.
+    const Json options = ReadJsonFile(out / "ground_truth/synth.json")["producer"]["options"];
+    EXPECT_EQ(options.value("kind", ""), kind);
+    EXPECT_EQ(options.value("curl", true), false);
+    EXPECT_EQ(options.value("cut_off", true), false);
+    EXPECT_EQ(options.value("creases", 0), 2);
   }
 }
 
@@ -113,6 +120,8 @@ TEST(Synth, CutOffFramingLeavesPartOfThePageOutsideEveryView) {
   CommandResult r =
       RunCommand(Synth(std::string(kSmall) + " --cut-off --out " + Quote((dir / "cut").string())));
   ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(ReadJsonFile(dir / "cut/ground_truth/synth.json")["producer"]["options"].value(
+      "cut_off", false));
   auto gt = LoadGroundTruth(dir / "cut");
   ASSERT_TRUE(gt);
   for (const PinholeCamera& cam : gt->cameras.views) {
@@ -127,11 +136,31 @@ TEST(Synth, CutOffFramingLeavesPartOfThePageOutsideEveryView) {
   }
 }
 
+TEST(Synth, LengthsInMillimetres) {
+  // A widest crease below the narrowest counts as the narrowest: every
+  // crease is then 6 mm wide.
+  TempDir dir;
+  CommandResult r = RunCommand(Synth(std::string(kSmall) +
+                                     " --crease-width-mm 6 --crease-width-max-mm 2 --page-size " +
+                                     "150x200 --out " + Quote((dir / "mm").string())));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const Json synth = ReadJsonFile(dir / "mm/ground_truth/synth.json");
+  ASSERT_EQ(synth["folds"].size(), 2u);
+  for (const Json& f : synth["folds"]) EXPECT_NEAR(f["width_mm"].get<double>(), 6.0, 1e-9);
+  EXPECT_EQ(synth["producer"]["options"]["crease_width_mm"], "6");
+  EXPECT_EQ(synth["producer"]["options"]["page_size"], "150x200");
+  const Json page = ReadJsonFile(dir / "mm/ground_truth/page.json");
+  EXPECT_DOUBLE_EQ(page["width_m"].get<double>(), 0.15);
+  EXPECT_DOUBLE_EQ(page["height_m"].get<double>(), 0.2);
+}
+
 TEST(Synth, BadRequestsFailWithUsageErrorsAndLeaveNothing) {
   TempDir dir;
   CommandResult r = RunCommand(Synth("--kind leaflet --out " + Quote((dir / "x").string())));
   EXPECT_EQ(r.exit_code, 2);
-  EXPECT_NE(r.output.find("unknown page kind 'leaflet'"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("--kind: expected text|table|receipt|poster, got 'leaflet'"),
+            std::string::npos)
+      << r.output;
   EXPECT_FALSE(fs::exists(dir / "x"));
 
   r = RunCommand(Synth("--background lava --out " + Quote((dir / "x").string())));
