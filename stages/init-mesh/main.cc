@@ -82,7 +82,6 @@ int main(int argc, char** argv) {
                  "ignored (re-decided every iteration)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 10.0));
-  AddFairnessBoostOptions(app, &o.refine.unsupported_fairness, &o.refine.support_radius);
   app.add_option("--lambda-iso", o.refine.weights.iso, "lambda1, isometry")->capture_default_str();
   app.add_option("--lambda-dist", o.refine.weights.dist, "lambda2, point fitting")
       ->capture_default_str();
@@ -96,7 +95,6 @@ int main(int argc, char** argv) {
       ->capture_default_str()
       ->check(CLI::IsMember({"strain", "raw"}));
   AddIsoEdgesOption(app, &o.refine.iso_edges);
-  AddFair2dAlongOption(app, &o.refine.fair2d_along);
   app.add_option("--outline-hold", o.outline_hold,
                  "weight of the term holding M's border to the page outline in the reference "
                  "image (sliding along it); 0 = off")

@@ -50,8 +50,7 @@ TEST(InitMeshCli, BlankMarginsContinueTheirPanels) {
   WriteFoldedPageWithMarginsWork(paper.path(), 40, 30, 0.15);
   const CommandResult a = RunCommand(InitMeshCommand(ours.path()));
   ASSERT_EQ(a.exit_code, 0) << a.output;
-  const CommandResult b =
-      RunCommand(InitMeshCommand(paper.path(), "--depth-model average --unsupported-fairness 1"));
+  const CommandResult b = RunCommand(InitMeshCommand(paper.path(), "--depth-model average"));
   ASSERT_EQ(b.exit_code, 0) << b.output;
   const double size = isometry::ModelSize(truth);
   const auto with = SurfaceDistance(ReadMeshPair(ours / "40_init"), truth);
