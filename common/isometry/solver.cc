@@ -7,7 +7,6 @@
 #include <functional>
 #include <limits>
 #include <memory>
-#include <queue>
 #include <stdexcept>
 #include <string>
 
@@ -26,7 +25,6 @@
 #include "common/isometry/isometry.h"
 #include "common/isometry/mesh_index.h"
 #include "common/isometry/residuals.h"
-#include "common/statistics.h"
 
 namespace docunfold::isometry {
 
@@ -90,8 +88,8 @@ TermValues EvaluateTerms(const State& s, const StepData& data, int threads) {
     AddSquares(rows, DistRows(s, data, p, rows), &acc[0]);
   })[0];
   const auto fair = OrderedSums<2>(triplets, threads, [&](int t, Row* rows, auto& acc) {
-    AddSquares(rows, FairRows(s, data, t, false, rows), &acc[0]);
-    AddSquares(rows, FairRows(s, data, t, true, rows), &acc[1]);
+    AddSquares(rows, FairRows(s, t, false, rows), &acc[0]);
+    AddSquares(rows, FairRows(s, t, true, rows), &acc[1]);
   });
   const auto feature = OrderedSums<2>(markers, threads, [&](int m, Row* rows, auto& acc) {
     AddSquares(rows, LineRows(s, data, m, rows), &acc[0]);
@@ -222,14 +220,6 @@ Work Normalise(const Problem& p, const SolveOptions& o) {
     w.data.iso_scale = 1;
   }
   w.data.iso_edge_weight = o.iso_edges;
-  w.data.fair2d_along = o.fair2d_along;
-  if (o.fair2d_relative) {
-    const auto& v = w.state.v2;
-    for (int t = 0; t < internal::NumFairTriplets(w.state.grid); ++t) {
-      const auto c = internal::FairTriplet(w.state.grid, t);
-      w.data.fair2d_rest.push_back(v[c[0]] - 2 * v[c[1]] + v[c[2]]);
-    }
-  }
   w.weights = o.weights;
   return w;
 }
@@ -294,50 +284,6 @@ void UpdateFootpoints(const State& s, StepData& data, double phi, int threads) {
   data.num_inliers = inliers;
 }
 
-// E_fair(M)'s per-vertex multiplier: 1 within `radius` (model-size units,
-// along the grid's edges on M) of a triangle holding an inlier footpoint,
-// rising linearly to `boost` at twice that distance. Where no point is near
-// (blank margins, gaps between columns) nothing else holds M's shape, and
-// the paper's tiny λ3 lets it drift; near points it keeps creases sharp.
-void UpdateFairScale(const State& s, StepData& data, double boost, double radius) {
-  if (boost == 1 || radius <= 0) {
-    data.fair3d_scale.clear();
-    return;
-  }
-  const QuadGrid& g = s.grid;
-  const int n = g.NumVertices();
-  std::vector<double> distance(n, std::numeric_limits<double>::infinity());
-  using Item = std::pair<double, int>;
-  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
-  for (const internal::Footpoint& f : data.footpoints) {
-    if (!f.inlier || f.triangle < 0) continue;
-    for (int v : internal::TriangleOf(g, f.triangle))
-      if (distance[v] > 0) {
-        distance[v] = 0;
-        queue.push({0, v});
-      }
-  }
-  while (!queue.empty()) {
-    const auto [d, v] = queue.top();
-    queue.pop();
-    if (d > distance[v] || d > 2 * radius) continue;
-    const int r = v / g.nx, c = v % g.nx;
-    const int next[4][2] = {{r - 1, c}, {r + 1, c}, {r, c - 1}, {r, c + 1}};
-    for (const auto& rc : next) {
-      if (rc[0] < 0 || rc[1] < 0 || rc[0] >= g.ny || rc[1] >= g.nx) continue;
-      const int u = g.Index(rc[0], rc[1]);
-      const double du = d + (s.v3[u] - s.v3[v]).norm();
-      if (du < distance[u]) {
-        distance[u] = du;
-        queue.push({du, u});
-      }
-    }
-  }
-  data.fair3d_scale.resize(n);
-  for (int v = 0; v < n; ++v)
-    data.fair3d_scale[v] = 1 + (boost - 1) * std::clamp(distance[v] / radius - 1, 0.0, 1.0);
-}
-
 Eigen::Vector2d FlatPoint(const State& s, const SurfacePoint& w) {
   const Triangle t = internal::TriangleOf(s.grid, w.triangle);
   return w.bary[0] * s.v2[t[0]] + w.bary[1] * s.v2[t[1]] + w.bary[2] * s.v2[t[2]];
@@ -372,80 +318,6 @@ void FitLines(State& s, const StepData& data) {
     s.lines[l].theta = theta;
     s.lines[l].offset = normal.dot(mean);
   }
-}
-
-// SolveOptions::line_spacing: each text row whose nearest parallel rows on
-// both sides overlap it along its length, with gaps within max_ratio of each
-// other and of the page's row pitch, moves `strength` of the way to their
-// middle (all from the offsets as fitted). Returns how many rows moved.
-int EvenTextRowSpacing(State& s, const StepData& data, double strength, double max_ratio) {
-  const int n = int(s.lines.size());
-  constexpr double kInf = std::numeric_limits<double>::infinity();
-  std::vector<double> lo(n, kInf), hi(n, -kInf);
-  std::vector<int> count(n, 0);
-  // Lines are axis-aligned: one whose normal is ±y runs along x.
-  auto horizontal = [&](int l) {
-    const Eigen::Vector2d nrm = s.lines[l].Normal();
-    return std::abs(nrm.y()) > std::abs(nrm.x());
-  };
-  auto along = [&](int l, const Eigen::Vector2d& p) { return horizontal(l) ? p.x() : p.y(); };
-  // The sign that turns the normal into +x or +y.
-  auto sign = [&](int l) {
-    const Eigen::Vector2d nrm = s.lines[l].Normal();
-    return horizontal(l) ? nrm.y() : nrm.x();
-  };
-  for (const Marker& m : data.markers) {
-    if (m.line < 0) continue;
-    const double t = along(m.line, FlatPoint(s, m.where));
-    lo[m.line] = std::min(lo[m.line], t);
-    hi[m.line] = std::max(hi[m.line], t);
-    ++count[m.line];
-  }
-  // Offset along the positive axis (x or y), whatever the normal's sign.
-  auto axis_offset = [&](int l) { return s.lines[l].offset * sign(l); };
-  auto overlapping = [&](int a, int b) {
-    const double overlap = std::min(hi[a], hi[b]) - std::max(lo[a], lo[b]);
-    return overlap > 0.5 * std::min(hi[a] - lo[a], hi[b] - lo[b]);
-  };
-  std::vector<int> rows;
-  for (int l = 0; l < n; ++l)
-    if (s.lines[l].text_row && s.lines[l].axis_aligned && count[l] >= 2 && hi[l] > lo[l])
-      rows.push_back(l);
-  // Nearest parallel, overlapping rows on either side of each row.
-  std::vector<int> below(n, -1), above(n, -1);
-  std::vector<double> nearest;  // per row: its smaller gap, for the pitch
-  for (const int b : rows) {
-    const double cb = axis_offset(b);
-    double ca = -kInf, cc = kInf;
-    for (const int x : rows) {
-      if (x == b || horizontal(x) != horizontal(b) || !overlapping(x, b)) continue;
-      const double cx = axis_offset(x);
-      if (cx < cb && cx > ca) ca = cx, below[b] = x;
-      if (cx > cb && cx < cc) cc = cx, above[b] = x;
-    }
-    const double g = std::min(cb - ca, cc - cb);
-    if (std::isfinite(g)) nearest.push_back(g);
-  }
-  if (nearest.empty()) return 0;
-  // The page's row pitch: rows farther apart than max_ratio of it are no
-  // consecutive rows (a sparse table column, a paragraph break).
-  const double pitch = Median(nearest);
-  std::vector<double> target(n, kInf);
-  for (const int b : rows) {
-    if (below[b] < 0 || above[b] < 0) continue;
-    const double ca = axis_offset(below[b]), cb = axis_offset(b), cc = axis_offset(above[b]);
-    const double g1 = cb - ca, g2 = cc - cb;
-    if (std::max(g1, g2) > max_ratio * std::min(g1, g2) || std::max(g1, g2) > max_ratio * pitch)
-      continue;
-    target[b] = cb + strength * (0.5 * (ca + cc) - cb);
-  }
-  int moved = 0;
-  for (const int b : rows) {
-    if (!std::isfinite(target[b])) continue;
-    s.lines[b].offset = target[b] * sign(b);
-    ++moved;
-  }
-  return moved;
 }
 
 // Feature line projection: p' onto its line, then the new face and
@@ -591,11 +463,11 @@ class GaussNewton {
           for (int k = colour; k < per_line; k += 3) {
             const int t = (phase == 0 ? 0 : along_rows) + l * per_line + k;
             if (w.fair3d > 0) {
-              const int m = internal::FairRows(s, data, t, false, rows);
+              const int m = internal::FairRows(s, t, false, rows);
               for (int i = 0; i < m; ++i) sum += add(w.fair3d, rows[i]);
             }
             if (w.fair2d > 0) {
-              const int m = internal::FairRows(s, data, t, true, rows);
+              const int m = internal::FairRows(s, t, true, rows);
               for (int i = 0; i < m; ++i) sum += add(w.fair2d, rows[i]);
             }
           }
@@ -813,7 +685,6 @@ Json IterationJson(const IterationReport& it) {
   j["outliers"] = it.outliers;
   j["markers"] = it.markers;
   j["lines"] = it.lines;
-  j["spaced_rows"] = it.spaced_rows;
   j["seconds"] = it.seconds;
   j["footpoint_seconds"] = it.footpoint_seconds;
   j["step_seconds"] = it.step_seconds;
@@ -891,9 +762,6 @@ Result Solve(const Problem& problem, const SolveOptions& o) {
     if (gn) gn->set_threads(threads);
     ir.threads = threads;
     UpdateFootpoints(w.state, w.data, o.outlier_distance, threads);
-    // Where the points are is decided once per solve: re-deciding it as
-    // footpoints move would change F's weights under the iterations.
-    if (it == 0) UpdateFairScale(w.state, w.data, o.unsupported_fairness, o.support_radius);
     // The callback first: it may regroup markers into new lines, which are
     // then fitted and projected onto like any others.
     if (o.on_outer_iteration) {
@@ -919,8 +787,6 @@ Result Solve(const Problem& problem, const SolveOptions& o) {
       for (FeatureLine& l : w.state.lines)  // the caller's may be slanted
         if (l.axis_aligned) l.theta = NearestAxisTheta(l.theta);
       if (o.refit_lines) FitLines(w.state, w.data);
-      if (o.line_spacing > 0)
-        ir.spaced_rows = EvenTextRowSpacing(w.state, w.data, o.line_spacing, o.max_spacing_ratio);
       if (o.project_markers) ProjectMarkers(w.state, w.data);
     }
     ir.terms = internal::EvaluateTerms(w.state, w.data, threads);

@@ -6,7 +6,6 @@
 #include <cstdint>
 #include <nanoflann.hpp>
 #include <numeric>
-#include <optional>
 
 #include "common/statistics.h"
 
@@ -87,68 +86,6 @@ bool MergedIsStraight(const Cluster& a, const Cluster& b, double max_straightnes
   return *straightness < max_straightness && overlap < 0.3 * std::min(a.Width(), b.Width());
 }
 
-// The border edges of M as seen by a camera, for outline samples that lie
-// off M's image: their marker goes on the nearest border point, and the ray
-// term then pulls M's border out to the page's outline. Snapping to the
-// nearest covered pixel instead extrapolates a border triangle's plane onto
-// the ray, which leaves the ray term nothing to pull.
-class MeshBorder {
- public:
-  MeshBorder(const MeshPair& m, const PinholeCamera& camera) {
-    const QuadGrid& g = m.grid;
-    const std::vector<Triangle> tris = g.Triangles();
-    for (int t = 0; t < int(tris.size()); ++t) {
-      for (int i = 0; i < 3; ++i) {
-        const int j = (i + 1) % 3, a = tris[t][i], b = tris[t][j];
-        // Both ends in the grid's first or last row (column): an outer edge.
-        const int ra = a / g.nx, rb = b / g.nx, ca = a % g.nx, cb = b % g.nx;
-        const bool row_edge = ra == rb && (ra == 0 || ra == g.ny - 1);
-        const bool col_edge = ca == cb && (ca == 0 || ca == g.nx - 1);
-        if (!row_edge && !col_edge) continue;
-        const Eigen::Vector3d pa = camera.CamFromWorld(m.mesh3d[a]);
-        const Eigen::Vector3d pb = camera.CamFromWorld(m.mesh3d[b]);
-        if (pa.z() <= 0 || pb.z() <= 0) continue;
-        edges_.push_back({t, i, j, camera.ProjectCam(pa), camera.ProjectCam(pb)});
-      }
-    }
-  }
-
-  // The border point whose image is nearest to `pixel` within `radius`,
-  // among edges running within 45 degrees of `along` (so a sample near a
-  // corner keeps to its own side).
-  std::optional<SurfacePoint> Nearest(const Eigen::Vector2d& pixel, const Eigen::Vector2d& along,
-                                      double radius) const {
-    const double along_norm = along.norm();
-    std::optional<SurfacePoint> best;
-    double best_d = radius;
-    for (const Edge& e : edges_) {
-      const Eigen::Vector2d d = e.b - e.a;
-      const double len2 = d.squaredNorm();
-      if (len2 <= 0) continue;
-      if (along_norm > 0 &&
-          std::abs(d.dot(along)) < std::cos(kPi / 4) * std::sqrt(len2) * along_norm)
-        continue;
-      const double t = std::clamp((pixel - e.a).dot(d) / len2, 0.0, 1.0);
-      const double dist = (e.a + t * d - pixel).norm();
-      if (dist >= best_d) continue;
-      best_d = dist;
-      SurfacePoint sp;
-      sp.triangle = e.triangle;
-      sp.bary[e.corner_a] = 1 - t;
-      sp.bary[e.corner_b] = t;
-      best = sp;
-    }
-    return best;
-  }
-
- private:
-  struct Edge {
-    int triangle, corner_a, corner_b;
-    Eigen::Vector2d a, b;  // images of the two corners
-  };
-  std::vector<Edge> edges_;
-};
-
 }  // namespace
 
 std::vector<Eigen::Vector2d> SamplePolyline(const std::vector<Eigen::Vector2d>& polyline,
@@ -170,21 +107,12 @@ MarkerSet CastMarkers(const MeshPair& meshes, const PinholeCamera& reference,
   const double scale = std::min(1.0, std::sqrt(options.max_raster_pixels / pixels));
   PixelToSurface map(meshes, reference, scale);
   const Eigen::Vector3d origin = reference.Center();
-  const double border_radius =
-      options.border_snap * std::hypot(double(reference.width), double(reference.height));
-  std::optional<MeshBorder> border;
   MarkerSet set;
   set.markers_of_segment.assign(segments.size(), 0);
   for (size_t s = 0; s < segments.size(); ++s)
     for (size_t k = 0; k < segments[s].pixels.size(); ++k) {
       const Eigen::Vector2d& px = segments[s].pixels[k];
-      auto where = map.LookupNear(px, options.snap_px);
-      if (!where && segments[s].kind == "boundary" && border_radius > 0) {
-        if (!border) border.emplace(meshes, reference);
-        const auto& p = segments[s].pixels;
-        const Eigen::Vector2d along = p[std::min(k + 1, p.size() - 1)] - p[k > 0 ? k - 1 : 0];
-        where = border->Nearest(px, along, border_radius);
-      }
+      const auto where = map.LookupNear(px, options.snap_px);
       if (!where) continue;
       isometry::Marker m;
       m.where = *where;
@@ -350,7 +278,6 @@ std::vector<isometry::FeatureLine> AssignLines(const MeshPair& meshes, const Gro
   for (int l = 0; l < n; ++l) {
     lines[l].axis_aligned = axis_lines == AxisLines::kAll || (axis_lines == AxisLines::kFeatures &&
                                                               grouping.line_kind[l] != "boundary");
-    lines[l].text_row = grouping.line_kind[l] == "text";
   }
   return lines;
 }
@@ -405,49 +332,6 @@ int DropSideOutliers(const MeshPair& meshes, const Grouping& grouping, double to
       }
   }
   return dropped;
-}
-
-namespace {
-
-// Corner k (TL TR BR BL) lies between sides kCornerSides[k] (top 0, right 1,
-// bottom 2, left 3).
-constexpr int kCornerSides[4][2] = {{0, 3}, {0, 1}, {1, 2}, {2, 3}};
-
-int CornerRow(const QuadGrid& grid, int k) { return k >= 2 ? grid.ny - 1 : 0; }
-int CornerCol(const QuadGrid& grid, int k) { return k == 1 || k == 2 ? grid.nx - 1 : 0; }
-
-}  // namespace
-
-std::array<bool, 4> HeldCorners(const MeshPair& meshes, const Boundary& boundary,
-                                const PinholeCamera& reference, double max_px) {
-  std::array<bool, 4> held = {false, false, false, false};
-  const QuadGrid& grid = meshes.grid;
-  if (grid.nx < 2 || grid.ny < 2) return held;
-  for (int k = 0; k < 4; ++k) {
-    if (!boundary.sides[kCornerSides[k][0]].real || !boundary.sides[kCornerSides[k][1]].real)
-      continue;
-    const Eigen::Vector3d x_cam =
-        reference.CamFromWorld(meshes.mesh3d[grid.Index(CornerRow(grid, k), CornerCol(grid, k))]);
-    held[k] = x_cam.z() > 0 && (reference.ProjectCam(x_cam) - boundary.corners[k]).norm() <= max_px;
-  }
-  return held;
-}
-
-std::vector<isometry::Marker> CornerMarkers(const MeshPair& meshes, const Boundary& boundary,
-                                            const PinholeCamera& reference,
-                                            const std::array<bool, 4>& held) {
-  std::vector<isometry::Marker> out;
-  const QuadGrid& grid = meshes.grid;
-  if (grid.nx < 2 || grid.ny < 2) return out;
-  for (int k = 0; k < 4; ++k) {
-    if (!held[k]) continue;
-    isometry::Marker m;
-    m.where = VertexSurfacePoint(grid, CornerRow(grid, k), CornerCol(grid, k));
-    m.ray_origin = reference.Center();
-    m.ray_direction = reference.RayDirection(boundary.corners[k]);
-    out.push_back(m);
-  }
-  return out;
 }
 
 }  // namespace docunfold::optimize

@@ -65,15 +65,7 @@ int main(int argc, char** argv) {
                  "fit only points projecting inside the boundary contour grown by this many "
                  "reference pixels")
       ->capture_default_str();
-  AddFairnessBoostOptions(app, &o.unsupported_fairness, &o.support_radius);
   AddIsoEdgesOption(app, &o.iso_edges);
-  AddFair2dAlongOption(app, &o.fair2d_along);
-  app.add_option("--fair2d-relative-rounds", o.fair2d_relative_rounds,
-                 "in this many rounds from the first, E_fair(M') measures the change of M' "
-                 "from the round's start, not its distance from an evenly spaced straight "
-                 "grid (0 = the paper)")
-      ->capture_default_str()
-      ->check(CLI::Range(0, 100));
   app.add_option("--side-outliers", o.side_outliers,
                  "take samples inside a real page side off it when farther "
                  "than this fraction of M's diagonal, and 4 sigma of the "
@@ -86,22 +78,6 @@ int main(int argc, char** argv) {
                  "be (0 = keep all)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1000.0));
-  app.add_option("--corner-max-px", o.corner_max_px,
-                 "hold M's grid corners to the rays of the page corners between two real "
-                 "sides where init-mesh's corner lies within this many reference pixels of "
-                 "them (0 = off)")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 10000.0));
-  app.add_option("--line-spacing", o.line_spacing,
-                 "each outer iteration, move a text row this fraction of the "
-                 "way to the middle of its neighbouring rows (0 = off)")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 1.0));
-  app.add_option("--max-spacing-ratio", o.max_spacing_ratio,
-                 "--line-spacing moves a row only when its two gaps, and the "
-                 "page's row pitch, differ by at most this factor")
-      ->capture_default_str()
-      ->check(CLI::Range(1.0, 10.0));
   app.add_option("--solver", solver, "gn (Gauss-Newton/LM, sparse Cholesky) or lbfgs")
       ->capture_default_str();
   app.add_option("--linear-solver", linear,
@@ -112,12 +88,6 @@ int main(int argc, char** argv) {
   app.add_flag("--boundary-only", o.boundary_only, "only the real page sides as lines (ablation)");
   app.add_flag("--no-projection", no_projection, "without feature line projection (ablation)");
   app.add_option("--marker-step", o.marker_step_px, "sample spacing along segments, pixels")
-      ->capture_default_str();
-  app.add_option("--border-snap", o.cast.border_snap,
-                 "page-side samples off M's image go on M's nearest border point within this "
-                 "fraction of the image diagonal, so the ray term pulls the border to the "
-                 "outline (0: dropped; README, \"Choices we measured\")")
-      ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
   app.add_option("--merge-gap", o.grouping.gap,
                  "segments merge when their closest ends are this close along the line "
@@ -189,16 +159,9 @@ int main(int argc, char** argv) {
                                {"rises_from_round", o.rises_from_round},
                                {"outlier_distance", o.outlier_distance},
                                {"region_margin_px", o.region_margin_px},
-                               {"unsupported_fairness", o.unsupported_fairness},
-                               {"support_radius", o.support_radius},
                                {"iso_edges", o.iso_edges},
-                               {"fair2d_along", o.fair2d_along},
-                               {"fair2d_relative_rounds", o.fair2d_relative_rounds},
                                {"side_outliers", o.side_outliers},
                                {"side_end_outliers", o.side_end_outliers},
-                               {"corner_max_px", o.corner_max_px},
-                               {"line_spacing", o.line_spacing},
-                               {"max_spacing_ratio", o.max_spacing_ratio},
                                {"features", o.features},
                                {"boundary_only", o.boundary_only},
                                {"projection", o.project},

@@ -97,14 +97,6 @@ OptimizeResult Run(const OptimizeInputs& in, const OptimizeOptions& o) {
       Log(std::string(buf) + ": M' left as it is");
     }
   }
-  const std::array<bool, 4> held_corners =
-      o.corner_max_px > 0 ? HeldCorners(in.init, in.boundary, in.reference, o.corner_max_px)
-                          : std::array<bool, 4>{false, false, false, false};
-  result.held_corners = int(std::count(held_corners.begin(), held_corners.end(), true));
-  if (o.corner_max_px > 0)
-    Log("M's grid corners held to " + std::to_string(result.held_corners) +
-        " page corners (between real sides, init-mesh's corner within " +
-        std::to_string(int(o.corner_max_px)) + " px)");
   isometry::Weights weights = o.weights;
   if (segments.empty()) weights.line = weights.ray = 0;
   for (int r = 0; r < o.rounds; ++r) {
@@ -124,13 +116,7 @@ OptimizeResult Run(const OptimizeInputs& in, const OptimizeOptions& o) {
     isometry::SolveOptions so;
     so.weights = weights;
     so.outlier_distance = o.outlier_distance;
-    so.unsupported_fairness = o.unsupported_fairness;
-    so.support_radius = o.support_radius;
     so.iso_edges = o.iso_edges;
-    so.fair2d_along = o.fair2d_along;
-    so.fair2d_relative = r < o.fair2d_relative_rounds;
-    so.line_spacing = o.line_spacing;
-    so.max_spacing_ratio = o.max_spacing_ratio;
     so.relative_tolerance = o.relative_tolerance;
     so.converged_iterations = r < o.rises_from_round ? o.converged_iterations : 1;
     so.max_outer_iterations = o.max_outer_iterations;
@@ -160,10 +146,6 @@ OptimizeResult Run(const OptimizeInputs& in, const OptimizeOptions& o) {
             c.markers->push_back(current.markers[i]);
             kept.push_back(int(i));
           }
-        // After the line markers, so `kept` still maps the solver's first ones.
-        const std::vector<isometry::Marker> corners =
-            CornerMarkers(*c.meshes, in.boundary, in.reference, held_corners);
-        c.markers->insert(c.markers->end(), corners.begin(), corners.end());
       };
     }
     isometry::Result solved = isometry::Solve(problem, so);

@@ -42,17 +42,7 @@ struct OptimizeOptions {
   // init-mesh; points of the table beside the page are within φ of M's edge
   // and would pull it outward.
   double region_margin_px = 4;
-  // λ3 × up to this far from every point (isometry::SolveOptions); 1 is
-  // the paper and the default: 100 helped on average with the old reference
-  // views but rounded an unsupported fold on set01 (README, "Choices we
-  // measured").
-  double unsupported_fairness = 1;
-  double support_radius = 0.03;  // fraction of the model size
-  double iso_edges = 0;          // isometry::SolveOptions::iso_edges
-  double fair2d_along = 1;       // isometry::SolveOptions::fair2d_along
-  // isometry::SolveOptions::fair2d_relative in this many rounds from the
-  // first (0 = none, the paper).
-  int fair2d_relative_rounds = 0;
+  double iso_edges = 0;  // isometry::SolveOptions::iso_edges
   // DropSideOutliers' tolerance (fraction of M's diagonal; 0 keeps every
   // marker). On set05 a fold's notch in the left side's outline, 30 px off
   // the page's edge in flat.png, was held straight with the side; two front
@@ -68,12 +58,6 @@ struct OptimizeOptions {
   // r03 +0.004 on the third; 3 took a curved end of set04's and set08's
   // sides off (-0.010, -0.011) (README, "Choices we measured").
   double side_end_outliers = 4;
-  // M's grid corners are held to the rays of the boundary's corners between
-  // two real sides (CornerMarkers) where init-mesh's corner projects within
-  // this many reference pixels of them; 0 = off.
-  double corner_max_px = 0;
-  double line_spacing = 0;          // isometry::SolveOptions::line_spacing
-  double max_spacing_ratio = 1.35;  // isometry::SolveOptions::max_spacing_ratio
   isometry::Method method = isometry::Method::kGaussNewton;
   isometry::LinearSolver linear_solver = isometry::LinearSolver::kAuto;
   bool features = true;        // false: no feature lines at all (--no-features)
@@ -149,7 +133,6 @@ struct OptimizeResult {
   int segments = 0;             // feature segments given (text + edge)
   int segments_off_page = 0;    // of those, dropped: their samples miss M
   int boundary_lines = 0;       // real boundary sides used
-  int held_corners = 0;         // page corners M's grid corners were held to
   double seconds = 0;
 };
 

@@ -87,7 +87,6 @@ Json LogJson(const OptimizeResult& result, const Json& options_json) {
                            {"segments", result.line_direction.lines},
                            {"turned_deg", result.upright_turn_deg}};
   doc["boundary_lines"] = result.boundary_lines;
-  doc["held_corners"] = result.held_corners;
   doc["points_in_region"] = result.region_points.size();
   doc["seconds"] = result.seconds;
   doc["rounds"] = Json::array();
