@@ -34,6 +34,13 @@ CLI::Option* OptionTable::Switch(const std::string& name, bool* field, const std
   return option;
 }
 
+CLI::Option* OptionTable::OffSwitch(const std::string& name, bool* field, const std::string& help) {
+  CLI::Option* option = app_.add_flag("!--no-" + name, *field, help);
+  option->default_str("off");
+  Add("no-" + name, option, [field] { return Json(!*field); });
+  return option;
+}
+
 CLI::Option* OptionTable::Path(const std::string& name, std::filesystem::path* field,
                                const std::string& help) {
   CLI::Option* option = app_.add_option(Flag(name), *field, help);

@@ -87,6 +87,11 @@ class OptionTable {
   // default.
   CLI::Option* Switch(const std::string& name, bool* field, const std::string& help);
 
+  // --no-name alone: *field (on by default) off. For a switch whose on-flag
+  // would clash with another option (optimize's --features is the feature
+  // file, --no-features turns feature lines off); recorded as no_name.
+  CLI::Option* OffSwitch(const std::string& name, bool* field, const std::string& help);
+
   // --name VALUE given as text and kept as *field: `parse` returns "" when
   // it took the text, else what is wrong with it; `format` writes *field
   // back as text (the default shown, and the record).
