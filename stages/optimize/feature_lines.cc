@@ -3,10 +3,9 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
-#include <cstdint>
-#include <nanoflann.hpp>
 #include <numeric>
 
+#include "common/point_index.h"
 #include "common/statistics.h"
 
 namespace docunfold::optimize {
@@ -58,19 +57,6 @@ struct Cluster {
   double Width() const { return t_max - t_min; }
   Eigen::Vector2d End(int k) const { return centre + (k == 0 ? t_min : t_max) * direction; }
 };
-
-struct EndpointCloud {
-  std::vector<Eigen::Vector2d> points;
-  size_t kdtree_get_point_count() const { return points.size(); }
-  double kdtree_get_pt(size_t i, size_t dim) const { return points[i][int(dim)]; }
-  template <class BBox>
-  bool kdtree_get_bbox(BBox&) const {
-    return false;
-  }
-};
-using EndpointTree =
-    nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, EndpointCloud>,
-                                        EndpointCloud, 2, uint32_t>;
 
 // Straightness h/w of the union of two clusters, and whether they overlap
 // along the line more than a little (then they are two parallel lines, or
@@ -162,30 +148,26 @@ Grouping GroupSegments(const MeshPair& meshes, const MarkerSet& markers,
   const double cos_parallel = std::cos(10 * kPi / 180);
   for (bool merged = true; merged;) {
     merged = false;
-    EndpointCloud cloud;
+    std::vector<Eigen::Vector2d> ends;
     std::vector<std::pair<int, int>> owner;  // cluster, end
     for (size_t c = 0; c < clusters.size(); ++c) {
       if (!clusters[c].alive) continue;
       for (int k = 0; k < 2; ++k) {
-        cloud.points.push_back(clusters[c].End(k));
+        ends.push_back(clusters[c].End(k));
         owner.emplace_back(int(c), k);
       }
     }
-    if (cloud.points.size() < 4) break;
-    EndpointTree tree(2, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(10));
-    tree.buildIndex();
+    if (ends.size() < 4) break;
+    const PointIndex2d tree(ends);
     struct Candidate {
       double cost;
       int a, b;
     };
     std::vector<Candidate> candidates;
-    std::vector<std::pair<uint32_t, double>> found;
     const double radius2 = gap * gap + offset * offset;
-    for (size_t e = 0; e < cloud.points.size(); ++e) {
-      found.clear();
-      tree.radiusSearch(cloud.points[e].data(), radius2, found, nanoflann::SearchParams());
+    for (size_t e = 0; e < ends.size(); ++e) {
       const auto [a, ka] = owner[e];
-      for (const auto& [f, d2] : found) {
+      for (const auto& [f, d2] : tree.WithinSquaredRadius(ends[e], radius2)) {
         const auto [b, kb] = owner[f];
         if (b <= a) continue;
         const Cluster& A = clusters[a];
@@ -194,7 +176,7 @@ Grouping GroupSegments(const MeshPair& meshes, const MarkerSet& markers,
         if (std::abs(A.direction.dot(B.direction)) < cos_parallel) continue;
         // The tolerance box, aligned with the longer of the two.
         const Eigen::Vector2d u = A.Width() >= B.Width() ? A.direction : B.direction;
-        const Eigen::Vector2d d = cloud.points[f] - cloud.points[e];
+        const Eigen::Vector2d d = ends[f] - ends[e];
         const double along = std::abs(d.dot(u)), across = std::abs(d.x() * u.y() - d.y() * u.x());
         if (along > gap || across > offset) continue;
         candidates.push_back({std::sqrt(d2), a, b});
