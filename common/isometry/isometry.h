@@ -1,6 +1,6 @@
 // The joint optimisation of the 3D page M and its flat twin M' (paper
-// "Document image rectification using isometric mapping" and "Algorithm";
-// DESIGN §6), shared by init-mesh and optimize.
+// "Document image rectification using isometric mapping" and "Algorithm"),
+// shared by init-mesh and optimize.
 //
 //   F = λ1 E_iso + λ2 E_dist + λ3 E_fair(M) + λ4 E_fair(M') + λ5 E_line + λ6 E_ray
 //
@@ -138,9 +138,9 @@ struct SolveOptions {
   // Direct CHOLMOD factorisation up to direct_max_vertices (the 21x31 first
   // round), block-Jacobi CG above: an inexact Gauss-Newton step (a few CG
   // iterations to a loose tolerance) is enough once the coarser rounds have
-  // settled the smooth part; measured on the truth of r01, r03, set07 it
-  // fits as well as exact steps at a fraction of the cost (a 41x61
-  // factorisation costs ~0.3 s, a 81x121 one ~5 s with the reference BLAS).
+  // settled the smooth part, and it fits as well as exact steps at a
+  // fraction of the cost of factorising the fine grids. See
+  // docs/decisions/optimize.md, "Conjugate gradients on the fine grids".
   LinearSolver linear_solver = LinearSolver::kAuto;
   int direct_max_vertices = 1000;
   int cg_max_iterations = 40;     // per Gauss-Newton step

@@ -76,10 +76,9 @@ Work Normalise(const Problem& p, const SolveOptions& o) {
   if (o.iso_normalization == IsoNormalization::kStrain) {
     // c_iso divided by ℓ², the mean squared diagonal length of the quads of
     // M' at the start (of M when M' is degenerate): rows are strains of an
-    // average quad. (Dividing each quad by its own ℓ_q² was tried: it lets
-    // the small quads of perspective-compressed grid corners dominate and
-    // measured worse, 2.0 % vs 0.9 % edge error on set08 and 0.44 % vs
-    // 0.35 % on r01.)
+    // average quad. (Dividing each quad by its own ℓ_q² lets the small
+    // quads of perspective-compressed grid corners dominate; see
+    // docs/decisions/optimize.md, "One strain scale for every quad".)
     const int quads = w.state.grid.NumQuads();
     auto mean_diag2 = [&](const auto& v) {
       double sum = 0;
