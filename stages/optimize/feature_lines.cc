@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <optional>
 
 #include "common/point_index.h"
 #include "common/statistics.h"
@@ -57,6 +58,54 @@ struct Cluster {
   double Width() const { return t_max - t_min; }
   Eigen::Vector2d End(int k) const { return centre + (k == 0 ? t_min : t_max) * direction; }
 };
+
+// Two clusters that may merge into one line; cost: the distance between
+// their closest ends.
+struct MergeCandidate {
+  double cost;
+  int a, b;
+};
+
+// Pairs of live clusters of one kind, within 10 degrees of parallel, whose
+// ends lie in the tolerance box (`gap` along the longer one, `offset`
+// across), cheapest first; nullopt when fewer than two clusters are alive.
+std::optional<std::vector<MergeCandidate>> MergeCandidates(const std::vector<Cluster>& clusters,
+                                                           double gap, double offset) {
+  const double cos_parallel = std::cos(10 * kPi / 180);
+  std::vector<Eigen::Vector2d> ends;
+  std::vector<std::pair<int, int>> owner;  // cluster, end
+  for (size_t c = 0; c < clusters.size(); ++c) {
+    if (!clusters[c].alive) continue;
+    for (int k = 0; k < 2; ++k) {
+      ends.push_back(clusters[c].End(k));
+      owner.emplace_back(int(c), k);
+    }
+  }
+  if (ends.size() < 4) return std::nullopt;
+  const PointIndex2d tree(ends);
+  std::vector<MergeCandidate> candidates;
+  const double radius2 = gap * gap + offset * offset;
+  for (size_t e = 0; e < ends.size(); ++e) {
+    const auto [a, ka] = owner[e];
+    for (const auto& [f, d2] : tree.WithinSquaredRadius(ends[e], radius2)) {
+      const auto [b, kb] = owner[f];
+      if (b <= a) continue;
+      const Cluster& A = clusters[a];
+      const Cluster& B = clusters[b];
+      if (A.kind != B.kind) continue;
+      if (std::abs(A.direction.dot(B.direction)) < cos_parallel) continue;
+      // The tolerance box, aligned with the longer of the two.
+      const Eigen::Vector2d u = A.Width() >= B.Width() ? A.direction : B.direction;
+      const Eigen::Vector2d d = ends[f] - ends[e];
+      const double along = std::abs(d.dot(u)), across = std::abs(d.x() * u.y() - d.y() * u.x());
+      if (along > gap || across > offset) continue;
+      candidates.push_back({std::sqrt(d2), a, b});
+    }
+  }
+  std::sort(candidates.begin(), candidates.end(),
+            [](const MergeCandidate& x, const MergeCandidate& y) { return x.cost < y.cost; });
+  return candidates;
+}
 
 // Straightness h/w of the union of two clusters, and whether they overlap
 // along the line more than a little (then they are two parallel lines, or
@@ -145,47 +194,13 @@ Grouping GroupSegments(const MeshPair& meshes, const MarkerSet& markers,
     clusters.push_back(std::move(c));
   }
 
-  const double cos_parallel = std::cos(10 * kPi / 180);
   for (bool merged = true; merged;) {
     merged = false;
-    std::vector<Eigen::Vector2d> ends;
-    std::vector<std::pair<int, int>> owner;  // cluster, end
-    for (size_t c = 0; c < clusters.size(); ++c) {
-      if (!clusters[c].alive) continue;
-      for (int k = 0; k < 2; ++k) {
-        ends.push_back(clusters[c].End(k));
-        owner.emplace_back(int(c), k);
-      }
-    }
-    if (ends.size() < 4) break;
-    const PointIndex2d tree(ends);
-    struct Candidate {
-      double cost;
-      int a, b;
-    };
-    std::vector<Candidate> candidates;
-    const double radius2 = gap * gap + offset * offset;
-    for (size_t e = 0; e < ends.size(); ++e) {
-      const auto [a, ka] = owner[e];
-      for (const auto& [f, d2] : tree.WithinSquaredRadius(ends[e], radius2)) {
-        const auto [b, kb] = owner[f];
-        if (b <= a) continue;
-        const Cluster& A = clusters[a];
-        const Cluster& B = clusters[b];
-        if (A.kind != B.kind) continue;
-        if (std::abs(A.direction.dot(B.direction)) < cos_parallel) continue;
-        // The tolerance box, aligned with the longer of the two.
-        const Eigen::Vector2d u = A.Width() >= B.Width() ? A.direction : B.direction;
-        const Eigen::Vector2d d = ends[f] - ends[e];
-        const double along = std::abs(d.dot(u)), across = std::abs(d.x() * u.y() - d.y() * u.x());
-        if (along > gap || across > offset) continue;
-        candidates.push_back({std::sqrt(d2), a, b});
-      }
-    }
-    std::sort(candidates.begin(), candidates.end(),
-              [](const Candidate& x, const Candidate& y) { return x.cost < y.cost; });
+    const std::optional<std::vector<MergeCandidate>> candidates =
+        MergeCandidates(clusters, gap, offset);
+    if (!candidates) break;
     std::vector<char> touched(clusters.size(), 0);
-    for (const Candidate& c : candidates) {
+    for (const MergeCandidate& c : *candidates) {
       if (touched[c.a] || touched[c.b] || !clusters[c.a].alive || !clusters[c.b].alive) continue;
       double straightness = 0;
       if (!MergedIsStraight(clusters[c.a], clusters[c.b], o.straightness, &straightness)) continue;
