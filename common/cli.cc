@@ -30,17 +30,10 @@ void LimitOpenMpThreads(char** argv) {
 
 void Log(const std::string& message) { std::cerr << ProgramName() << ": " << message << std::endl; }
 
-int RunStage(const std::string& program, OptionTable& options, int argc, char** argv,
-             const std::function<void()>& body) {
-  if (argc == 2 && std::string(argv[1]) == "--help-markdown") {
-    std::cout << options.Markdown();
-    return kExitOk;
-  }
-  return RunStage(program, options.app(), argc, argv, body);
-}
+namespace {
 
-int RunStage(const std::string& program, CLI::App& app, int argc, char** argv,
-             const std::function<void()>& body) {
+int ParseAndRun(const std::string& program, CLI::App& app, int argc, char** argv,
+                const std::function<void()>& body) {
   SetProgramName(program);
   app.set_version_flag("--version", std::string(ProgramVersion()));
   try {
@@ -82,6 +75,17 @@ int RunStage(const std::string& program, CLI::App& app, int argc, char** argv,
   }
 }
 
+}  // namespace
+
+int RunStage(const std::string& program, OptionTable& options, int argc, char** argv,
+             const std::function<void()>& body) {
+  if (argc == 2 && std::string(argv[1]) == "--help-markdown") {
+    std::cout << options.Markdown();
+    return kExitOk;
+  }
+  return ParseAndRun(program, options.app(), argc, argv, body);
+}
+
 Progress::Progress(std::string what, long total)
     : what_(std::move(what)),
       total_(total),
@@ -103,36 +107,6 @@ void Progress::Done() {
 
 double SecondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
-void AddFairnessBoostOptions(CLI::App& app, double* unsupported_fairness, double* support_radius) {
-  app.add_option("--unsupported-fairness", *unsupported_fairness,
-                 "lambda3 is multiplied by up to this where M has no point within "
-                 "--support-radius (blank paper keeps its panel's plane); 1 = off")
-      ->capture_default_str()
-      ->check(CLI::Range(1.0, 1e9));
-  app.add_option("--support-radius", *support_radius,
-                 "distance to the nearest point, along M, beyond which fairness stiffens "
-                 "(fraction of the model size; full at twice this)")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 1.0));
-}
-
-void AddIsoEdgesOption(CLI::App& app, double* iso_edges) {
-  app.add_option("--iso-edges", *iso_edges,
-                 "weight of E_iso's edge-length rows next to the paper's diagonal rows "
-                 "(0 = diagonals only, as in the paper)")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 100.0));
-}
-
-void AddFair2dAlongOption(CLI::App& app, double* fair2d_along) {
-  app.add_option("--fair2d-along", *fair2d_along,
-                 "weight of E_fair(M') along each grid line against across it (1 = the "
-                 "paper's even spacing; 0 = bending only, so M' spaces vertices as unevenly "
-                 "as the isometry asks)")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 1.0));
 }
 
 std::string Fixed(double value, int decimals) {

@@ -28,8 +28,6 @@ const std::string& ProgramName();
 // for docs/stages/ instead.
 int RunStage(const std::string& program, OptionTable& options, int argc, char** argv,
              const std::function<void()>& body);
-int RunStage(const std::string& program, CLI::App& app, int argc, char** argv,
-             const std::function<void()>& body);
 
 // For programs that use Tesseract: its OpenMP parallelism (up to 10 threads
 // per region) spins on few shared cores and makes OCR several times slower.
@@ -37,18 +35,6 @@ int RunStage(const std::string& program, CLI::App& app, int argc, char** argv,
 // is unset this sets it to 1 and re-executes the program once (call first
 // thing in main; returns normally when nothing needs doing or exec fails).
 void LimitOpenMpThreads(char** argv);
-
-// --unsupported-fairness and --support-radius, the same in every stage that
-// runs the isometric solver (isometry::SolveOptions documents them).
-void AddFairnessBoostOptions(CLI::App& app, double* unsupported_fairness, double* support_radius);
-
-// --iso-edges, the same in every stage that runs the isometric solver
-// (isometry::SolveOptions::iso_edges documents it).
-void AddIsoEdgesOption(CLI::App& app, double* iso_edges);
-
-// --fair2d-along, the same in every stage that runs the isometric solver
-// (isometry::SolveOptions::fair2d_along documents it).
-void AddFair2dAlongOption(CLI::App& app, double* fair2d_along);
 
 // One plain line on stderr: "<program>: <message>".
 void Log(const std::string& message);

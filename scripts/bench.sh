@@ -36,7 +36,7 @@
 # Rows per set: homography, oracle and oracle-seen (build/bin/baseline),
 # docunfold (60_render/rectified.png) when render ran, and, when the binaries exist,
 # docunfold-init (render on 40_init), docunfold-nofeatures and
-# docunfold-boundary (optimize --no-features / --boundary-only, then render),
+# docunfold-boundary (optimize --no-feature-lines / --boundary-only, then render),
 # and docunfold-deshaded and oracle-deshaded (render / baseline --shading
 # remove: the light's shading divided out of the final meshes' rendering and
 # of the oracle alike).
@@ -216,7 +216,7 @@ optimize_variant() {  # optimize_variant <row> <suffix> <optimize flag>
     --features "$work/30_features/features.json" || return
   image=$work/60_render_$suffix/rectified.png
 }
-make_row_docunfold-nofeatures() { optimize_variant docunfold-nofeatures nofeatures --no-features; }
+make_row_docunfold-nofeatures() { optimize_variant docunfold-nofeatures nofeatures --no-feature-lines; }
 make_row_docunfold-boundary() { optimize_variant docunfold-boundary boundary --boundary-only; }
 
 ROWS=(homography oracle oracle-seen docunfold docunfold-init docunfold-nofeatures docunfold-boundary

@@ -1,6 +1,6 @@
 // The joint optimisation of the 3D page M and its flat twin M' (paper
-// "Document image rectification using isometric mapping" and "Algorithm";
-// DESIGN §6), shared by init-mesh and optimize.
+// "Document image rectification using isometric mapping" and "Algorithm"),
+// shared by init-mesh and optimize.
 //
 //   F = λ1 E_iso + λ2 E_dist + λ3 E_fair(M) + λ4 E_fair(M') + λ5 E_line + λ6 E_ray
 //
@@ -75,9 +75,6 @@ struct FeatureLine {
   // parallel or perpendicular to each other, which straightness alone does
   // not ask (the paper's E_line leaves M' free to shear).
   bool axis_aligned = false;
-  // A row of text: with SolveOptions::line_spacing > 0 it is drawn toward
-  // the middle of its neighbouring rows (see there).
-  bool text_row = false;
   Eigen::Vector2d Normal() const { return {std::cos(theta), std::sin(theta)}; }
   double SignedDistance(const Eigen::Vector2d& p) const { return Normal().dot(p) - offset; }
 };
@@ -136,36 +133,14 @@ struct SolveOptions {
   // rows per quad (0 = the paper). The diagonals alone leave a quad of M free
   // to twist out of its plane, which lengthens its edges.
   double iso_edges = 0;
-  // Weight of the part of E_fair(M') along each grid line, against the part
-  // across it (bending). 1 is the paper's |v'_i − 2 v'_j + v'_k|² (both parts
-  // alike); below 1 M' may space its vertices along a grid line as unevenly
-  // as the isometry asks. The paper's even spacing cannot be granted where
-  // the reference image's even grid is uneven on the page (a panel seen at a
-  // grazing angle: few grid rows, each long on the page), and M, held to M'
-  // by the isometry, swings such a panel about its fold where it has few
-  // points to hold it. 0 = bending only.
-  double fair2d_along = 1;
-  // E_fair(M') measures how far each second difference has moved from its
-  // value in the M' given to Solve instead of from zero: it smooths the
-  // change of M' and no longer pulls M' (and M with it) toward an evenly
-  // spaced, straight grid, which the given pair may rightly not be.
-  bool fair2d_relative = false;
-  // λ3 is multiplied by up to this where M has no inlier point within
-  // support_radius (fraction of the model size, along M), reaching it at
-  // twice that distance: blank paper then continues its panel's plane
-  // instead of drifting (the paper's λ3 is tiny so creases stay sharp,
-  // which leaves regions without points almost unconstrained). Decided at
-  // the start of each solve (then held, so F stays one function). 1 = off.
-  double unsupported_fairness = 1;
-  double support_radius = 0.03;
 
   Method method = Method::kGaussNewton;
   // Direct CHOLMOD factorisation up to direct_max_vertices (the 21x31 first
   // round), block-Jacobi CG above: an inexact Gauss-Newton step (a few CG
   // iterations to a loose tolerance) is enough once the coarser rounds have
-  // settled the smooth part; measured on the truth of r01, r03, set07 it
-  // fits as well as exact steps at a fraction of the cost (a 41x61
-  // factorisation costs ~0.3 s, a 81x121 one ~5 s with the reference BLAS).
+  // settled the smooth part, and it fits as well as exact steps at a
+  // fraction of the cost of factorising the fine grids. See
+  // docs/decisions/optimize.md, "Conjugate gradients on the fine grids".
   LinearSolver linear_solver = LinearSolver::kAuto;
   int direct_max_vertices = 1000;
   int cg_max_iterations = 40;     // per Gauss-Newton step
@@ -202,17 +177,6 @@ struct SolveOptions {
   // every marker's p' onto its line and keep the face and barycentrics of
   // the moved point (found in M') as the marker's new surface point.
   bool project_markers = false;
-  // Rows of text in a block are evenly spaced on the page. Where a fold runs
-  // along the rows, straightness does not constrain how far apart M' puts
-  // them, and a fold M does not open far enough (no points on a panel seen
-  // obliquely) squeezes the rows there. After the lines are fitted, each
-  // text row with a parallel, overlapping neighbouring row on both sides
-  // whose two gaps differ by at most max_spacing_ratio from each other and
-  // from the page's typical row pitch (median nearest gap) is moved this
-  // fraction of the way to the middle of its neighbours (before the markers
-  // are projected, so E_ray then carries the spacing to M). 0 = off.
-  double line_spacing = 0;
-  double max_spacing_ratio = 1.35;
 
   // OpenMP threads for footpoints, assembly and CG at most; each outer
   // iteration runs fewer while other processes keep cores busy (CpuShare).
@@ -241,8 +205,6 @@ struct IterationReport {
   int outliers = 0;
   int markers = 0;
   int lines = 0;
-  // Text rows moved toward the middle of their neighbours (line_spacing).
-  int spaced_rows = 0;
   double seconds = 0;            // wall time since the solve started, at the end of this iteration
   double footpoint_seconds = 0;  // footpoints + outliers + lines
   double step_seconds = 0;       // assembly + linear solves (or L-BFGS batch)

@@ -2,48 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdint>
-#include <nanoflann.hpp>
 
 namespace docunfold::isometry {
-namespace {
-
-template <int D>
-struct CloudAdaptor {
-  const std::vector<Eigen::Matrix<double, D, 1>>* points;
-  size_t kdtree_get_point_count() const { return points->size(); }
-  double kdtree_get_pt(size_t i, size_t dim) const { return (*points)[i][int(dim)]; }
-  template <class BBox>
-  bool kdtree_get_bbox(BBox&) const {
-    return false;
-  }
-};
-
-template <int D>
-using KdTree =
-    nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, CloudAdaptor<D>>,
-                                        CloudAdaptor<D>, D, uint32_t>;
-using Matches = std::vector<std::pair<uint32_t, double>>;
-
-}  // namespace
-
-struct TriangleMeshIndex::Tree {
-  CloudAdaptor<3> adaptor;
-  KdTree<3> tree;
-  explicit Tree(const std::vector<Eigen::Vector3d>* c)
-      : adaptor{c}, tree(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(10)) {
-    tree.buildIndex();
-  }
-};
-
-struct FlatMeshLocator::Tree {
-  CloudAdaptor<2> adaptor;
-  KdTree<2> tree;
-  explicit Tree(const std::vector<Eigen::Vector2d>* c)
-      : adaptor{c}, tree(2, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(10)) {
-    tree.buildIndex();
-  }
-};
 
 // Ericson, Real-Time Collision Detection, 5.1.5, with barycentrics kept.
 ClosestPoint ClosestPointOnTriangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
@@ -88,13 +48,14 @@ ClosestPoint ClosestPointOnTriangle(const Eigen::Vector3d& p, const Eigen::Vecto
 TriangleMeshIndex::TriangleMeshIndex(const std::vector<Eigen::Vector3d>& vertices,
                                      const std::vector<Triangle>& triangles)
     : vertices_(vertices), triangles_(triangles) {
-  centroids_.reserve(triangles_.size());
+  std::vector<Eigen::Vector3d> centroids;
+  centroids.reserve(triangles_.size());
   for (const Triangle& t : triangles_) {
     const Eigen::Vector3d g = (vertices_[t[0]] + vertices_[t[1]] + vertices_[t[2]]) / 3;
-    centroids_.push_back(g);
+    centroids.push_back(g);
     for (int k = 0; k < 3; ++k) max_radius_ = std::max(max_radius_, (vertices_[t[k]] - g).norm());
   }
-  tree_ = std::make_unique<Tree>(&centroids_);
+  tree_ = std::make_unique<PointIndex3d>(std::move(centroids));
 }
 
 TriangleMeshIndex::~TriangleMeshIndex() = default;
@@ -102,34 +63,25 @@ TriangleMeshIndex::~TriangleMeshIndex() = default;
 std::optional<ClosestPoint> TriangleMeshIndex::Closest(const Eigen::Vector3d& p,
                                                        double max_distance) const {
   if (triangles_.empty()) return std::nullopt;
-  auto exact = [&](size_t t) {
+  auto exact = [&](int t) {
     const Triangle& tri = triangles_[t];
     ClosestPoint c =
         ClosestPointOnTriangle(p, vertices_[tri[0]], vertices_[tri[1]], vertices_[tri[2]]);
-    c.triangle = int(t);
+    c.triangle = t;
     return c;
   };
   // A few nearest centroids give an upper bound on the distance.
-  const size_t k = std::min<size_t>(6, triangles_.size());
-  uint32_t idx[6];
-  double d2[6];
-  nanoflann::KNNResultSet<double, uint32_t> knn(k);
-  knn.init(idx, d2);
-  tree_->tree.findNeighbors(knn, p.data(), nanoflann::SearchParams());
+  const std::vector<PointIndex3d::Neighbour> nearest = tree_->Nearest(p, 6);
   // Any triangle is at least (centroid distance - max_radius) away.
-  if (std::sqrt(d2[0]) - max_radius_ > max_distance) return std::nullopt;
+  if (std::sqrt(nearest[0].second) - max_radius_ > max_distance) return std::nullopt;
   ClosestPoint best;
-  for (size_t i = 0; i < k; ++i) {
-    ClosestPoint c = exact(idx[i]);
+  for (const auto& [t, dist2] : nearest) {
+    ClosestPoint c = exact(t);
     if (c.distance < best.distance) best = c;
   }
   const double bound = std::min(best.distance, max_distance);
   const double radius = bound + max_radius_;
-  Matches matches;
-  nanoflann::SearchParams params;
-  params.sorted = true;
-  tree_->tree.radiusSearch(p.data(), radius * radius, matches, params);
-  for (const auto& [t, dist2] : matches) {
+  for (const auto& [t, dist2] : tree_->WithinSquaredRadius(p, radius * radius)) {
     if (std::sqrt(dist2) - max_radius_ > std::min(best.distance, max_distance)) break;
     ClosestPoint c = exact(t);
     if (c.distance < best.distance) best = c;
@@ -140,24 +92,22 @@ std::optional<ClosestPoint> TriangleMeshIndex::Closest(const Eigen::Vector3d& p,
 
 FlatMeshLocator::FlatMeshLocator(const MeshPair& meshes)
     : vertices_(meshes.mesh2d), triangles_(meshes.grid.Triangles()) {
-  centroids_.reserve(triangles_.size());
+  std::vector<Eigen::Vector2d> centroids;
+  centroids.reserve(triangles_.size());
   for (const Triangle& t : triangles_) {
     const Eigen::Vector2d g = (vertices_[t[0]] + vertices_[t[1]] + vertices_[t[2]]) / 3;
-    centroids_.push_back(g);
+    centroids.push_back(g);
     for (int k = 0; k < 3; ++k) max_radius_ = std::max(max_radius_, (vertices_[t[k]] - g).norm());
   }
-  tree_ = std::make_unique<Tree>(&centroids_);
+  tree_ = std::make_unique<PointIndex2d>(std::move(centroids));
 }
 
 FlatMeshLocator::~FlatMeshLocator() = default;
 
 std::optional<SurfacePoint> FlatMeshLocator::Locate(const Eigen::Vector2d& p) const {
   if (triangles_.empty()) return std::nullopt;
-  Matches matches;
-  nanoflann::SearchParams params;
-  params.sorted = true;
   const double r = max_radius_ * (1 + 1e-9);
-  tree_->tree.radiusSearch(p.data(), r * r, matches, params);
+  const std::vector<PointIndex2d::Neighbour> matches = tree_->WithinSquaredRadius(p, r * r);
   std::optional<SurfacePoint> best;
   double best_violation = std::numeric_limits<double>::infinity();
   for (const auto& match : matches) {
@@ -173,7 +123,7 @@ std::optional<SurfacePoint> FlatMeshLocator::Locate(const Eigen::Vector2d& p) co
     const double violation = -std::min(0.0, bary.minCoeff());
     if (violation < best_violation) {
       best_violation = violation;
-      best = SurfacePoint{int(match.first), bary};
+      best = SurfacePoint{match.first, bary};
       if (violation == 0) break;
     }
   }

@@ -1,7 +1,8 @@
 // Spatial queries on the triangulated grid: closest point of a 3D point on M
 // (footpoints for E_dist, distances for outliers and tests) and the triangle
 // of M' containing a 2D point (feature line projection). A k-d tree over
-// triangle centroids (nanoflann) narrows the search; results are exact.
+// triangle centroids (common/point_index.h) narrows the search; results are
+// exact.
 #pragma once
 
 #include <Eigen/Core>
@@ -11,6 +12,7 @@
 #include <vector>
 
 #include "common/grid_mesh.h"
+#include "common/point_index.h"
 #include "common/raster.h"
 
 namespace docunfold::isometry {
@@ -41,12 +43,10 @@ class TriangleMeshIndex {
       double max_distance = std::numeric_limits<double>::infinity()) const;
 
  private:
-  struct Tree;
   std::vector<Eigen::Vector3d> vertices_;
   std::vector<Triangle> triangles_;
-  std::vector<Eigen::Vector3d> centroids_;
-  double max_radius_ = 0;  // largest centroid-to-corner distance
-  std::unique_ptr<Tree> tree_;
+  double max_radius_ = 0;               // largest centroid-to-corner distance
+  std::unique_ptr<PointIndex3d> tree_;  // of the triangles' centroids
 };
 
 // Point location in the flat mesh M' (triangles of the grid, see
@@ -61,12 +61,10 @@ class FlatMeshLocator {
   std::optional<SurfacePoint> Locate(const Eigen::Vector2d& p) const;
 
  private:
-  struct Tree;
   std::vector<Eigen::Vector2d> vertices_;
   std::vector<Triangle> triangles_;
-  std::vector<Eigen::Vector2d> centroids_;
   double max_radius_ = 0;
-  std::unique_ptr<Tree> tree_;
+  std::unique_ptr<PointIndex2d> tree_;  // of the triangles' centroids
 };
 
 }  // namespace docunfold::isometry

@@ -40,16 +40,9 @@ struct StepData {
   std::vector<Marker> markers;        // rays in the normalised frame
   double iso_scale = 1;               // multiplies every c_iso (see IsoNormalization)
   double iso_edge_weight = 0;         // edge rows' share of E_iso (SolveOptions::iso_edges)
-  double fair2d_along = 1;            // SolveOptions::fair2d_along
-  // Per fairness triplet, the second difference E_fair(M') measures from
-  // (SolveOptions::fair2d_relative); empty: zero.
-  std::vector<Eigen::Vector2d> fair2d_rest;
   double beta_point = 1;
   double beta_normal = 0.1;
   int num_inliers = 0;
-  // Multiplier of E_fair(M)'s rows centred on each vertex (empty: all 1):
-  // stiffer where no point is near (see SolveOptions::unsupported_fairness).
-  std::vector<double> fair3d_scale;
 };
 
 struct Row {
@@ -183,54 +176,19 @@ inline std::array<int, 3> FairTriplet(const QuadGrid& g, int t) {
   const int c = t / (g.ny - 2), r = t % (g.ny - 2) + 1;
   return {g.Index(r - 1, c), g.Index(r, c), g.Index(r + 1, c)};
 }
-// dims 0..2 (M) or 3..4 (M'): one row per coordinate. M' with
-// fair2d_along < 1: s = v'_i − 2 v'_j + v'_k split along u = v'_k − v'_i
-// (t = u/|u|, n its normal): rows n·s and √fair2d_along t·s. Exact
-// derivatives: ∂(n·s)/∂u = −(t·s/|u|) n and ∂(t·s)/∂u = (n·s/|u|) n.
-inline int FairRows(const State& s, const StepData& data, int t, bool flat, Row* rows) {
+// dims 0..2 (M) or 3..4 (M'): one row per coordinate.
+inline int FairRows(const State& s, int t, bool flat, Row* rows) {
   const auto v = FairTriplet(s.grid, t);
-  const Eigen::Vector2d rest =
-      flat && !data.fair2d_rest.empty() ? data.fair2d_rest[t] : Eigen::Vector2d::Zero();
-  if (flat && data.fair2d_along < 1) {
-    const Eigen::Vector2d u = s.v2[v[2]] - s.v2[v[0]];
-    const Eigen::Vector2d sd = s.v2[v[0]] - 2 * s.v2[v[1]] + s.v2[v[2]] - rest;
-    const double len = u.norm();
-    if (!(len > 0)) {  // a collapsed triplet has no direction to split along
-      rows[0].Reset();
-      rows[0].Add(v[1]);
-      rows[1] = rows[0];
-      return 2;
-    }
-    const Eigen::Vector2d tangent = u / len;
-    const Eigen::Vector2d normal = Eigen::Vector2d(-u.y(), u.x()) / len;
-    const double along = tangent.dot(sd), across = normal.dot(sd);
-    Row& bend = rows[0];
-    bend.Reset();
-    bend.value = across;
-    bend.Add(v[0]).tail<2>() = normal + (along / len) * normal;
-    bend.Add(v[1]).tail<2>() = -2 * normal;
-    bend.Add(v[2]).tail<2>() = normal - (along / len) * normal;
-    const double k = std::sqrt(data.fair2d_along);
-    Row& stretch = rows[1];
-    stretch.Reset();
-    stretch.value = k * along;
-    stretch.Add(v[0]).tail<2>() = k * (tangent - (across / len) * normal);
-    stretch.Add(v[1]).tail<2>() = -2 * k * tangent;
-    stretch.Add(v[2]).tail<2>() = k * (tangent + (across / len) * normal);
-    return 2;
-  }
   const int first = flat ? 3 : 0, n = flat ? 2 : 3;
-  const double scale = flat || data.fair3d_scale.empty() ? 1.0 : std::sqrt(data.fair3d_scale[v[1]]);
   for (int k = 0; k < n; ++k) {
     const int dim = first + k;
     Row& r = rows[k];
     r.Reset();
-    r.value = flat ? s.v2[v[0]][k] - 2 * s.v2[v[1]][k] + s.v2[v[2]][k] - rest[k]
+    r.value = flat ? s.v2[v[0]][k] - 2 * s.v2[v[1]][k] + s.v2[v[2]][k]
                    : s.v3[v[0]][k] - 2 * s.v3[v[1]][k] + s.v3[v[2]][k];
-    r.value *= scale;
-    r.Add(v[0])[dim] = scale;
-    r.Add(v[1])[dim] = -2 * scale;
-    r.Add(v[2])[dim] = scale;
+    r.Add(v[0])[dim] = 1;
+    r.Add(v[1])[dim] = -2;
+    r.Add(v[2])[dim] = 1;
   }
   return n;
 }
@@ -302,9 +260,9 @@ void ForEachRow(const State& s, const StepData& data, Sink&& sink) {
   }
   const int triplets = NumFairTriplets(s.grid);
   for (int t = 0; t < triplets; ++t) {
-    int n = FairRows(s, data, t, false, rows);
+    int n = FairRows(s, t, false, rows);
     for (int i = 0; i < n; ++i) sink(kFair3d, rows[i]);
-    n = FairRows(s, data, t, true, rows);
+    n = FairRows(s, t, true, rows);
     for (int i = 0; i < n; ++i) sink(kFair2d, rows[i]);
   }
   for (int m = 0; m < int(data.markers.size()); ++m) {

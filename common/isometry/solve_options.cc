@@ -12,12 +12,6 @@ void DeclareSolveOptions(OptionTable& table, SolveOptions* o) {
   table.Value("outlier-distance", &o->outlier_distance, 0.0, 10.0,
               "φ: points farther from M than this fraction of the model size are ignored "
               "(re-decided every outer iteration)");
-  table.Value("unsupported-fairness", &o->unsupported_fairness, 1.0, 1e9,
-              "λ3 is multiplied by up to this where M has no point within --support-radius "
-              "(blank paper keeps its panel's plane); 1 = off");
-  table.Value("support-radius", &o->support_radius, 0.0, 1.0,
-              "distance to the nearest point, along M, beyond which fairness stiffens "
-              "(fraction of the model size; full at twice this)");
   table.Choice("iso-normalization", &o->iso_normalization,
                {{"strain", IsoNormalization::kStrain}, {"raw", IsoNormalization::kRaw}},
                "strain: E_iso as mean squared strain (independent of the grid's resolution); "
@@ -25,10 +19,6 @@ void DeclareSolveOptions(OptionTable& table, SolveOptions* o) {
   table.Value("iso-edges", &o->iso_edges, 0.0, 100.0,
               "weight of E_iso's edge-length rows next to the paper's diagonal rows (0 = "
               "diagonals only, as in the paper)");
-  table.Value("fair2d-along", &o->fair2d_along, 0.0, 1.0,
-              "weight of E_fair(M') along each grid line against across it (1 = the paper's "
-              "even spacing; 0 = bending only, so M' spaces vertices as unevenly as the "
-              "isometry asks)");
   table.Choice("solver", &o->method, {{"gn", Method::kGaussNewton}, {"lbfgs", Method::kLbfgs}},
                "gn: Gauss-Newton/Levenberg-Marquardt with sparse Cholesky; lbfgs: L-BFGS (the "
                "paper's)");

@@ -3,11 +3,10 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
-#include <cstdint>
-#include <nanoflann.hpp>
 #include <numeric>
 #include <optional>
 
+#include "common/point_index.h"
 #include "common/statistics.h"
 
 namespace docunfold::optimize {
@@ -60,18 +59,53 @@ struct Cluster {
   Eigen::Vector2d End(int k) const { return centre + (k == 0 ? t_min : t_max) * direction; }
 };
 
-struct EndpointCloud {
-  std::vector<Eigen::Vector2d> points;
-  size_t kdtree_get_point_count() const { return points.size(); }
-  double kdtree_get_pt(size_t i, size_t dim) const { return points[i][int(dim)]; }
-  template <class BBox>
-  bool kdtree_get_bbox(BBox&) const {
-    return false;
-  }
+// Two clusters that may merge into one line; cost: the distance between
+// their closest ends.
+struct MergeCandidate {
+  double cost;
+  int a, b;
 };
-using EndpointTree =
-    nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, EndpointCloud>,
-                                        EndpointCloud, 2, uint32_t>;
+
+// Pairs of live clusters of one kind, within 10 degrees of parallel, whose
+// ends lie in the tolerance box (`gap` along the longer one, `offset`
+// across), cheapest first; nullopt when fewer than two clusters are alive.
+std::optional<std::vector<MergeCandidate>> MergeCandidates(const std::vector<Cluster>& clusters,
+                                                           double gap, double offset) {
+  const double cos_parallel = std::cos(10 * kPi / 180);
+  std::vector<Eigen::Vector2d> ends;
+  std::vector<std::pair<int, int>> owner;  // cluster, end
+  for (size_t c = 0; c < clusters.size(); ++c) {
+    if (!clusters[c].alive) continue;
+    for (int k = 0; k < 2; ++k) {
+      ends.push_back(clusters[c].End(k));
+      owner.emplace_back(int(c), k);
+    }
+  }
+  if (ends.size() < 4) return std::nullopt;
+  const PointIndex2d tree(ends);
+  std::vector<MergeCandidate> candidates;
+  const double radius2 = gap * gap + offset * offset;
+  for (size_t e = 0; e < ends.size(); ++e) {
+    const auto [a, ka] = owner[e];
+    for (const auto& [f, d2] : tree.WithinSquaredRadius(ends[e], radius2)) {
+      const auto [b, kb] = owner[f];
+      if (b <= a) continue;
+      const Cluster& A = clusters[a];
+      const Cluster& B = clusters[b];
+      if (A.kind != B.kind) continue;
+      if (std::abs(A.direction.dot(B.direction)) < cos_parallel) continue;
+      // The tolerance box, aligned with the longer of the two.
+      const Eigen::Vector2d u = A.Width() >= B.Width() ? A.direction : B.direction;
+      const Eigen::Vector2d d = ends[f] - ends[e];
+      const double along = std::abs(d.dot(u)), across = std::abs(d.x() * u.y() - d.y() * u.x());
+      if (along > gap || across > offset) continue;
+      candidates.push_back({std::sqrt(d2), a, b});
+    }
+  }
+  std::sort(candidates.begin(), candidates.end(),
+            [](const MergeCandidate& x, const MergeCandidate& y) { return x.cost < y.cost; });
+  return candidates;
+}
 
 // Straightness h/w of the union of two clusters, and whether they overlap
 // along the line more than a little (then they are two parallel lines, or
@@ -86,68 +120,6 @@ bool MergedIsStraight(const Cluster& a, const Cluster& b, double max_straightnes
   const double overlap = a.Width() + b.Width() - u.Width();
   return *straightness < max_straightness && overlap < 0.3 * std::min(a.Width(), b.Width());
 }
-
-// The border edges of M as seen by a camera, for outline samples that lie
-// off M's image: their marker goes on the nearest border point, and the ray
-// term then pulls M's border out to the page's outline. Snapping to the
-// nearest covered pixel instead extrapolates a border triangle's plane onto
-// the ray, which leaves the ray term nothing to pull.
-class MeshBorder {
- public:
-  MeshBorder(const MeshPair& m, const PinholeCamera& camera) {
-    const QuadGrid& g = m.grid;
-    const std::vector<Triangle> tris = g.Triangles();
-    for (int t = 0; t < int(tris.size()); ++t) {
-      for (int i = 0; i < 3; ++i) {
-        const int j = (i + 1) % 3, a = tris[t][i], b = tris[t][j];
-        // Both ends in the grid's first or last row (column): an outer edge.
-        const int ra = a / g.nx, rb = b / g.nx, ca = a % g.nx, cb = b % g.nx;
-        const bool row_edge = ra == rb && (ra == 0 || ra == g.ny - 1);
-        const bool col_edge = ca == cb && (ca == 0 || ca == g.nx - 1);
-        if (!row_edge && !col_edge) continue;
-        const Eigen::Vector3d pa = camera.CamFromWorld(m.mesh3d[a]);
-        const Eigen::Vector3d pb = camera.CamFromWorld(m.mesh3d[b]);
-        if (pa.z() <= 0 || pb.z() <= 0) continue;
-        edges_.push_back({t, i, j, camera.ProjectCam(pa), camera.ProjectCam(pb)});
-      }
-    }
-  }
-
-  // The border point whose image is nearest to `pixel` within `radius`,
-  // among edges running within 45 degrees of `along` (so a sample near a
-  // corner keeps to its own side).
-  std::optional<SurfacePoint> Nearest(const Eigen::Vector2d& pixel, const Eigen::Vector2d& along,
-                                      double radius) const {
-    const double along_norm = along.norm();
-    std::optional<SurfacePoint> best;
-    double best_d = radius;
-    for (const Edge& e : edges_) {
-      const Eigen::Vector2d d = e.b - e.a;
-      const double len2 = d.squaredNorm();
-      if (len2 <= 0) continue;
-      if (along_norm > 0 &&
-          std::abs(d.dot(along)) < std::cos(kPi / 4) * std::sqrt(len2) * along_norm)
-        continue;
-      const double t = std::clamp((pixel - e.a).dot(d) / len2, 0.0, 1.0);
-      const double dist = (e.a + t * d - pixel).norm();
-      if (dist >= best_d) continue;
-      best_d = dist;
-      SurfacePoint sp;
-      sp.triangle = e.triangle;
-      sp.bary[e.corner_a] = 1 - t;
-      sp.bary[e.corner_b] = t;
-      best = sp;
-    }
-    return best;
-  }
-
- private:
-  struct Edge {
-    int triangle, corner_a, corner_b;
-    Eigen::Vector2d a, b;  // images of the two corners
-  };
-  std::vector<Edge> edges_;
-};
 
 }  // namespace
 
@@ -170,21 +142,12 @@ MarkerSet CastMarkers(const MeshPair& meshes, const PinholeCamera& reference,
   const double scale = std::min(1.0, std::sqrt(options.max_raster_pixels / pixels));
   PixelToSurface map(meshes, reference, scale);
   const Eigen::Vector3d origin = reference.Center();
-  const double border_radius =
-      options.border_snap * std::hypot(double(reference.width), double(reference.height));
-  std::optional<MeshBorder> border;
   MarkerSet set;
   set.markers_of_segment.assign(segments.size(), 0);
   for (size_t s = 0; s < segments.size(); ++s)
     for (size_t k = 0; k < segments[s].pixels.size(); ++k) {
       const Eigen::Vector2d& px = segments[s].pixels[k];
-      auto where = map.LookupNear(px, options.snap_px);
-      if (!where && segments[s].kind == "boundary" && border_radius > 0) {
-        if (!border) border.emplace(meshes, reference);
-        const auto& p = segments[s].pixels;
-        const Eigen::Vector2d along = p[std::min(k + 1, p.size() - 1)] - p[k > 0 ? k - 1 : 0];
-        where = border->Nearest(px, along, border_radius);
-      }
+      const auto where = map.LookupNear(px, options.snap_px);
       if (!where) continue;
       isometry::Marker m;
       m.where = *where;
@@ -231,51 +194,13 @@ Grouping GroupSegments(const MeshPair& meshes, const MarkerSet& markers,
     clusters.push_back(std::move(c));
   }
 
-  const double cos_parallel = std::cos(10 * kPi / 180);
   for (bool merged = true; merged;) {
     merged = false;
-    EndpointCloud cloud;
-    std::vector<std::pair<int, int>> owner;  // cluster, end
-    for (size_t c = 0; c < clusters.size(); ++c) {
-      if (!clusters[c].alive) continue;
-      for (int k = 0; k < 2; ++k) {
-        cloud.points.push_back(clusters[c].End(k));
-        owner.emplace_back(int(c), k);
-      }
-    }
-    if (cloud.points.size() < 4) break;
-    EndpointTree tree(2, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(10));
-    tree.buildIndex();
-    struct Candidate {
-      double cost;
-      int a, b;
-    };
-    std::vector<Candidate> candidates;
-    std::vector<std::pair<uint32_t, double>> found;
-    const double radius2 = gap * gap + offset * offset;
-    for (size_t e = 0; e < cloud.points.size(); ++e) {
-      found.clear();
-      tree.radiusSearch(cloud.points[e].data(), radius2, found, nanoflann::SearchParams());
-      const auto [a, ka] = owner[e];
-      for (const auto& [f, d2] : found) {
-        const auto [b, kb] = owner[f];
-        if (b <= a) continue;
-        const Cluster& A = clusters[a];
-        const Cluster& B = clusters[b];
-        if (A.kind != B.kind) continue;
-        if (std::abs(A.direction.dot(B.direction)) < cos_parallel) continue;
-        // The tolerance box, aligned with the longer of the two.
-        const Eigen::Vector2d u = A.Width() >= B.Width() ? A.direction : B.direction;
-        const Eigen::Vector2d d = cloud.points[f] - cloud.points[e];
-        const double along = std::abs(d.dot(u)), across = std::abs(d.x() * u.y() - d.y() * u.x());
-        if (along > gap || across > offset) continue;
-        candidates.push_back({std::sqrt(d2), a, b});
-      }
-    }
-    std::sort(candidates.begin(), candidates.end(),
-              [](const Candidate& x, const Candidate& y) { return x.cost < y.cost; });
+    const std::optional<std::vector<MergeCandidate>> candidates =
+        MergeCandidates(clusters, gap, offset);
+    if (!candidates) break;
     std::vector<char> touched(clusters.size(), 0);
-    for (const Candidate& c : candidates) {
+    for (const MergeCandidate& c : *candidates) {
       if (touched[c.a] || touched[c.b] || !clusters[c.a].alive || !clusters[c.b].alive) continue;
       double straightness = 0;
       if (!MergedIsStraight(clusters[c.a], clusters[c.b], o.straightness, &straightness)) continue;
@@ -350,7 +275,6 @@ std::vector<isometry::FeatureLine> AssignLines(const MeshPair& meshes, const Gro
   for (int l = 0; l < n; ++l) {
     lines[l].axis_aligned = axis_lines == AxisLines::kAll || (axis_lines == AxisLines::kFeatures &&
                                                               grouping.line_kind[l] != "boundary");
-    lines[l].text_row = grouping.line_kind[l] == "text";
   }
   return lines;
 }
@@ -405,49 +329,6 @@ int DropSideOutliers(const MeshPair& meshes, const Grouping& grouping, double to
       }
   }
   return dropped;
-}
-
-namespace {
-
-// Corner k (TL TR BR BL) lies between sides kCornerSides[k] (top 0, right 1,
-// bottom 2, left 3).
-constexpr int kCornerSides[4][2] = {{0, 3}, {0, 1}, {1, 2}, {2, 3}};
-
-int CornerRow(const QuadGrid& grid, int k) { return k >= 2 ? grid.ny - 1 : 0; }
-int CornerCol(const QuadGrid& grid, int k) { return k == 1 || k == 2 ? grid.nx - 1 : 0; }
-
-}  // namespace
-
-std::array<bool, 4> HeldCorners(const MeshPair& meshes, const Boundary& boundary,
-                                const PinholeCamera& reference, double max_px) {
-  std::array<bool, 4> held = {false, false, false, false};
-  const QuadGrid& grid = meshes.grid;
-  if (grid.nx < 2 || grid.ny < 2) return held;
-  for (int k = 0; k < 4; ++k) {
-    if (!boundary.sides[kCornerSides[k][0]].real || !boundary.sides[kCornerSides[k][1]].real)
-      continue;
-    const Eigen::Vector3d x_cam =
-        reference.CamFromWorld(meshes.mesh3d[grid.Index(CornerRow(grid, k), CornerCol(grid, k))]);
-    held[k] = x_cam.z() > 0 && (reference.ProjectCam(x_cam) - boundary.corners[k]).norm() <= max_px;
-  }
-  return held;
-}
-
-std::vector<isometry::Marker> CornerMarkers(const MeshPair& meshes, const Boundary& boundary,
-                                            const PinholeCamera& reference,
-                                            const std::array<bool, 4>& held) {
-  std::vector<isometry::Marker> out;
-  const QuadGrid& grid = meshes.grid;
-  if (grid.nx < 2 || grid.ny < 2) return out;
-  for (int k = 0; k < 4; ++k) {
-    if (!held[k]) continue;
-    isometry::Marker m;
-    m.where = VertexSurfacePoint(grid, CornerRow(grid, k), CornerCol(grid, k));
-    m.ray_origin = reference.Center();
-    m.ray_direction = reference.RayDirection(boundary.corners[k]);
-    out.push_back(m);
-  }
-  return out;
 }
 
 }  // namespace docunfold::optimize

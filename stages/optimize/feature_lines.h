@@ -5,7 +5,6 @@
 #pragma once
 
 #include <Eigen/Core>
-#include <array>
 #include <string>
 #include <vector>
 
@@ -13,7 +12,6 @@
 #include "common/camera.h"
 #include "common/grid_mesh.h"
 #include "common/isometry/isometry.h"
-#include "common/page_files.h"
 
 namespace docunfold::optimize {
 
@@ -41,12 +39,6 @@ struct CastOptions {
   // Samples whose ray misses M (page borders: half the pixel lies outside)
   // snap to the nearest covered pixel within this many pixels.
   double snap_px = 3;
-  // Samples of a real page side whose ray misses M by more go on the
-  // nearest point of M's border within this fraction of the image diagonal
-  // (0: dropped, as other samples are). Off by default: on the 12 benchmark
-  // sets 0.02 puts more of the page in the crop and lowers mean LD (1.97 ->
-  // 1.83; set08 6.9 -> 4.4) but not MS-SSIM (mean -0.002, set07 -0.010).
-  double border_snap = 0;
   // The face-id image is rasterized at most this many pixels large.
   double max_raster_pixels = 2.5e6;
 };
@@ -109,17 +101,5 @@ std::vector<isometry::FeatureLine> AssignLines(const MeshPair& meshes, const Gro
 // land anywhere along it. Returns how many were dropped.
 int DropSideOutliers(const MeshPair& meshes, const Grouping& grouping, double tolerance,
                      MarkerSet* markers, double end_factor = 0);
-
-// M's grid corners are the page's corners TL TR BR BL (init-mesh builds the
-// grid between the boundary's four sides). Which corners lie between two
-// real sides and have their grid corner in `meshes` project within `max_px`
-// reference pixels of them.
-std::array<bool, 4> HeldCorners(const MeshPair& meshes, const Boundary& boundary,
-                                const PinholeCamera& reference, double max_px);
-// For each `held` corner an E_ray marker (no line) holding M's grid corner
-// to the viewing ray of the boundary's corner.
-std::vector<isometry::Marker> CornerMarkers(const MeshPair& meshes, const Boundary& boundary,
-                                            const PinholeCamera& reference,
-                                            const std::array<bool, 4>& held);
 
 }  // namespace docunfold::optimize

@@ -1,5 +1,6 @@
 // optimize: the joint isometric optimisation of M and M' with feature lines
-// (paper §3-4, DESIGN §6): rounds of the inner loop of isometry::Solve,
+// (the paper's "Document image rectification using isometric mapping" and
+// "Feature line generation"): rounds of the inner loop of isometry::Solve,
 // separated by Catmull-Clark subdivision, with markers recast, feature lines
 // regrouped and markers projected onto their lines every outer iteration.
 #pragma once
@@ -12,98 +13,84 @@
 #include "common/camera.h"
 #include "common/grid_mesh.h"
 #include "common/isometry/isometry.h"
+#include "common/option_table.h"
 #include "common/page_files.h"
 #include "stages/optimize/feature_lines.h"
 
 namespace docunfold::optimize {
 
 struct OptimizeOptions {
+  // The solver's settings for every round (isometry::DeclareSolveOptions):
+  // λ1..λ6 of the first round (the paper's), φ, the method and its stopping
+  // rule, threads. Each round hands the solver a copy with its own λ5, λ6,
+  // converged_iterations and max_rises (below) and the marker callback.
+  // Feature line projection (the paper's) is on.
+  isometry::SolveOptions solve = [] {
+    isometry::SolveOptions o;
+    o.project_markers = true;
+    return o;
+  }();
   int rounds = 4;                    // rounds of optimisation; rounds - 1 subdivisions between them
-  isometry::Weights weights;         // λ1..λ6 of the first round (paper values)
   double feature_weight_growth = 4;  // λ5 and λ6 are multiplied by this per subdivision
-  double relative_tolerance = 0.01;  // inner loop stops when |ΔF/F| < this (ε)
-  // ... for the converged_iterations-th time (1 = the paper; see
-  // isometry::SolveOptions::converged_iterations), in the rounds before
-  // rises_from_round (below): they are cheap, and a round that stops on one
-  // short step hands the next a page it has not finished fitting.
+  // A round stops at the converged_iterations-th outer iteration with
+  // |ΔF/F| < ε (1 = the paper; see isometry::SolveOptions::
+  // converged_iterations), in the rounds before rises_from_round: they are
+  // cheap, and a round that stops on one short step hands the next a page it
+  // has not finished fitting. From rises_from_round on, 1.
   int converged_iterations = 2;
-  int max_outer_iterations = 100;  // ... or after this many outer iterations (Q)
-  // ... or once F rose from one outer iteration to the next this often (0 =
-  // off), in round rises_from_round and later. With markers re-decided every
-  // iteration F can oscillate without settling in the fine rounds, where an
-  // iteration costs ~0.4 s: set04 took 21 iterations in its last round (12 s
-  // in all) and 4.5 s in all from another start. The first rounds are cheap
-  // and may need many iterations (set02's first: 35, after a rise at the 4th).
+  // From round rises_from_round on, a round also stops once F rose from one
+  // outer iteration to the next this often (0 = off): with markers re-decided
+  // every iteration F can oscillate without settling in the fine rounds,
+  // where an iteration is expensive; the first rounds are cheap and may need
+  // many iterations. See docs/decisions/optimize.md, "Stopping on rises".
   int max_rises = 3;
   int rises_from_round = 2;
-  double outlier_distance = 0.06;  // φ, fraction of the model size
   // Only points projecting into the document region of the reference view
   // (boundary contour grown by this many pixels) are fitted, as in
   // init-mesh; points of the table beside the page are within φ of M's edge
   // and would pull it outward.
   double region_margin_px = 4;
-  // λ3 × up to this far from every point (isometry::SolveOptions); 1 is
-  // the paper and the default: 100 helped on average with the old reference
-  // views but rounded an unsupported fold on set01 (README, "Choices we
-  // measured").
-  double unsupported_fairness = 1;
-  double support_radius = 0.03;  // fraction of the model size
-  double iso_edges = 0;          // isometry::SolveOptions::iso_edges
-  double fair2d_along = 1;       // isometry::SolveOptions::fair2d_along
-  // isometry::SolveOptions::fair2d_relative in this many rounds from the
-  // first (0 = none, the paper).
-  int fair2d_relative_rounds = 0;
   // DropSideOutliers' tolerance (fraction of M's diagonal; 0 keeps every
-  // marker). On set05 a fold's notch in the left side's outline, 30 px off
-  // the page's edge in flat.png, was held straight with the side; two front
-  // ends, 12 sets: set05 +0.009 and +0.005, the sample mean -0.000 and +0.004,
-  // the realistic sets' +0.004 and -0.003 (README, "Choices we measured").
+  // marker): a fold's notch in a side's outline is not held straight with
+  // the side. See docs/decisions/optimize.md, "A notch in a page side".
   double side_outliers = 0.005;
   // DropSideOutliers' end_factor (0 keeps every marker in a side's last
-  // tenths). r03's standing flap: the bottom side's first samples landed
-  // 5-18 % of M's diagonal off its line, somewhere else each iteration, so F
-  // jumped (the line term x20) and rounds 0 and 1 ran 61 and 44 iterations.
-  // 4 against 0 on three benchmark front ends: r03 0.691 -> 0.719 (11 ->
-  // 5.6 s), set04 +0.010, set08 -0.003 on one, all 12 identical on another,
-  // r03 +0.004 on the third; 3 took a curved end of set04's and set08's
-  // sides off (-0.010, -0.011) (README, "Choices we measured").
+  // tenths): a sample whose ray grazes M's border and lands elsewhere each
+  // iteration makes F jump. See docs/decisions/optimize.md, "A sample at a
+  // side's end".
   double side_end_outliers = 4;
-  // M's grid corners are held to the rays of the boundary's corners between
-  // two real sides (CornerMarkers) where init-mesh's corner projects within
-  // this many reference pixels of them; 0 = off.
-  double corner_max_px = 0;
-  double line_spacing = 0;          // isometry::SolveOptions::line_spacing
-  double max_spacing_ratio = 1.35;  // isometry::SolveOptions::max_spacing_ratio
-  isometry::Method method = isometry::Method::kGaussNewton;
-  isometry::LinearSolver linear_solver = isometry::LinearSolver::kAuto;
-  bool features = true;        // false: no feature lines at all (--no-features)
+  bool features = true;        // false: no feature lines at all (--no-feature-lines)
   bool boundary_only = false;  // only the real boundary sides (--boundary-only)
-  bool project = true;         // feature line projection (paper §"Feature line projection")
   // Which lines run exactly along the axes of the upright M' (kNone: only
   // straight, as in the paper). A page is a rectangle: with only straight
-  // sides, M' kept one of set04's sides 1.5 degrees off the others (M is
-  // least certain at the page edge) and the crop cut into the page. kAll
-  // against kNone, 12 sets on three sfm runs: mean MS-SSIM of the samples
-  // +0.017, +0.015, +0.030 (set04 +0.16 each time, r02 +0.10, r01 +0.05;
-  // worst single change set02 -0.022 and set07 -0.011).
+  // sides M' can keep a side a little off the others (M is least certain at
+  // the page edge) and the crop cuts into the page. See
+  // docs/decisions/optimize.md, "Every line along an axis of M'".
   AxisLines axis_lines = AxisLines::kAll;
   double marker_step_px = 4;  // sample spacing along segments, reference pixels
   // Turn M' before the first round when the detected segments (text rows,
   // rules) run at least upright_min_deg off its axes: at least
   // upright_min_segments of them, upright_min_share of their length within
-  // 3 degrees of one direction. Measured on the 12 benchmark sets: set08
-  // (a fold taken for the top side) 31 deg off with 59-150 segments, 78-98 %
-  // agreeing; set07's curled receipt 6-10 deg off with 12-13 segments, 62-69 %
-  // agreeing, where turning changed nothing (render deskews by the sides);
-  // every other set within 1.2 deg.
+  // 3 degrees of one direction (a fold taken for a side turned M'). See
+  // docs/decisions/optimize.md, "M' turned upright by the lines".
   bool upright_by_lines = true;
   double upright_min_deg = 2;
   int upright_min_segments = 20;
   double upright_min_share = 0.5;
   CastOptions cast;
   GroupingOptions grouping;
-  int threads = 2;
 };
+
+// Declares optimize's flags into `table`, bound to `options`' fields: the
+// solver's (isometry::DeclareSolveOptions) and optimize's own.
+void DeclareOptions(OptionTable& table, OptimizeOptions* options);
+
+// What round `round` (0 first) hands the solver: options.solve with the
+// round's weights (λ5 and λ6 grown per subdivision by the caller) and
+// stopping rule (converged_iterations before rises_from_round, max_rises
+// from it on).
+isometry::SolveOptions RoundSolveOptions(const OptimizeOptions& options, int round,
+                                         const isometry::Weights& weights);
 
 struct OptimizeInputs {
   MeshPair init;                                     // 40_init/
@@ -149,7 +136,6 @@ struct OptimizeResult {
   int segments = 0;             // feature segments given (text + edge)
   int segments_off_page = 0;    // of those, dropped: their samples miss M
   int boundary_lines = 0;       // real boundary sides used
-  int held_corners = 0;         // page corners M's grid corners were held to
   double seconds = 0;
 };
 

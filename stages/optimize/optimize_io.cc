@@ -25,6 +25,10 @@ Json WeightsJson(const isometry::Weights& w) {
 
 }  // namespace
 
+void DeclareOutputOptions(OptionTable& table, OutputOptions* o) {
+  table.Switch("scene", &o->scene, "write scene.glb");
+}
+
 OptimizeInputs ReadInputs(const InputPaths& paths) {
   OptimizeInputs in;
   const CameraSet cameras = ReadCameras(paths.sfm / "cameras.json");
@@ -56,9 +60,9 @@ OptimizeInputs ReadInputs(const InputPaths& paths) {
   return in;
 }
 
-Json LinesJson(const std::vector<LineRecord>& lines, const Json& options_json,
+Json LinesJson(const std::vector<LineRecord>& lines, const Json& options_record,
                const std::optional<Eigen::Vector2d>& text_down_flat) {
-  Json doc = MakeHeader("docunfold.lines", 1, "optimize", options_json);
+  Json doc = MakeHeader("docunfold.lines", 1, "optimize", options_record);
   doc["description"] =
       "Feature lines straightened in M': n.p' = offset with n = normal; markers in "
       "reference-image pixels and in M' (same length unit as M).";
@@ -78,8 +82,8 @@ Json LinesJson(const std::vector<LineRecord>& lines, const Json& options_json,
   return doc;
 }
 
-Json LogJson(const OptimizeResult& result, const Json& options_json) {
-  Json doc = MakeHeader("docunfold.optimize-log", 1, "optimize", options_json);
+Json LogJson(const OptimizeResult& result, const Json& options_record) {
+  Json doc = MakeHeader("docunfold.optimize-log", 1, "optimize", options_record);
   doc["segments"] = result.segments;
   doc["segments_off_page"] = result.segments_off_page;
   doc["line_direction"] = {{"angle_deg", result.line_direction.angle_deg},
@@ -87,7 +91,6 @@ Json LogJson(const OptimizeResult& result, const Json& options_json) {
                            {"segments", result.line_direction.lines},
                            {"turned_deg", result.upright_turn_deg}};
   doc["boundary_lines"] = result.boundary_lines;
-  doc["held_corners"] = result.held_corners;
   doc["points_in_region"] = result.region_points.size();
   doc["seconds"] = result.seconds;
   doc["rounds"] = Json::array();
@@ -110,7 +113,7 @@ Json LogJson(const OptimizeResult& result, const Json& options_json) {
 }
 
 void WriteOutputs(const fs::path& out, const InputPaths& paths, const OptimizeInputs& in,
-                  const OptimizeResult& result, const Json& options_json,
+                  const OptimizeResult& result, const Json& options_record,
                   const OutputOptions& output_options) {
   EnsureDirectory(out);
   const fs::path reference_image = paths.sfm / "reference.png";
@@ -122,7 +125,7 @@ void WriteOutputs(const fs::path& out, const InputPaths& paths, const OptimizeIn
     MeshPairWriteOptions o = mesh_options;
     o.comments = {"docunfold optimize round " + std::to_string(r.round)};
     WriteMeshPair(dir, r.meshes, o);
-    WriteJsonAtomic(dir / "lines.json", LinesJson(r.lines, options_json));
+    WriteJsonAtomic(dir / "lines.json", LinesJson(r.lines, options_record));
   }
   // Rounds of an earlier run with more rounds would mislead.
   std::error_code ec;
@@ -134,8 +137,8 @@ void WriteOutputs(const fs::path& out, const InputPaths& paths, const OptimizeIn
   mesh_options.comments = {"docunfold optimize: final meshes"};
   WriteMeshPair(out, result.meshes, mesh_options);
   WriteJsonAtomic(out / "lines.json",
-                  LinesJson(result.rounds.back().lines, options_json, result.text_down_flat));
-  WriteJsonAtomic(out / "log.json", LogJson(result, options_json));
+                  LinesJson(result.rounds.back().lines, options_record, result.text_down_flat));
+  WriteJsonAtomic(out / "log.json", LogJson(result, options_record));
   if (!output_options.scene) return;
 
   // scene.glb: M textured from the reference image, M' beside it with the

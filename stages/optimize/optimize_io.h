@@ -31,14 +31,17 @@ struct OutputOptions {
   int texture_width = 2048;  // scene.glb's texture, pixels at most
 };
 
+// Declares the output flags (--scene/--no-scene) into `table`.
+void DeclareOutputOptions(OptionTable& table, OutputOptions* options);
+
 // Writes everything into `out` (each file atomically).
 void WriteOutputs(const fs::path& out, const InputPaths& paths, const OptimizeInputs& in,
-                  const OptimizeResult& result, const Json& options_json,
+                  const OptimizeResult& result, const Json& options_record,
                   const OutputOptions& output_options);
 
 // `text_down_flat`, when given, is the reader's down in M' (unit).
-Json LinesJson(const std::vector<LineRecord>& lines, const Json& options_json,
+Json LinesJson(const std::vector<LineRecord>& lines, const Json& options_record,
                const std::optional<Eigen::Vector2d>& text_down_flat = std::nullopt);
-Json LogJson(const OptimizeResult& result, const Json& options_json);
+Json LogJson(const OptimizeResult& result, const Json& options_record);
 
 }  // namespace docunfold::optimize

@@ -1,7 +1,5 @@
-// CastMarkers on a flat sheet seen square-on: with --border-snap, samples of
-// a real page side that lie off M's image go on M's border (so the ray term
-// can pull the border to the outline); other segments' samples off M, and
-// every sample without it, are dropped.
+// CastMarkers on a flat sheet seen square-on: which samples become markers
+// and where; DropSideOutliers on a real page side with notches.
 #include "stages/optimize/feature_lines.h"
 
 #include <gtest/gtest.h>
@@ -28,12 +26,6 @@ struct Scene {
   }
 };
 
-CastOptions Snapping() {
-  CastOptions o;
-  o.border_snap = 0.02;  // of the diagonal: 22.6 px
-  return o;
-}
-
 // A vertical segment `offset` pixels left of the sheet's left border.
 Segment LeftOf(const std::string& kind, double offset) {
   Segment s;
@@ -43,41 +35,27 @@ Segment LeftOf(const std::string& kind, double offset) {
   return s;
 }
 
-TEST(CastMarkers, PageSideSamplesOffTheMeshGoOnItsBorder) {
+TEST(CastMarkers, SamplesOnTheMeshBecomeMarkersOthersAreDropped) {
   const Scene scene;
-  const std::vector<Segment> segments = {LeftOf("boundary", 12), LeftOf("text", 12)};
-  const MarkerSet set = CastMarkers(scene.meshes, scene.camera, segments, Snapping());
+  // 2 px off M's image: snapped to a border triangle (within
+  // CastOptions::snap_px), whose plane extended meets the pixel's own ray.
+  const std::vector<Segment> near = {LeftOf("boundary", 2), LeftOf("text", 2)};
+  const MarkerSet set = CastMarkers(scene.meshes, scene.camera, near);
   ASSERT_EQ(set.markers_of_segment.size(), 2u);
-  EXPECT_EQ(set.markers_of_segment[0], int(segments[0].pixels.size()));
-  EXPECT_EQ(set.markers_of_segment[1], 0);  // a text segment off the page
+  EXPECT_EQ(set.markers_of_segment[0], int(near[0].pixels.size()));
+  EXPECT_EQ(set.markers_of_segment[1], int(near[1].pixels.size()));
   for (size_t i = 0; i < set.markers.size(); ++i) {
-    // On the left border (flat x = -0.5), level with its pixel, and its ray
-    // is the pixel's own.
     const Eigen::Vector2d flat = PointOnMesh2d(scene.meshes, set.markers[i].where);
-    EXPECT_NEAR(flat.x(), -0.5, 1e-9) << i;
+    EXPECT_NEAR(flat.x(), (set.pixel[i].x() - 400) / 800 * 4, 1e-9) << i;
     EXPECT_NEAR(flat.y(), (set.pixel[i].y() - 400) / 800 * 4, 1e-9) << i;
     EXPECT_GT(set.markers[i].ray_direction.dot(scene.camera.RayDirection(set.pixel[i])), 1 - 1e-12);
   }
-  // Beyond the radius, or by default (off): none.
-  EXPECT_EQ(CastMarkers(scene.meshes, scene.camera, {LeftOf("boundary", 30)}, Snapping())
-                .markers_of_segment[0],
-            0);
-  EXPECT_EQ(CastMarkers(scene.meshes, scene.camera, {LeftOf("boundary", 12)}).markers_of_segment[0],
-            0);
-}
-
-TEST(CastMarkers, OutlineSamplesNearACornerKeepToTheirOwnSide) {
-  // The left side's samples above the sheet's top-left corner still go on
-  // the left border (its nearest edge by direction), not on the top one.
-  const Scene scene;
-  Segment left;
-  left.kind = "boundary";
-  left.side = 3;
-  left.pixels = SamplePolyline({{292, 244}, {292, 300}}, 4);
-  const MarkerSet set = CastMarkers(scene.meshes, scene.camera, {left}, Snapping());
-  ASSERT_EQ(set.markers_of_segment[0], int(left.pixels.size()));
-  for (const auto& m : set.markers)
-    EXPECT_NEAR(PointOnMesh2d(scene.meshes, m.where).x(), -0.5, 1e-9);
+  // 12 px off: dropped, a page side's samples as any other's.
+  const MarkerSet off =
+      CastMarkers(scene.meshes, scene.camera, {LeftOf("boundary", 12), LeftOf("text", 12)});
+  EXPECT_EQ(off.markers_of_segment[0], 0);
+  EXPECT_EQ(off.markers_of_segment[1], 0);
+  EXPECT_TRUE(off.markers.empty());
 }
 
 // A real left side 5 px inside the sheet's border, with `bumps`: runs of
@@ -137,41 +115,6 @@ TEST(DropSideOutliers, AtTheEndsOnlyFarOutliersLoseTheirLine) {
   for (size_t i = 0; i < far.markers.size(); ++i)
     EXPECT_EQ(far.markers[i].line, i == 0 ? -1 : 0) << "y " << far.pixel[i].y();
   EXPECT_EQ(DropSideOutliers(scene.meshes, grouping, 0.005, &far_kept, 0), 0);
-}
-
-TEST(CornerMarkers, HoldTheGridCornersToTheRaysOfRealCornersNearThem) {
-  const Scene scene;
-  Boundary boundary;
-  boundary.corners = {Eigen::Vector2d(300, 250), Eigen::Vector2d(500, 250),
-                      Eigen::Vector2d(530, 580), Eigen::Vector2d(304, 547)};
-  for (BoundarySide& side : boundary.sides) side.real = true;
-  // BR is 42 px from the grid's corner, the others within 5 px.
-  EXPECT_EQ(HeldCorners(scene.meshes, boundary, scene.camera, 20),
-            (std::array<bool, 4>{true, true, false, true}));
-  EXPECT_EQ(HeldCorners(scene.meshes, boundary, scene.camera, 50),
-            (std::array<bool, 4>{true, true, true, true}));
-  // A corner on a cut side is no page corner.
-  Boundary cut = boundary;
-  cut.sides[2].real = false;
-  EXPECT_EQ(HeldCorners(scene.meshes, cut, scene.camera, 50),
-            (std::array<bool, 4>{true, true, false, false}));
-
-  const std::array<bool, 4> held = {true, true, true, true};
-  const std::vector<isometry::Marker> markers =
-      CornerMarkers(scene.meshes, boundary, scene.camera, held);
-  ASSERT_EQ(markers.size(), 4u);
-  const int corner_vertex[4] = {0, 4, 34, 30};  // TL TR BR BL of the 5 x 7 grid
-  for (int k = 0; k < 4; ++k) {
-    const isometry::Marker& m = markers[k];
-    EXPECT_EQ(m.line, -1);
-    EXPECT_TRUE(m.across.isZero());
-    EXPECT_LT((PointOnMesh3d(scene.meshes, m.where) - scene.meshes.mesh3d[corner_vertex[k]]).norm(),
-              1e-12)
-        << k;
-    EXPECT_GT(m.ray_direction.dot(scene.camera.RayDirection(boundary.corners[k])), 1 - 1e-12);
-  }
-  EXPECT_EQ(CornerMarkers(scene.meshes, boundary, scene.camera, {false, true, false, false}).size(),
-            1u);
 }
 
 }  // namespace
