@@ -4,6 +4,7 @@
 #include <cctype>
 
 #include "common/errors.h"
+#include "common/json_io.h"
 
 namespace docunfold {
 
@@ -27,6 +28,15 @@ DataSet OpenDataSet(const fs::path& root) {
   std::sort(set.images.begin(), set.images.end());
   set.has_ground_truth = fs::is_directory(root / "ground_truth", ec);
   return set;
+}
+
+std::pair<double, double> ReadTruePageSize(const fs::path& page_json) {
+  const Json page = ReadJsonFile(page_json);
+  CheckFormat(page, page_json, "docunfold.gt-page", 1);
+  JsonReader r(page, page_json);
+  const double w = r.Number("/width_m"), h = r.Number("/height_m");
+  if (!(w > 0) || !(h > 0)) r.Fail("/width_m", "page size must be positive");
+  return {w, h};
 }
 
 }  // namespace docunfold

@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace docunfold {
@@ -24,5 +25,9 @@ bool IsImageFile(const fs::path& path);
 
 // Lists a data set; throws InputError when the folder or images/ is missing.
 DataSet OpenDataSet(const fs::path& root);
+
+// The page's size in metres (width, height) from ground_truth/page.json
+// (docunfold.gt-page); InputError when missing, malformed or not positive.
+std::pair<double, double> ReadTruePageSize(const fs::path& page_json);
 
 }  // namespace docunfold

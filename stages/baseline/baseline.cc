@@ -10,6 +10,7 @@
 
 #include "common/atomic_file.h"
 #include "common/cli.h"
+#include "common/dataset.h"
 #include "common/errors.h"
 #include "common/json_io.h"
 #include "common/raster.h"
@@ -130,11 +131,7 @@ Corners ReadCorners(const fs::path& path) {
 }
 
 double PageAspect(const fs::path& page_json) {
-  const Json doc = ReadJsonFile(page_json);
-  CheckFormat(doc, page_json, "docunfold.gt-page", 1);
-  JsonReader r(doc, page_json);
-  const double w = r.Number("/width_m"), h = r.Number("/height_m");
-  if (!(w > 0) || !(h > 0)) r.Fail("/width_m", "page size must be positive");
+  const auto [w, h] = ReadTruePageSize(page_json);
   return w / h;
 }
 

@@ -312,6 +312,31 @@ std::vector<std::vector<int>> ChainMarks(const std::vector<Mark>& marks, double 
   return chains;
 }
 
+// A chain's centre line (the line fitted to its marks' middles, as the height
+// across the text at each position along it) and its marks' tops and bottoms
+// measured from that line.
+struct ChainBand {
+  LineFit fit;
+  double slope = 0;
+  std::vector<double> tops, bottoms;
+  double Trend(double along) const { return fit.point.y + slope * (along - fit.point.x); }
+};
+
+ChainBand FitChainBand(const std::vector<Mark>& marks, const std::vector<int>& chain) {
+  ChainBand band;
+  std::vector<cv::Point2d> mids;
+  for (int k : chain) mids.emplace_back(marks[k].along_mid(), marks[k].across_mid());
+  band.fit = FitLine(mids);
+  band.slope =
+      band.fit.direction.y / (std::abs(band.fit.direction.x) > 1e-9 ? band.fit.direction.x : 1e-9);
+  for (int k : chain) {
+    const double trend = band.Trend(marks[k].along_mid());
+    band.tops.push_back(marks[k].c0 - trend);
+    band.bottoms.push_back(marks[k].c1 - trend);
+  }
+  return band;
+}
+
 // Step 4: the line height (x-height band) from each chain's medians of tops
 // and bottoms, after removing its tilt; `h_med` when no chain has three marks.
 double LineHeight(const std::vector<Mark>& marks, const std::vector<std::vector<int>>& chains,
@@ -319,18 +344,8 @@ double LineHeight(const std::vector<Mark>& marks, const std::vector<std::vector<
   std::vector<double> line_heights;
   for (const auto& chain : chains) {
     if (chain.size() < 3) continue;
-    std::vector<cv::Point2d> mids;
-    for (int k : chain) mids.emplace_back(marks[k].along_mid(), marks[k].across_mid());
-    const LineFit fit = FitLine(mids);
-    const double slope =
-        fit.direction.y / (std::abs(fit.direction.x) > 1e-9 ? fit.direction.x : 1e-9);
-    std::vector<double> tops, bottoms;
-    for (int k : chain) {
-      const double trend = fit.point.y + slope * (marks[k].along_mid() - fit.point.x);
-      tops.push_back(marks[k].c0 - trend);
-      bottoms.push_back(marks[k].c1 - trend);
-    }
-    line_heights.push_back(Median(bottoms) - Median(tops) + 1);
+    const ChainBand band = FitChainBand(marks, chain);
+    line_heights.push_back(Median(band.bottoms) - Median(band.tops) + 1);
   }
   return line_heights.empty() ? h_med : Median(line_heights);
 }
@@ -455,18 +470,9 @@ void DotVotes(const InkComponents& ink, const TextLines& lines, int* dots_plus, 
         .push_back(&m);
   for (const auto& chain : lines.chains) {
     if (chain.size() < 3) continue;
-    std::vector<cv::Point2d> mids;
-    for (int k : chain) mids.emplace_back(marks[k].along_mid(), marks[k].across_mid());
-    const LineFit fit = FitLine(mids);
-    const double slope =
-        fit.direction.y / (std::abs(fit.direction.x) > 1e-9 ? fit.direction.x : 1e-9);
-    auto trend = [&](double a) { return fit.point.y + slope * (a - fit.point.x); };
-    std::vector<double> tops, bottoms;
-    for (int k : chain) {
-      tops.push_back(marks[k].c0 - trend(marks[k].along_mid()));
-      bottoms.push_back(marks[k].c1 - trend(marks[k].along_mid()));
-    }
-    const double t = Median(tops), b = Median(bottoms), x = b - t;
+    const ChainBand band = FitChainBand(marks, chain);
+    auto trend = [&](double a) { return band.Trend(a); };
+    const double t = Median(band.tops), b = Median(band.bottoms), x = b - t;
     if (x < 2) continue;
     const double a_first = marks[chain.front()].a0, a_last = marks[chain.back()].a1;
     const double mid = trend(0.5 * (a_first + a_last));

@@ -10,6 +10,7 @@
 #include "common/atomic_file.h"
 #include "common/camera.h"
 #include "common/cli.h"
+#include "common/dataset.h"
 #include "common/errors.h"
 #include "common/ply.h"
 #include "common/raster.h"
@@ -132,11 +133,7 @@ Json EvaluateOcr(const EvaluateInputs& in, const EvaluateOptions& options,
 }
 
 double PageDiagonal(const fs::path& page_json) {
-  const Json page = ReadJsonFile(page_json);
-  CheckFormat(page, page_json, "docunfold.gt-page", 1);
-  JsonReader r(page, page_json);
-  const double w = r.Number("/width_m"), h = r.Number("/height_m");
-  if (!(w > 0) || !(h > 0)) r.Fail("/width_m", "page size must be positive");
+  const auto [w, h] = ReadTruePageSize(page_json);
   return std::hypot(w, h);
 }
 
