@@ -11,14 +11,7 @@
 namespace docunfold {
 namespace {
 
-std::string ErrorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
-}
+using testing::ErrorOf;
 
 TEST(JsonIo, ReportsFileAndPointer) {
   testing::TempDir dir;

@@ -10,6 +10,8 @@
 namespace docunfold {
 namespace {
 
+using testing::ErrorOf;
+
 const char* kBoundary = R"({"format": "docunfold.boundary", "version": 1,
   "producer": {"stage": "test", "version": "0"}, "image": "r.png", "width": 100, "height": 80,
   "contour": [[10, 10], [90, 10], [90, 70], [10, 70]],
@@ -18,15 +20,6 @@ const char* kBoundary = R"({"format": "docunfold.boundary", "version": 1,
             "right": {"points": [[90, 10], [90, 70]], "real": true},
             "bottom": {"points": [[10, 70], [90, 70]], "real": false},
             "left": {"points": [[10, 10], [10, 70]], "real": true}}})";
-
-std::string ErrorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
-}
 
 TEST(PageFiles, ReadsABoundary) {
   testing::TempDir dir;

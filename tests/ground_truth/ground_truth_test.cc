@@ -92,19 +92,6 @@ cv::Mat1f PredictedView(const GroundTruth& gt, const PinholeCamera& cam, cv::Mat
 
 // Grey levels with the slowly varying shading divided out, so a photo and
 // the prediction from flat.png can be compared.
-cv::Mat1f Detail(const cv::Mat1f& image) {
-  cv::Mat1f low;
-  cv::GaussianBlur(image, low, cv::Size(0, 0), 6);
-  return image / (low + 10.0f) - 1.0f;
-}
-
-double Correlation(const cv::Mat1f& a, const cv::Mat1f& b, const cv::Mat1b& mask) {
-  cv::Scalar ma, sa, mb, sb;
-  cv::meanStdDev(a, ma, sa, mask);
-  cv::meanStdDev(b, mb, sb, mask);
-  cv::Mat1f prod = (a - ma[0]).mul(b - mb[0]);
-  return cv::mean(prod, mask)[0] / (sa[0] * sb[0] + 1e-12);
-}
 
 TEST(GroundTruth, TrueSurfaceAndCamerasReproduceThePageInEveryPhoto) {
   auto sets = DataSetsWithGroundTruth();

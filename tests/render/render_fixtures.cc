@@ -253,26 +253,6 @@ void WriteScene(const SyntheticScene& scene, const fs::path& work) {
   WriteMeshPair(work / "40_init", scene.meshes);
 }
 
-cv::Mat1f Detail(const cv::Mat& image) {
-  cv::Mat grey;
-  if (image.channels() == 3)
-    cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
-  else
-    grey = image;
-  cv::Mat1f f, low;
-  grey.convertTo(f, CV_32F);
-  cv::GaussianBlur(f, low, cv::Size(0, 0), 6);
-  return f / (low + 10.0f) - 1.0f;
-}
-
-double Correlation(const cv::Mat1f& a, const cv::Mat1f& b, const cv::Mat1b& mask) {
-  cv::Scalar ma, sa, mb, sb;
-  cv::meanStdDev(a, ma, sa, mask);
-  cv::meanStdDev(b, mb, sb, mask);
-  cv::Mat1f prod = (a - ma[0]).mul(b - mb[0]);
-  return cv::mean(prod, mask)[0] / (sa[0] * sb[0] + 1e-12);
-}
-
 TileOffsets FindTileOffsets(const cv::Mat1f& ref, const cv::Mat1f& moved, const cv::Mat1b& mask,
                             int tile, int radius) {
   TileOffsets out;

@@ -75,12 +75,6 @@ void WriteScene(const SyntheticScene& scene, const fs::path& work);
 render::RenderInputs InputsOf(const SyntheticScene& scene);
 render::RenderInputs InputsOf(const TruthInputs& truth);
 
-// Grey levels with the slowly varying shading divided out.
-cv::Mat1f Detail(const cv::Mat& image);
-// Normalised cross-correlation of two equally sized images over `mask`
-// (all pixels when empty).
-double Correlation(const cv::Mat1f& a, const cv::Mat1f& b, const cv::Mat1b& mask = {});
-
 // Where the content of `ref` is found in `moved`: tiles of `tile` pixels of
 // `ref` with enough texture are searched for in `moved` within +-`radius`
 // pixels (normalised cross-correlation, sub-pixel peak); only tiles whose

@@ -3,6 +3,8 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
 
@@ -40,5 +42,14 @@ fs::path SampleDir(const std::string& name);
 fs::path RealisticDir();
 
 std::string Quote(const std::string& s);
+
+// The message of the InputError `f` throws ("" when it throws none).
+std::string ErrorOf(const std::function<void()>& f);
+
+// Grey levels with the slowly varying shading divided out (BGR or grey in).
+cv::Mat1f Detail(const cv::Mat& image);
+// Normalised cross-correlation of two equally sized images over `mask`
+// (all pixels when empty).
+double Correlation(const cv::Mat1f& a, const cv::Mat1f& b, const cv::Mat1b& mask = {});
 
 }  // namespace docunfold::testing
