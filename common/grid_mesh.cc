@@ -174,7 +174,7 @@ std::optional<SurfacePoint> PixelToSurface::OnTriangle(int f, const Eigen::Vecto
   const Eigen::Vector3d a = camera_.CamFromWorld(mesh_.mesh3d[t[0]]);
   const Eigen::Vector3d b = camera_.CamFromWorld(mesh_.mesh3d[t[1]]);
   const Eigen::Vector3d c = camera_.CamFromWorld(mesh_.mesh3d[t[2]]);
-  const Eigen::Vector3d d = camera_.K.inverse() * Eigen::Vector3d(pixel.x(), pixel.y(), 1);
+  const Eigen::Vector3d d = camera_.CamRay(pixel);
   // Solve a + u (b - a) + v (c - a) = s d.
   Eigen::Matrix3d A;
   A << b - a, c - a, -d;

@@ -113,15 +113,6 @@ Eigen::Vector2d ScalePixel(const Eigen::Vector2d& p, double scale) {
   return (p.array() + 0.5) * scale - 0.5;
 }
 
-// Eigen evaluates depth * (K^-1 v) as (depth K^-1) v, which rounds
-// differently from PinholeCamera::LiftAtDepth's depth * CamRay: kept as it is,
-// for the same points.
-Eigen::Vector3d RayPoint(const PinholeCamera& camera, const Eigen::Vector2d& pixel, double depth) {
-  const Eigen::Vector3d xc =
-      depth * (camera.K.inverse() * Eigen::Vector3d(pixel.x(), pixel.y(), 1));
-  return camera.R.transpose() * (xc - camera.t);
-}
-
 double ParabolaPeak(const std::vector<double>& g, int i) {
   const double curvature = g[i - 1] - 2 * g[i] + g[i + 1];
   return curvature < 0 ? 0.5 * (g[i - 1] - g[i + 1]) / curvature : 0;

@@ -47,9 +47,6 @@ View MakeView(int index, const PinholeCamera& camera, const cv::Mat& grey_photo,
 // A pixel of an image in a copy resized by `scale` (cv::resize's centres).
 Eigen::Vector2d ScalePixel(const Eigen::Vector2d& p, double scale);
 
-// Point of the reference camera's ray through `pixel` at camera depth `depth`.
-Eigen::Vector3d RayPoint(const PinholeCamera& camera, const Eigen::Vector2d& pixel, double depth);
-
 struct Observation {
   const PinholeCamera* camera;
   Eigen::Vector2d pixel;

@@ -121,7 +121,7 @@ bool DepthAcrossEdges(const PinholeCamera& ref, const Eigen::Vector2d& pixel,
                       double* mean) {
   auto residuals = [&](double d, std::vector<double>* r) {
     r->clear();
-    const Eigen::Vector3d X = RayPoint(ref, pixel, d);
+    const Eigen::Vector3d X = ref.LiftAtDepth(pixel, d);
     for (size_t k = 1; k < obs.size(); ++k) {
       const Eigen::Vector3d xc = obs[k].camera->CamFromWorld(X);
       if (!(xc.z() > 0)) return false;
@@ -228,9 +228,9 @@ void FindCandidates(const View& ref, const std::vector<View>& others, const Outl
   for (const View& view : others) {
     for (EdgeSample& e : *samples) {
       const Eigen::Vector3d A =
-          view.camera.CamFromWorld(RayPoint(ref.camera, e.pixel, e.near_depth));
+          view.camera.CamFromWorld(ref.camera.LiftAtDepth(e.pixel, e.near_depth));
       const Eigen::Vector3d B =
-          view.camera.CamFromWorld(RayPoint(ref.camera, e.pixel, e.far_depth));
+          view.camera.CamFromWorld(ref.camera.LiftAtDepth(e.pixel, e.far_depth));
       if (!(A.z() > 0) || !(B.z() > 0)) continue;
       const Eigen::Vector2d a = view.camera.ProjectCam(A), b = view.camera.ProjectCam(B);
       const double length = (b - a).norm();
@@ -239,9 +239,9 @@ void FindCandidates(const View& ref, const std::vector<View>& others, const Outl
       // The sample's outward normal as this view sees it (at mid depth; only
       // for the crossing angle and the gradient's direction).
       const double mid = 0.5 * (e.near_depth + e.far_depth);
-      const Eigen::Vector2d at = view.camera.Project(RayPoint(ref.camera, e.pixel, mid));
+      const Eigen::Vector2d at = view.camera.Project(ref.camera.LiftAtDepth(e.pixel, mid));
       const Eigen::Vector2d nj =
-          (view.camera.Project(RayPoint(ref.camera, e.pixel + e.normal, mid)) - at).normalized();
+          (view.camera.Project(ref.camera.LiftAtDepth(e.pixel + e.normal, mid)) - at).normalized();
       const double cos_cross = nj.dot(dir);
       if (!nj.allFinite() || std::abs(cos_cross) < min_cos) continue;
       const int sign_along = e.sign * (cos_cross > 0 ? 1 : -1);
@@ -384,7 +384,7 @@ void MatchEdgeSamples(const View& ref, const std::vector<View>& others, int num_
       ++counts->off_surface;
       continue;
     }
-    AppendPoint(RayPoint(ref.camera, e.pixel, depth), colour, int(h.obs.size()), error, source,
+    AppendPoint(ref.camera.LiftAtDepth(e.pixel, depth), colour, int(h.obs.size()), error, source,
                 points);
     if (stats)
       for (int vi : h.views) ++(*stats)[vi].outline_votes;

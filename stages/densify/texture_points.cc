@@ -176,7 +176,7 @@ void FollowBySurface(const View& ref, const std::vector<View>& others, const cv:
         const float inv = SampleOrZero(inverse_depth, double(x - box.x) / g, double(y - box.y) / g);
         if (!(inv > 0)) continue;
         const Eigen::Vector3d xc =
-            view.camera.CamFromWorld(RayPoint(ref.camera, Eigen::Vector2d(x, y), 1 / inv));
+            view.camera.CamFromWorld(ref.camera.LiftAtDepth(Eigen::Vector2d(x, y), 1 / inv));
         if (!(xc.z() > 0)) continue;
         const Eigen::Vector2d p = view.camera.ProjectCam(xc);
         if (view.Inside(p, 0)) map(y, x) = cv::Vec2f(float(p.x()), float(p.y()));
