@@ -168,17 +168,24 @@ std::optional<SurfacePoint> PixelToSurface::LookupNear(const Eigen::Vector2d& pi
   return OnTriangle(best, pixel);
 }
 
-std::optional<SurfacePoint> PixelToSurface::OnTriangle(int f, const Eigen::Vector2d& pixel) const {
-  // Intersect the pixel's viewing ray with the triangle's plane.
-  const Triangle& t = triangles_[f];
-  const Eigen::Vector3d a = camera_.CamFromWorld(mesh_.mesh3d[t[0]]);
-  const Eigen::Vector3d b = camera_.CamFromWorld(mesh_.mesh3d[t[1]]);
-  const Eigen::Vector3d c = camera_.CamFromWorld(mesh_.mesh3d[t[2]]);
-  const Eigen::Vector3d d = camera_.CamRay(pixel);
+Eigen::Vector3d RayOnTrianglePlane(const PinholeCamera& camera,
+                                   const std::array<Eigen::Vector3d, 3>& world,
+                                   const Eigen::Vector2d& pixel) {
+  const Eigen::Vector3d a = camera.CamFromWorld(world[0]);
+  const Eigen::Vector3d b = camera.CamFromWorld(world[1]);
+  const Eigen::Vector3d c = camera.CamFromWorld(world[2]);
+  const Eigen::Vector3d d = camera.CamRay(pixel);
   // Solve a + u (b - a) + v (c - a) = s d.
   Eigen::Matrix3d A;
   A << b - a, c - a, -d;
-  const Eigen::Vector3d sol = A.colPivHouseholderQr().solve(-a);
+  return A.colPivHouseholderQr().solve(-a);
+}
+
+std::optional<SurfacePoint> PixelToSurface::OnTriangle(int f, const Eigen::Vector2d& pixel) const {
+  // Intersect the pixel's viewing ray with the triangle's plane.
+  const Triangle& t = triangles_[f];
+  const Eigen::Vector3d sol = RayOnTrianglePlane(
+      camera_, {mesh_.mesh3d[t[0]], mesh_.mesh3d[t[1]], mesh_.mesh3d[t[2]]}, pixel);
   SurfacePoint p;
   p.triangle = f;
   p.bary = Eigen::Vector3d(1 - sol[0] - sol[1], sol[0], sol[1]);

@@ -75,6 +75,14 @@ struct MeshPairWriteOptions {
 void WriteMeshPair(const fs::path& dir, const MeshPair& m,
                    const MeshPairWriteOptions& options = {});
 
+// Where the viewing ray of `pixel` meets the plane of the triangle with
+// corners `world` (world coordinates): (u, v, s) with
+// a + u (b - a) + v (c - a) = s K^-1 (x, y, 1) in the camera's frame; s > 0
+// in front of the camera. Not finite when the ray runs along the plane.
+Eigen::Vector3d RayOnTrianglePlane(const PinholeCamera& camera,
+                                   const std::array<Eigen::Vector3d, 3>& world,
+                                   const Eigen::Vector2d& pixel);
+
 // Which point of M each pixel of the reference camera sees: a face-id raster
 // of M, built once and then queried for any number of pixels.
 class PixelToSurface {

@@ -22,13 +22,8 @@ std::optional<Eigen::Vector2d> RayThroughTrianglePlane(const MeshPair& mesh,
                                                        const PinholeCamera& camera, int triangle,
                                                        const Eigen::Vector2d& pixel) {
   const Triangle t = CornersOf(mesh.grid, triangle);
-  const Eigen::Vector3d a = camera.CamFromWorld(mesh.mesh3d[t[0]]);
-  const Eigen::Vector3d b = camera.CamFromWorld(mesh.mesh3d[t[1]]);
-  const Eigen::Vector3d c = camera.CamFromWorld(mesh.mesh3d[t[2]]);
-  const Eigen::Vector3d d = camera.CamRay(pixel);
-  Eigen::Matrix3d A;
-  A << b - a, c - a, -d;
-  const Eigen::Vector3d sol = A.colPivHouseholderQr().solve(-a);
+  const Eigen::Vector3d sol =
+      RayOnTrianglePlane(camera, {mesh.mesh3d[t[0]], mesh.mesh3d[t[1]], mesh.mesh3d[t[2]]}, pixel);
   if (!sol.allFinite() || sol[2] <= 0) return std::nullopt;
   return (1 - sol[0] - sol[1]) * mesh.mesh2d[t[0]] + sol[0] * mesh.mesh2d[t[1]] +
          sol[1] * mesh.mesh2d[t[2]];
