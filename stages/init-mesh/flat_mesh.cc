@@ -126,17 +126,7 @@ MeshPair RegridOnPage(const MeshPair& m) {
   auto resample = [](const std::vector<Eigen::Vector2d>& line) {
     std::vector<double> s{0};
     for (size_t i = 1; i < line.size(); ++i) s.push_back(s.back() + (line[i] - line[i - 1]).norm());
-    std::vector<Eigen::Vector2d> out;
-    size_t j = 0;
-    const int n = int(line.size());
-    for (int k = 0; k < n; ++k) {
-      const double target = s.back() * k / (n - 1);
-      while (j + 2 < s.size() && s[j + 1] < target) ++j;
-      const double span = s[j + 1] - s[j];
-      const double f = span > 0 ? std::clamp((target - s[j]) / span, 0.0, 1.0) : 0.0;
-      out.push_back(line[j] + f * (line[j + 1] - line[j]));
-    }
-    return out;
+    return AtEqualArcLength(line, s, int(line.size()));
   };
   std::array<std::vector<Eigen::Vector2d>, 4> side;
   for (int k = 0; k < 4; ++k) side[k] = resample(border(k));

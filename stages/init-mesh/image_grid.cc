@@ -34,16 +34,7 @@ std::vector<Eigen::Vector2d> ResampleOnPage(const std::vector<Eigen::Vector2d>& 
     prev = x;
   }
   *length3d = s.back();
-  std::vector<Eigen::Vector2d> out;
-  size_t j = 0;
-  for (int k = 0; k < n; ++k) {
-    const double target = s.back() * k / (n - 1);
-    while (j + 2 < s.size() && s[j + 1] < target) ++j;
-    const double span = s[j + 1] - s[j];
-    const double f = span > 0 ? std::clamp((target - s[j]) / span, 0.0, 1.0) : 0.0;
-    out.push_back(dense[j] + f * (dense[j + 1] - dense[j]));
-  }
-  return out;
+  return AtEqualArcLength(dense, s, n);
 }
 
 // Signed area of quad q in the image (y down: positive for our orientation).
@@ -150,6 +141,20 @@ int UnfoldPatch(ImageGrid* patch) {
 }
 
 }  // namespace
+
+std::vector<Eigen::Vector2d> AtEqualArcLength(const std::vector<Eigen::Vector2d>& points,
+                                              const std::vector<double>& arc, int n) {
+  std::vector<Eigen::Vector2d> out;
+  size_t j = 0;
+  for (int k = 0; k < n; ++k) {
+    const double target = arc.back() * k / (n - 1);
+    while (j + 2 < arc.size() && arc[j + 1] < target) ++j;
+    const double span = arc[j + 1] - arc[j];
+    const double f = span > 0 ? std::clamp((target - arc[j]) / span, 0.0, 1.0) : 0.0;
+    out.push_back(points[j] + f * (points[j + 1] - points[j]));
+  }
+  return out;
+}
 
 std::vector<Eigen::Vector2d> Densify(const std::vector<Eigen::Vector2d>& p, double step) {
   std::vector<Eigen::Vector2d> out{p.front()};

@@ -25,6 +25,11 @@ struct ImageGrid {
 
 // --- image_grid.cc
 
+// `n` points along the polyline `points`, equally spaced in `arc` (its
+// cumulative length at each point, from 0; at least two points).
+std::vector<Eigen::Vector2d> AtEqualArcLength(const std::vector<Eigen::Vector2d>& points,
+                                              const std::vector<double>& arc, int n);
+
 // Densifies a polyline to steps of at most `step` pixels.
 std::vector<Eigen::Vector2d> Densify(const std::vector<Eigen::Vector2d>& p, double step);
 
