@@ -22,6 +22,11 @@ std::vector<std::vector<int>> QuadGrid::Faces() const {
   return faces;
 }
 
+Triangle QuadGrid::TriangleOf(int t) const {
+  const auto c = Quad(t / 2);
+  return t % 2 == 0 ? Triangle{c[0], c[1], c[2]} : Triangle{c[0], c[2], c[3]};
+}
+
 std::vector<Triangle> QuadGrid::Triangles() const {
   std::vector<Triangle> tris;
   tris.reserve(2 * NumQuads());
@@ -33,24 +38,7 @@ std::vector<Triangle> QuadGrid::Triangles() const {
   return tris;
 }
 
-SurfacePoint VertexSurfacePoint(const QuadGrid& grid, int row, int col) {
-  const int qr = std::min(row, grid.ny - 2), qc = std::min(col, grid.nx - 2);
-  const int quad = qr * (grid.nx - 1) + qc;
-  // Its place among the quad's corners (r,c) (r,c+1) (r+1,c+1) (r+1,c);
-  // triangle 2q holds corners 0 1 2, triangle 2q+1 corners 0 2 3.
-  const int corner = row == qr ? (col == qc ? 0 : 1) : (col == qc ? 3 : 2);
-  SurfacePoint p;
-  p.triangle = corner == 3 ? 2 * quad + 1 : 2 * quad;
-  p.bary = Eigen::Vector3d::Unit(corner == 3 ? 2 : corner);
-  return p;
-}
-
 namespace {
-
-Triangle TriangleCorners(const QuadGrid& grid, int triangle) {
-  const auto c = grid.Quad(triangle / 2);
-  return triangle % 2 == 0 ? Triangle{c[0], c[1], c[2]} : Triangle{c[0], c[2], c[3]};
-}
 
 QuadGrid GridOf(const PlyData& ply, const fs::path& path) {
   auto size = ply.GridSize();
@@ -68,12 +56,12 @@ QuadGrid GridOf(const PlyData& ply, const fs::path& path) {
 }  // namespace
 
 Eigen::Vector3d PointOnMesh3d(const MeshPair& m, const SurfacePoint& p) {
-  const Triangle t = TriangleCorners(m.grid, p.triangle);
+  const Triangle t = m.grid.TriangleOf(p.triangle);
   return p.bary[0] * m.mesh3d[t[0]] + p.bary[1] * m.mesh3d[t[1]] + p.bary[2] * m.mesh3d[t[2]];
 }
 
 Eigen::Vector2d PointOnMesh2d(const MeshPair& m, const SurfacePoint& p) {
-  const Triangle t = TriangleCorners(m.grid, p.triangle);
+  const Triangle t = m.grid.TriangleOf(p.triangle);
   return p.bary[0] * m.mesh2d[t[0]] + p.bary[1] * m.mesh2d[t[1]] + p.bary[2] * m.mesh2d[t[2]];
 }
 

@@ -35,6 +35,8 @@ struct QuadGrid {
   int Index(int row, int col) const { return row * nx + col; }
   // Corners of quad q in the order (r,c) (r,c+1) (r+1,c+1) (r+1,c).
   std::array<int, 4> Quad(int q) const;
+  // Triangle t: 2q holds quad q's corners 0 1 2, 2q+1 its corners 0 2 3.
+  Triangle TriangleOf(int t) const;
   std::vector<std::vector<int>> Faces() const;
   // Triangles 2q and 2q+1 of every quad q (see the file contract above).
   std::vector<Triangle> Triangles() const;
@@ -52,9 +54,6 @@ struct SurfacePoint {
   int triangle = -1;
   Eigen::Vector3d bary = Eigen::Vector3d::Zero();
 };
-
-// Grid vertex (row, col) as a corner of one of its quads' triangles.
-SurfacePoint VertexSurfacePoint(const QuadGrid& grid, int row, int col);
 
 Eigen::Vector3d PointOnMesh3d(const MeshPair& m, const SurfacePoint& p);
 Eigen::Vector2d PointOnMesh2d(const MeshPair& m, const SurfacePoint& p);

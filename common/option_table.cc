@@ -3,13 +3,17 @@
 #include <sstream>
 
 namespace docunfold {
+namespace {
 
+// A record key for a flag name: "lambda-iso" -> "lambda_iso".
 std::string RecordKey(const std::string& name) {
   std::string key = name;
   for (char& c : key)
     if (c == '-') c = '_';
   return key;
 }
+
+}  // namespace
 
 std::string OptionTable::JoinChoices(const std::vector<std::string>& names) {
   std::string joined;

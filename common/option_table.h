@@ -136,7 +136,4 @@ class OptionTable {
   std::vector<Entry> entries_;
 };
 
-// A record key for a flag name: "lambda-iso" -> "lambda_iso".
-std::string RecordKey(const std::string& name);
-
 }  // namespace docunfold

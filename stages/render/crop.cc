@@ -11,17 +11,12 @@
 namespace docunfold::render {
 namespace {
 
-Triangle CornersOf(const QuadGrid& grid, int triangle) {
-  const auto c = grid.Quad(triangle / 2);
-  return triangle % 2 == 0 ? Triangle{c[0], c[1], c[2]} : Triangle{c[0], c[2], c[3]};
-}
-
 // Where the viewing ray of `pixel` meets the plane of `triangle`, as a point
 // of M' (barycentrics may lie slightly outside the triangle).
 std::optional<Eigen::Vector2d> RayThroughTrianglePlane(const MeshPair& mesh,
                                                        const PinholeCamera& camera, int triangle,
                                                        const Eigen::Vector2d& pixel) {
-  const Triangle t = CornersOf(mesh.grid, triangle);
+  const Triangle t = mesh.grid.TriangleOf(triangle);
   const Eigen::Vector3d sol =
       RayOnTrianglePlane(camera, {mesh.mesh3d[t[0]], mesh.mesh3d[t[1]], mesh.mesh3d[t[2]]}, pixel);
   if (!sol.allFinite() || sol[2] <= 0) return std::nullopt;

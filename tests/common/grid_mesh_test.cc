@@ -39,19 +39,6 @@ TEST(GridMesh, TrianglesSplitEachQuadIntoTwo) {
   EXPECT_EQ(g.Faces()[1], (std::vector<int>{1, 2, 5, 4}));
 }
 
-TEST(GridMesh, EveryVertexIsACornerOfItsSurfacePoint) {
-  const MeshPair m = CurvedSheet();
-  for (int r = 0; r < m.grid.ny; ++r)
-    for (int c = 0; c < m.grid.nx; ++c) {
-      const SurfacePoint p = VertexSurfacePoint(m.grid, r, c);
-      ASSERT_GE(p.triangle, 0);
-      ASSERT_LT(p.triangle, 2 * m.grid.NumQuads());
-      EXPECT_DOUBLE_EQ(p.bary.sum(), 1.0);
-      EXPECT_EQ(PointOnMesh3d(m, p), m.mesh3d[m.grid.Index(r, c)]) << r << "," << c;
-      EXPECT_EQ(PointOnMesh2d(m, p), m.mesh2d[m.grid.Index(r, c)]) << r << "," << c;
-    }
-}
-
 TEST(GridMesh, WriteAndReadKeepTheGridAndTextureCoordinates) {
   testing::TempDir dir;
   MeshPair m = CurvedSheet();
