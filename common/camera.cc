@@ -76,8 +76,8 @@ std::optional<Eigen::Vector2d> ProjectDistorted(const PinholeCamera& camera,
 }
 
 cv::Mat ReadViewPhoto(const fs::path& path, const PinholeCamera& view, const fs::path& cameras_file,
-                      int flags) {
-  cv::Mat photo = ReadImage(path, flags);
+                      PhotoColor color) {
+  cv::Mat photo = ReadPhoto(path, color).image;
   if (photo.cols != view.width || photo.rows != view.height)
     throw InputError(path.string() + ": " + std::to_string(photo.cols) + "x" +
                      std::to_string(photo.rows) + " differs from its camera's " +

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "common/json_io.h"
+#include "common/photo.h"
 
 namespace docunfold {
 
@@ -83,11 +84,11 @@ std::optional<Eigen::Vector2d> ProjectDistorted(const PinholeCamera& camera,
                                                 const std::array<double, 4>& distortion,
                                                 const Eigen::Vector3d& x_world);
 
-// The photo `path` of `view`, read with cv::imread's `flags`; InputError
-// naming the file when it is missing, unreadable or not the size its camera
-// in `cameras_file` says.
+// The photo `path` of `view`, read upright by the photo reader (photo.h);
+// InputError naming the file when it is missing, unreadable, damaged or not
+// the size its camera in `cameras_file` says.
 cv::Mat ReadViewPhoto(const fs::path& path, const PinholeCamera& view, const fs::path& cameras_file,
-                      int flags);
+                      PhotoColor color = PhotoColor::kBgr);
 
 // JSON for one camera: {"image","width","height","K","R","t"}.
 Json CameraToJson(const PinholeCamera& camera);

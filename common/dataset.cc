@@ -1,19 +1,11 @@
 #include "common/dataset.h"
 
 #include <algorithm>
-#include <cctype>
 
 #include "common/errors.h"
 #include "common/json_io.h"
 
 namespace docunfold {
-
-bool IsImageFile(const fs::path& path) {
-  std::string ext = path.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return std::tolower(c); });
-  return ext == ".jpg" || ext == ".jpeg" || ext == ".png" || ext == ".tif" || ext == ".tiff";
-}
 
 DataSet OpenDataSet(const fs::path& root) {
   std::error_code ec;
@@ -24,7 +16,8 @@ DataSet OpenDataSet(const fs::path& root) {
   DataSet set;
   set.root = root;
   for (const auto& entry : fs::directory_iterator(root / "images", ec))
-    if (entry.is_regular_file() && IsImageFile(entry.path())) set.images.push_back(entry.path());
+    if (entry.is_regular_file() && entry.path().filename().string().rfind('.', 0) != 0)
+      set.images.push_back(entry.path());
   std::sort(set.images.begin(), set.images.end());
   set.has_ground_truth = fs::is_directory(root / "ground_truth", ec);
   return set;

@@ -14,14 +14,13 @@ namespace fs = std::filesystem;
 
 struct DataSet {
   fs::path root;
-  std::vector<fs::path> images;  // sorted by file name
+  // Every file in images/ but hidden ones, sorted by name: which are photos
+  // the photo reader (photo.h) tells by their content.
+  std::vector<fs::path> images;
   bool has_ground_truth = false;
 
   fs::path ground_truth(const std::string& file) const { return root / "ground_truth" / file; }
 };
-
-// True for the photo extensions we accept (jpg, jpeg, png, tif, tiff; any case).
-bool IsImageFile(const fs::path& path);
 
 // Lists a data set; throws InputError when the folder or images/ is missing.
 DataSet OpenDataSet(const fs::path& root);

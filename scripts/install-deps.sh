@@ -11,6 +11,9 @@ packages=(
   build-essential cmake pkg-config
   # images, features, freetype text rendering (synth), LSD, DeepFlow
   libopencv-dev libopencv-contrib-dev
+  # the photo reader: libjpeg to tell a damaged JPEG from a whole one, EXIF
+  # orientation and focal length, iPhones' HEIC photos
+  libjpeg-dev libexif-dev libheif-dev
   # linear algebra everywhere
   libeigen3-dev
   # self-describing JSON files; command lines
@@ -37,8 +40,9 @@ packages=(
   # files and functions short)
   universal-ctags
   # tests (assimp reads our PLYs as an independent check; chromium opens the
-  # HTML report)
-  googletest libgtest-dev assimp-utils chromium
+  # HTML report; heif-enc, exiftool and jpegtran make phone-like photos)
+  googletest libgtest-dev assimp-utils chromium libheif-examples libimage-exiftool-perl
+  libjpeg-turbo-progs
 )
 
 if [[ "${1:-}" == "--list" ]]; then

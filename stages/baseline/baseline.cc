@@ -13,6 +13,7 @@
 #include "common/dataset.h"
 #include "common/errors.h"
 #include "common/json_io.h"
+#include "common/photo.h"
 #include "common/raster.h"
 #include "common/shading.h"
 #include "common/statistics.h"
@@ -302,7 +303,7 @@ BaselineResult Oracle(const BaselineInputs& in, const BaselineOptions& options,
     throw InputError((gt / "cameras.json").string() + ": no view named " + cameras.reference +
                      " (the reference of " + sfm_cameras.string() + ")");
   const fs::path photo_path = MustExist(in.data / "images" / cameras.reference, "oracle");
-  const cv::Mat photo = ReadImage(photo_path, cv::IMREAD_COLOR | cv::IMREAD_IGNORE_ORIENTATION);
+  const cv::Mat photo = ReadPhoto(photo_path).image;
   if (photo.cols != camera->width || photo.rows != camera->height)
     throw InputError(photo_path.string() + ": size " + std::to_string(photo.cols) + "x" +
                      std::to_string(photo.rows) + " differs from its true camera");

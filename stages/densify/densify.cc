@@ -279,8 +279,12 @@ WorkingCopies MakeWorkingCopies(const DensifyInputs& in, const DensifyOptions& o
   w.ref = detail::MakeView(ref_index, ref_camera, ref_grey, {}, result->working_scale);
   for (int i = 0; i < num_views; ++i) {
     if (i == ref_index) continue;
-    w.others.push_back(detail::MakeView(i, in.cameras.views[i], in.photos[i], in.distortion[i],
-                                        result->working_scale));
+    // Each view at most max_image_size too: a photo from a larger sensor is
+    // brought down to about the reference's resolution, not kept at its own.
+    const PinholeCamera& camera = in.cameras.views[i];
+    const double scale =
+        std::min(1.0, double(o.max_image_size) / std::max(camera.width, camera.height));
+    w.others.push_back(detail::MakeView(i, camera, in.photos[i], in.distortion[i], scale));
   }
   cv::resize(full_region, w.region, w.ref.grey.size(), 0, 0, cv::INTER_NEAREST);
   cv::resize(in.region, w.page, w.ref.grey.size(), 0, 0, cv::INTER_NEAREST);

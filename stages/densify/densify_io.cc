@@ -36,7 +36,7 @@ DensifyInputs ReadInputs(const DensifyOptions& o) {
       continue;
     }
     in.photos.push_back(
-        ReadViewPhoto(images / view.image, view, cameras_path, cv::IMREAD_GRAYSCALE));
+        ReadViewPhoto(images / view.image, view, cameras_path, PhotoColor::kGray));
   }
   const fs::path boundary_file =
       fs::is_directory(o.boundary) ? o.boundary / "boundary.json" : o.boundary;

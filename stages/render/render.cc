@@ -164,7 +164,7 @@ void TexturePastMesh(const RenderOptions& options, const RenderInputs& in,
     for (size_t v = 0; v < in.views.size(); ++v) {
       const ViewMask& view = in.views[v];
       if (view.photo.empty()) continue;
-      photos[v] = ReadViewPhoto(view.photo, view.camera, in.cameras_file, cv::IMREAD_COLOR);
+      photos[v] = ReadViewPhoto(view.photo, view.camera, in.cameras_file);
     }
   // The margin reached past M's border, from the reference photo itself.
   std::vector<const ExtensionStrip*> reached_strips;

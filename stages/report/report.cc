@@ -15,6 +15,7 @@
 #include "common/errors.h"
 #include "common/grid_mesh.h"
 #include "common/json_io.h"
+#include "common/photo.h"
 #include "common/ply.h"
 #include "stages/report/html.h"
 #include "stages/report/mesh_views.h"
@@ -115,8 +116,12 @@ void PhotosSection(const ReportOptions& o, const DataSet& data, const Json& came
   std::string reference = cameras.is_object() ? cameras.value("reference", "") : "";
   std::string html;
   for (const fs::path& p : data.images) {
-    cv::Mat image = cv::imread(p.string(), cv::IMREAD_COLOR);
-    if (image.empty()) continue;
+    cv::Mat image;
+    try {
+      image = ReadPhoto(p).image;
+    } catch (const InputError&) {
+      continue;  // left out: listed below from cameras.json
+    }
     const std::string name = p.filename().string();
     const bool is_ref = name == reference;
     std::string img = InlineImage(image, o.thumbnail_width, name);
@@ -160,8 +165,18 @@ void PhotosSection(const ReportOptions& o, const DataSet& data, const Json& came
         why += "</table>";
       }
     }
-    page->Add("<p>" + std::to_string(cameras.at("views").size()) + " of " +
-              std::to_string(data.images.size()) + " views registered. " + why + "</p>");
+    std::string left_out;
+    if (cameras.contains("left_out") && cameras["left_out"].is_array())
+      for (const Json& l : cameras["left_out"])
+        left_out += "<li>" + Escape(l.value("image", "?")) + " (" + Escape(l.value("reason", "")) +
+                    ")</li>";
+    const size_t photos =
+        data.images.size() - (cameras.contains("left_out") && cameras["left_out"].is_array()
+                                  ? cameras["left_out"].size()
+                                  : 0);
+    page->Add("<p>" + std::to_string(cameras.at("views").size()) + " of " + std::to_string(photos) +
+              " photos registered. " + why + "</p>" +
+              (left_out.empty() ? "" : "<p>Left out:</p><ul>" + left_out + "</ul>"));
   }
   page->End();
 }
@@ -558,7 +573,7 @@ ReportResult Run(const ReportOptions& o) {
   ReportResult r;
   r.html = page.Html("docunfold report: " + name,
                      "Data set <code>" + Escape(fs::absolute(o.data).string()) + "</code>, " +
-                         std::to_string(data.images.size()) + " photos; made " + date +
+                         std::to_string(data.images.size()) + " files in images/; made " + date +
                          " by docunfold " + ProgramVersion() + ".");
   return r;
 }

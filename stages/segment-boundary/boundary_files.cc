@@ -121,7 +121,7 @@ std::vector<BoundaryFiles> SegmentOtherViews(const OtherViews& views, const fs::
     if (view.image == cameras.reference) continue;
     ++*tried;
     const fs::path photo = views.views_dir / view.image;
-    const cv::Mat view_image = ReadViewPhoto(photo, view, views.cameras_path, cv::IMREAD_COLOR);
+    const cv::Mat view_image = ReadViewPhoto(photo, view, views.cameras_path);
     BoundaryResult result;
     try {
       result = SegmentBoundary(view_image, options);

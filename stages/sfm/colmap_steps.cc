@@ -101,22 +101,66 @@ std::string Colmap::NotFoundMessage(const std::string& program) {
          "scripts/install-deps.sh, or give its path with --colmap";
 }
 
-void ExtractFeatures(const Colmap& colmap, const Photos& photos) {
+namespace {
+
+// COLMAP's --ImageReader.camera_params for a focal length prior `f` on a
+// `width` x `height` copy (principal point at the centre, no distortion).
+std::string PriorParams(const std::string& model, double f, int width, int height) {
+  const std::string fs = Fixed(f, 3), cx = Fixed(width / 2.0, 1), cy = Fixed(height / 2.0, 1);
+  if (model == "PINHOLE") return fs + "," + fs + "," + cx + "," + cy;
+  if (model == "SIMPLE_RADIAL") return fs + "," + cx + "," + cy + ",0";
+  if (model == "RADIAL") return fs + "," + cx + "," + cy + ",0,0";
+  return fs + "," + cx + "," + cy;
+}
+
+}  // namespace
+
+void ExtractFeatures(const Colmap& colmap, const PhotoSet& photos) {
   const SfmOptions& o = *colmap.options;
-  Progress progress("extracting features", long(photos.names.size()));
+  Progress progress("extracting features", long(photos.photos.size()));
   const std::regex processed(R"(Processed file \[(\d+)/(\d+)\])");
-  colmap.Run(
-      "feature_extractor",
-      {"--database_path", colmap.database.string(), "--image_path", colmap.image_dir.string(),
-       "--image_list_path", (colmap.dir / "image_list.txt").string(), "--ImageReader.single_camera",
-       "1", "--ImageReader.camera_model", o.camera_model, "--SiftExtraction.use_gpu", "0",
-       "--SiftExtraction.max_image_size", std::to_string(o.max_image_size),
-       "--SiftExtraction.max_num_features", std::to_string(o.max_num_features),
-       "--SiftExtraction.num_threads", colmap.threads},
-      "feature_extractor.log", [&](const std::string& line) {
-        std::smatch m;
-        if (std::regex_search(line, m, processed)) progress.Update(std::stol(m[1]));
-      });
+  long done_before = 0;
+  // One run per camera group: each run with single_camera makes one camera.
+  for (size_t g = 0; g < photos.groups.size(); ++g) {
+    const CameraGroup& group = photos.groups[g];
+    const fs::path list_file = colmap.dir / ("image_list_" + std::to_string(g) + ".txt");
+    {
+      std::ofstream list(list_file);
+      for (const std::string& name : group.colmap_names) list << name << "\n";
+      if (!list) throw OutputError(list_file.string() + ": write failed");
+    }
+    std::vector<std::string> args = {"--database_path",
+                                     colmap.database.string(),
+                                     "--image_path",
+                                     colmap.image_dir.string(),
+                                     "--image_list_path",
+                                     list_file.string(),
+                                     "--ImageReader.single_camera",
+                                     "1",
+                                     "--ImageReader.camera_model",
+                                     o.camera_model,
+                                     "--SiftExtraction.use_gpu",
+                                     "0",
+                                     "--SiftExtraction.max_image_size",
+                                     std::to_string(o.max_image_size),
+                                     "--SiftExtraction.max_num_features",
+                                     std::to_string(o.max_num_features),
+                                     "--SiftExtraction.num_threads",
+                                     colmap.threads};
+    if (group.focal_prior > 0) {
+      args.push_back("--ImageReader.camera_params");
+      args.push_back(
+          PriorParams(o.camera_model, group.focal_prior, group.copy_width, group.copy_height));
+    }
+    colmap.Run("feature_extractor", args,
+               "feature_extractor" + (g ? "_" + std::to_string(g) : std::string()) + ".log",
+               [&](const std::string& line) {
+                 std::smatch m;
+                 if (std::regex_search(line, m, processed))
+                   progress.Update(done_before + std::stol(m[1]));
+               });
+    done_before += long(group.colmap_names.size());
+  }
   progress.Done();
 }
 
@@ -153,18 +197,13 @@ void MatchExactly(const Colmap& colmap, int pairs) {
 
 }  // namespace
 
-void MatchFeatures(const Colmap& colmap, const Photos& photos) {
+void MatchFeatures(const Colmap& colmap, const PhotoSet& photos) {
   const SfmOptions& o = *colmap.options;
-  const int n = int(photos.names.size());
+  const int n = int(photos.photos.size());
   const int pairs = n * (n - 1) / 2;
-  // matches_importer's list names a pair by its two names split at a space.
-  const bool spaced_names = std::any_of(
-      photos.names.begin(), photos.names.end(),
-      [](const std::string& name) { return name.find_first_of(" \t") != std::string::npos; });
-  const bool exact = o.matcher == "exact" && !spaced_names;
-  if (o.matcher == "exact" && spaced_names)
-    Log("an image name has a space, which COLMAP's match list cannot carry: COLMAP's "
-        "exhaustive matcher is used instead (its matches differ a little between runs)");
+  // The copies' names have no spaces, which matches_importer's list could
+  // not carry (photo_set.h).
+  const bool exact = o.matcher == "exact";
   Log("matching features: " + std::to_string(pairs) + " pairs of views (" +
       (exact ? std::string("exact, ") + AutoDotKernelName() : std::string("colmap")) + ")");
   if (exact) {
@@ -215,23 +254,27 @@ struct MapperSetting {
 
 // Judges the model an attempt made: every view registered, a plausible
 // focal length, enough points.
-void JudgeModel(const ColmapModel& m, const Photos& photos, const SfmOptions& o,
+void JudgeModel(const ColmapModel& m, const PhotoSet& photos, const SfmOptions& o,
                 MapperAttempt* attempt) {
-  const int n = int(photos.names.size());
+  const int n = int(photos.photos.size());
   attempt->produced_model = true;
   attempt->registered = int(m.images.size());
   attempt->points = int(m.points.size());
   attempt->mean_reprojection_error = m.MeanReprojectionError();
-  const ColmapCamera& cam = m.cameras.begin()->second;
-  attempt->focal = cam.MeanFocal();
-  attempt->params = cam.params;
-  const double factor = attempt->focal / photos.long_side;
+  const ColmapCamera& first = m.cameras.begin()->second;
+  attempt->focal = first.MeanFocal();
+  attempt->params = first.params;
   std::vector<std::string> problems;
   if (attempt->registered < n)
     problems.push_back(std::to_string(n - attempt->registered) + " of " + std::to_string(n) +
                        " views not registered");
-  if (factor < o.min_focal_factor || factor > o.max_focal_factor)
-    problems.push_back("implausible focal length " + Fixed(attempt->focal, 0) + " px");
+  for (const auto& [id, cam] : m.cameras) {
+    const double factor = cam.MeanFocal() / std::max(cam.width, cam.height);
+    if (factor < o.min_focal_factor || factor > o.max_focal_factor) {
+      problems.push_back("implausible focal length " + Fixed(cam.MeanFocal(), 0) + " px");
+      break;
+    }
+  }
   if (attempt->points < o.min_points)
     problems.push_back("only " + std::to_string(attempt->points) + " points");
   attempt->plausible = problems.empty();
@@ -240,10 +283,10 @@ void JudgeModel(const ColmapModel& m, const Photos& photos, const SfmOptions& o,
 
 // One run of the mapper with setting `s` into `dir`; the largest model it
 // made into *m and *m_dir.
-MapperAttempt RunMapper(const Colmap& colmap, const Photos& photos, const MapperSetting& s,
+MapperAttempt RunMapper(const Colmap& colmap, const PhotoSet& photos, const MapperSetting& s,
                         const fs::path& dir, ColmapModel* m, fs::path* m_dir) {
   const SfmOptions& o = *colmap.options;
-  const int n = int(photos.names.size());
+  const int n = int(photos.photos.size());
   const int model_id = CameraModelId(o.camera_model);
   MapperAttempt attempt;
   attempt.description =
@@ -261,8 +304,7 @@ MapperAttempt RunMapper(const Colmap& colmap, const Photos& photos, const Mapper
       {"--database_path", colmap.database.string(), "--image_path", colmap.image_dir.string(),
        "--output_path", dir.string(), "--Mapper.num_threads", colmap.threads,
        "--Mapper.ba_refine_extra_params", s.refine ? "1" : "0", "--Mapper.filter_max_reproj_error",
-       Fixed(s.filter * photos.matching_scale, 3), "--Mapper.tri_ignore_two_view_tracks",
-       o.two_view_tracks ? "0" : "1"},
+       Fixed(s.filter, 3), "--Mapper.tri_ignore_two_view_tracks", o.two_view_tracks ? "0" : "1"},
       "mapper.log",
       [&](const std::string& line) {
         std::smatch match;
@@ -295,7 +337,7 @@ MapperAttempt RunMapper(const Colmap& colmap, const Photos& photos, const Mapper
 
 }  // namespace
 
-Mapping MapWithRetries(const Colmap& colmap, const Photos& photos) {
+Mapping MapWithRetries(const Colmap& colmap, const PhotoSet& photos) {
   const SfmOptions& o = *colmap.options;
   const int model_id = CameraModelId(o.camera_model);
   std::vector<MapperSetting> settings = {{o.refine_distortion, o.max_reprojection_error}};

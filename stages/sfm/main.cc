@@ -28,10 +28,13 @@ int main(int argc, char** argv) {
 
   return RunStage("sfm", table, argc, argv, [&] {
     const sfm::SfmResult r = sfm::RunSfm(o, table.Record());
+    const size_t left_out = r.photos.left_out.size();
     Log(std::to_string(r.cameras.views.size()) + "/" + std::to_string(r.images.size()) +
-        " views registered, " + std::to_string(r.points.size()) + " points, " + r.camera_model +
-        " focal " + std::to_string(int(r.colmap_params[0] + 0.5)) + " px, reference " +
-        r.reference + " (" + r.reference_choice + "), " +
+        " views registered" +
+        (left_out ? " (" + std::to_string(left_out) + " files left out)" : std::string()) + ", " +
+        std::to_string(r.points.size()) + " points, " + r.camera_model + ", reference " +
+        r.reference + " (" + r.reference_choice + ", focal " +
+        std::to_string(int(r.cameras.Find(r.reference)->K(0, 0) + 0.5)) + " px), " +
         std::to_string(int(r.seconds_total + 0.5)) + " s; wrote " + o.out_dir.string());
   });
 }

@@ -14,6 +14,7 @@
 #include "common/cli.h"
 #include "common/dataset.h"
 #include "common/errors.h"
+#include "common/photo.h"
 #include "common/ply.h"
 #include "common/statistics.h"
 #include "stages/sfm/sfm_internal.h"
@@ -30,12 +31,6 @@ std::string JoinNames(const std::vector<std::string>& names, size_t max = 8) {
   for (size_t i = 0; i < names.size() && i < max; ++i) s += (i ? ", " : "") + names[i];
   if (names.size() > max) s += ", ...";
   return s;
-}
-
-cv::Mat ReadPhoto(const fs::path& path) {
-  // COLMAP ignores EXIF orientation; so must we, or reference.png and its K
-  // would disagree.
-  return cv::imread(path.string(), cv::IMREAD_COLOR | cv::IMREAD_IGNORE_ORIENTATION);
 }
 
 }  // namespace
@@ -78,52 +73,37 @@ void DeclareOptions(OptionTable& table, SfmOptions* o) {
                "echo COLMAP's output on stderr (it always goes to colmap/*.log)");
 }
 
-std::vector<std::string> CheckImages(const fs::path& data_dir, int* width, int* height,
-                                     std::vector<cv::Mat>* thumbnails) {
-  const DataSet set = OpenDataSet(data_dir);
-  const fs::path images_dir = data_dir / "images";
-  if (set.images.size() < 2)
-    throw InputError(images_dir.string() + ": " + std::to_string(set.images.size()) + " photo" +
-                     (set.images.size() == 1 ? "" : "s") +
-                     " (jpg, png or tif); sfm needs at least 2 views of the page");
-  std::vector<std::string> names;
-  Progress progress("checking images", long(set.images.size()));
-  for (size_t i = 0; i < set.images.size(); ++i) {
-    const fs::path& path = set.images[i];
-    const cv::Mat image = ReadPhoto(path);
-    if (image.empty()) throw InputError(path.string() + ": cannot be decoded as an image");
-    if (i == 0) {
-      *width = image.cols;
-      *height = image.rows;
-    } else if (image.cols != *width || image.rows != *height) {
-      throw InputError(path.string() + ": " + std::to_string(image.cols) + "x" +
-                       std::to_string(image.rows) + ", but " + set.images[0].filename().string() +
-                       " is " + std::to_string(*width) + "x" + std::to_string(*height) +
-                       "; all photos must come from one camera at one size");
-    }
-    names.push_back(path.filename().string());
-    if (thumbnails) {
-      const double f = std::min(1.0, 640.0 / std::max(image.cols, image.rows));
-      cv::Mat small;
-      cv::resize(image, small, cv::Size(), f, f, cv::INTER_AREA);
-      thumbnails->push_back(small);
-    }
-    progress.Update(long(i + 1));
-  }
-  return names;
-}
-
-double ToReferenceFrame(const ColmapModel& model, const std::string& reference, CameraSet* cameras,
+double ToReferenceFrame(const ColmapModel& model, const PhotoSet& photos,
+                        const std::string& reference, CameraSet* cameras,
                         std::vector<Eigen::Vector3d>* points) {
-  const ColmapImage* ref = nullptr;
-  for (const auto& [id, im] : model.images)
-    if (im.name == reference) ref = &im;
+  // Each image's camera in its own photo's pixels and frame (photo_set.h).
+  struct PhotoView {
+    const ColmapImage* image;
+    const PhotoCopy* photo;
+    PhotoFrame frame;
+    Eigen::Matrix3d R;  // photo camera from COLMAP's world
+    Eigen::Vector3d t;
+  };
+  std::vector<PhotoView> views;
+  const PhotoView* ref = nullptr;
+  for (const auto& [id, im] : model.images) {
+    const PhotoCopy* photo = photos.Find(im.name);
+    if (!photo) throw std::invalid_argument(im.name + " is not among the photos");
+    PhotoView v{&im, photo, ToPhotoFrame(model.cameras.at(im.camera_id), *photo), im.R(), im.t};
+    if (photo->turned) {
+      v.R = v.frame.Q * v.R;
+      v.t = v.frame.Q * v.t;
+    }
+    views.push_back(v);
+  }
+  for (const PhotoView& v : views)
+    if (v.image->name == reference) ref = &v;
   if (!ref) throw std::invalid_argument(reference + " is not in the model");
-  const Eigen::Matrix3d R_ref = ref->R();
+  const Eigen::Matrix3d R_ref = ref->R;
   const Eigen::Vector3d t_ref = ref->t;
   std::vector<double> depths;
   for (const ColmapPoint& p : model.points)
-    if (std::find(p.image_ids.begin(), p.image_ids.end(), ref->id) != p.image_ids.end())
+    if (std::find(p.image_ids.begin(), p.image_ids.end(), ref->image->id) != p.image_ids.end())
       depths.push_back((R_ref * p.xyz + t_ref).z());
   if (depths.empty())
     throw std::runtime_error("the reference view " + reference + " sees no 3D point");
@@ -134,18 +114,17 @@ double ToReferenceFrame(const ColmapModel& model, const std::string& reference, 
 
   cameras->reference = reference;
   cameras->views.clear();
-  for (const auto& [id, im] : model.images) {
-    const ColmapCamera& c = model.cameras.at(im.camera_id);
+  for (const PhotoView& v : views) {
     PinholeCamera cam;
-    cam.image = im.name;
-    cam.width = c.width;
-    cam.height = c.height;
-    cam.K = c.PinholeK();
+    cam.image = v.image->name;
+    cam.width = v.photo->width;
+    cam.height = v.photo->height;
+    cam.K = v.frame.K;
     // x_j = R_j x + t_j and x = R_ref^T (d x' - t_ref), so
     // x_j / d = R_j R_ref^T x' + (t_j - R_j R_ref^T t_ref) / d.
-    cam.R = im.R() * R_ref.transpose();
-    cam.t = (im.t - cam.R * t_ref) / divisor;
-    if (im.id == ref->id) {  // exactly, not up to rounding
+    cam.R = v.R * R_ref.transpose();
+    cam.t = (v.t - cam.R * t_ref) / divisor;
+    if (&v == ref) {  // exactly, not up to rounding
       cam.R.setIdentity();
       cam.t.setZero();
     }
@@ -159,13 +138,15 @@ double ToReferenceFrame(const ColmapModel& model, const std::string& reference, 
   return divisor;
 }
 
-cv::Mat UndistortPhoto(const cv::Mat& photo, const ColmapCamera& camera) {
-  if (!camera.HasDistortion()) return photo.clone();
+cv::Mat UndistortPhoto(const cv::Mat& photo, const Eigen::Matrix3d& K_photo,
+                       const std::array<double, 4>& distortion) {
+  if (std::all_of(distortion.begin(), distortion.end(), [](double d) { return d == 0; }))
+    return photo.clone();
   // Same K before and after: reference.png keeps the photo's size and pixel
   // grid, and cameras.json's K is exactly its pinhole camera.
   cv::Mat K;
-  cv::eigen2cv(Eigen::Matrix3d(camera.PinholeK()), K);
-  const auto d = camera.OpenCvDistortion();
+  cv::eigen2cv(K_photo, K);
+  const auto& d = distortion;
   const cv::Mat dist = (cv::Mat_<double>(1, 4) << d[0], d[1], d[2], d[3]);
   cv::Mat map1, map2;
   cv::initUndistortRectifyMap(K, dist, cv::Mat(), K, photo.size(), CV_32FC1, map1, map2);
@@ -184,18 +165,21 @@ Json CamerasJson(const SfmResult& r, const Json& options_record) {
   doc["frame"] =
       "camera frame of the reference view (x right, y down, z forward), scaled so "
       "that the median depth of the points it sees is 1; x_cam = R x_world + t";
-  const bool distorted =
-      std::any_of(r.distortion.begin(), r.distortion.end(), [](double d) { return d != 0; });
+  bool distorted = false;
+  for (const auto& [name, d] : r.distortion)
+    distorted = distorted || std::any_of(d.begin(), d.end(), [](double k) { return k != 0; });
   doc["views"] = Json::array();
   for (const PinholeCamera& c : r.cameras.views) {
     Json v = CameraToJson(c);
+    const auto& d = r.distortion.at(c.image);
     if (distorted && c.image != r.reference)
-      v["distortion"] = {
-          {"model", "opencv"},
-          {"coefficients", {r.distortion[0], r.distortion[1], r.distortion[2], r.distortion[3]}}};
+      v["distortion"] = {{"model", "opencv"}, {"coefficients", {d[0], d[1], d[2], d[3]}}};
     doc["views"].push_back(v);
   }
   doc["reference_undistorted"] = distorted;
+  doc["left_out"] = Json::array();
+  for (const LeftOut& l : r.photos.left_out)
+    doc["left_out"].push_back({{"image", l.name}, {"reason", l.reason}});
   Json scores = Json::array();
   for (const ViewScore& s : r.view_scores)
     scores.push_back({{"image", s.image},
@@ -218,8 +202,26 @@ Json CamerasJson(const SfmResult& r, const Json& options_record) {
                         {"plausible", a.plausible},
                         {"problem", a.problem},
                         {"seconds", a.seconds}});
+  Json cameras = Json::array();
+  for (const auto& [g, params] : r.colmap_params) {
+    const CameraGroup& group = r.photos.groups[size_t(g)];
+    Json images = Json::array();
+    for (const PhotoCopy& p : r.photos.photos)
+      if (p.group == g)
+        images.push_back({{"image", p.name},
+                          {"copy", p.colmap_name},
+                          {"turned", p.turned},
+                          {"scale", double(p.copy_width) / (p.turned ? p.height : p.width)}});
+    cameras.push_back({{"width", group.copy_width},
+                       {"height", group.copy_height},
+                       {"params", params},
+                       {"exif_camera", group.camera},
+                       {"exif_focal_35mm", group.focal_35mm},
+                       {"focal_prior_px", group.focal_prior},
+                       {"images", images}});
+  }
   doc["colmap"] = {{"camera_model", r.camera_model},
-                   {"params", r.colmap_params},
+                   {"cameras", cameras},
                    {"images", r.images.size()},
                    {"registered", r.cameras.views.size()},
                    {"unregistered", r.unregistered},
@@ -281,11 +283,13 @@ void ChooseReference(const ColmapModel& model, const std::set<std::string>& regi
 // The cameras and points of `model` in the reference view's frame.
 void ToResult(const ColmapModel& model, SfmResult* result) {
   result->scale_divisor =
-      ToReferenceFrame(model, result->reference, &result->cameras, &result->points);
-  const ColmapCamera& camera = model.cameras.begin()->second;
-  result->camera_model = CameraModelName(camera.model_id);
-  result->colmap_params = camera.params;
-  result->distortion = camera.OpenCvDistortion();
+      ToReferenceFrame(model, result->photos, result->reference, &result->cameras, &result->points);
+  result->camera_model = CameraModelName(model.cameras.begin()->second.model_id);
+  for (const auto& [id, image] : model.images) {
+    const ColmapCamera& camera = model.cameras.at(image.camera_id);
+    result->distortion[image.name] = camera.OpenCvDistortion();
+    result->colmap_params[result->photos.Find(image.name)->group] = camera.params;
+  }
   result->mean_reprojection_error = model.MeanReprojectionError();
   for (const ColmapPoint& p : model.points) {
     result->colors.push_back(p.rgb);
@@ -294,19 +298,18 @@ void ToResult(const ColmapModel& model, SfmResult* result) {
   }
 }
 
-// reference.png (the reference photo undistorted by `camera`) and
+// reference.png (the reference photo, upright and undistorted) and
 // points.ply into `dir`.
-void WritePhotoAndPoints(const SfmResult& result, const ColmapCamera& camera, const SfmOptions& o,
-                         const fs::path& dir) {
+void WritePhotoAndPoints(const SfmResult& result, const SfmOptions& o, const fs::path& dir) {
   {
     const fs::path photo = o.data_dir / "images" / result.reference;
-    cv::Mat image = ReadPhoto(photo);
-    if (image.empty()) throw InputError(photo.string() + ": cannot be decoded as an image");
+    cv::Mat image = ReadPhoto(photo).image;
+    const PinholeCamera& camera = *result.cameras.Find(result.reference);
     if (image.cols != camera.width || image.rows != camera.height)
-      throw std::runtime_error(photo.string() + ": " + std::to_string(image.cols) + "x" +
-                               std::to_string(image.rows) + " but COLMAP's camera is " +
-                               std::to_string(camera.width) + "x" + std::to_string(camera.height));
-    image = UndistortPhoto(image, camera);
+      throw InputError(photo.string() + ": " + std::to_string(image.cols) + "x" +
+                       std::to_string(image.rows) + " now, " + std::to_string(camera.width) + "x" +
+                       std::to_string(camera.height) + " when it was read first");
+    image = UndistortPhoto(image, camera.K, result.distortion.at(result.reference));
     WriteImageAtomic(dir / "reference.png", image, {cv::IMWRITE_PNG_COMPRESSION, 1});
   }
   PlyData ply;
@@ -321,7 +324,8 @@ void WritePhotoAndPoints(const SfmResult& result, const ColmapCamera& camera, co
                       " (x right, y down, z forward), scaled so the median depth of the points "
                       "it sees is 1",
                   "track_length: number of views observing the point; reprojection_error: "
-                  "COLMAP's mean over the track, pixels of the photos",
+                  "COLMAP's mean over the track, pixels of the copies it saw (long side at most "
+                  "--max-image-size)",
                   "camera model " + result.camera_model + "; cameras in cameras.json"};
   WritePly(dir / "points.ply", ply);
 }
@@ -339,38 +343,33 @@ SfmResult RunSfm(const SfmOptions& o, const Json& options_record) {
     throw UsageError("--max-reprojection-error must be positive");
 
   SfmResult result;
-  int width = 0, height = 0;
+  CheckOutputDir(o.out_dir);
+  StagingDir staging(o.out_dir);
+  // COLMAP's workspace, colmap/ in the staging directory, with the copies of
+  // the photos it works on.
+  Colmap colmap;
+  colmap.options = &o;
+  colmap.dir = staging.path() / "colmap";
+  colmap.image_dir = colmap.dir / "images";
+  EnsureDirectory(colmap.image_dir);
   std::vector<cv::Mat> thumbnails;
-  result.images = CheckImages(o.data_dir, &width, &height, &thumbnails);
-  result.seconds_reading = timer.Mark("checking images");
-  if (!o.reference.empty() &&
-      std::find(result.images.begin(), result.images.end(), o.reference) == result.images.end())
+  result.photos = PreparePhotos(o.data_dir, o.max_image_size, colmap.image_dir, &thumbnails);
+  const PhotoSet& photos = result.photos;
+  for (const PhotoCopy& p : photos.photos) result.images.push_back(p.name);
+  result.seconds_reading = timer.Mark("reading photos");
+  if (photos.groups.size() > 1)
+    Log(std::to_string(photos.groups.size()) +
+        " cameras (photos of different sizes or from different phones)");
+  if (!o.reference.empty() && !photos.Find(o.reference))
     throw InputError("--ref " + o.reference + ": no such photo in " +
                      (o.data_dir / "images").string() + " (there are " + JoinNames(result.images) +
                      ")");
-  CheckOutputDir(o.out_dir);
 
-  // COLMAP's workspace, colmap/ in the staging directory.
-  Colmap colmap;
-  colmap.options = &o;
   colmap.exe = FindExecutable(o.colmap);
   if (colmap.exe.empty()) throw std::runtime_error(Colmap::NotFoundMessage(o.colmap));
-  StagingDir staging(o.out_dir);
-  colmap.dir = staging.path() / "colmap";
-  EnsureDirectory(colmap.dir);
   colmap.database = colmap.dir / "database.db";
-  colmap.image_dir = fs::absolute(o.data_dir / "images");
   colmap.threads = std::to_string(o.threads);
-  {
-    std::ofstream list(colmap.dir / "image_list.txt");
-    for (const std::string& name : result.images) list << name << "\n";
-    if (!list) throw OutputError((colmap.dir / "image_list.txt").string() + ": write failed");
-  }
-  Photos photos;
-  photos.names = result.images;
-  photos.long_side = std::max(width, height);
-  photos.matching_scale = double(photos.long_side) / std::min(photos.long_side, o.max_image_size);
-  const int n = int(result.images.size());
+  const int n = int(photos.photos.size());
   timer.Mark("workspace");
 
   ExtractFeatures(colmap, photos);
@@ -386,6 +385,7 @@ SfmResult RunSfm(const SfmOptions& o, const Json& options_record) {
                      " photos share enough matching features (fewer than 2 views "
                      "registered)");
   KeepModel(colmap, mapping.model_dir);
+  NameByPhotos(photos, &mapping.model);
   const ColmapModel& model = mapping.model;
   if (model.images.size() < 2)
     throw InputError("only " + std::to_string(model.images.size()) + " of " + std::to_string(n) +
@@ -400,7 +400,7 @@ SfmResult RunSfm(const SfmOptions& o, const Json& options_record) {
   ToResult(model, &result);
 
   // Outputs, into the staging directory, which then replaces --out.
-  WritePhotoAndPoints(result, model.cameras.begin()->second, o, staging.path());
+  WritePhotoAndPoints(result, o, staging.path());
   result.seconds_total = timer.Total();
   WriteJsonAtomic(staging.path() / "cameras.json", CamerasJson(result, options_record));
   staging.Commit();

@@ -11,14 +11,16 @@
 //                  depth of the points the reference sees is 1)
 //   points.ply     binary PLY: x y z, red green blue, track_length,
 //                  reprojection_error (pixels)
-//   reference.png  the reference photo, undistorted when the camera model has
-//                  distortion; its K is the one in cameras.json
-//   colmap/        database.db, sparse/0/*.bin (COLMAP's binary model),
+//   reference.png  the reference photo (upright), undistorted when the camera
+//                  model has distortion; its K is the one in cameras.json
+//   colmap/        images/ (the photos' copies COLMAP saw, photo_set.h),
+//                  database.db, sparse/0/*.bin (COLMAP's binary model),
 //                  *.log (everything COLMAP printed)
 #pragma once
 
 #include <Eigen/Core>
 #include <filesystem>
+#include <map>
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
@@ -26,6 +28,7 @@
 #include "common/camera.h"
 #include "common/json_io.h"
 #include "common/option_table.h"
+#include "stages/sfm/photo_set.h"
 #include "stages/sfm/reference_view.h"
 
 namespace docunfold::sfm {
@@ -105,17 +108,21 @@ struct SfmResult {
   std::string reference;         // image name
   std::string reference_choice;  // "auto" or "--ref"
   CameraSet cameras;             // every registered view, reference frame
-  // Distortion (OpenCV k1, k2, p1, p2 on normalized coordinates) of the
-  // photos; all zero for pinhole models. reference.png is undistorted.
-  std::array<double, 4> distortion{};
-  std::string camera_model;           // COLMAP model name
-  std::vector<double> colmap_params;  // COLMAP's camera parameters
-  std::vector<std::string> images;    // every image of the data set
+  // Distortion (OpenCV k1, k2, p1, p2 on normalized coordinates) of each
+  // registered photo; all zero for pinhole models. reference.png is
+  // undistorted.
+  std::map<std::string, std::array<double, 4>> distortion;
+  std::string camera_model;  // COLMAP model name
+  PhotoSet photos;           // the photos as COLMAP saw them; what was left out
+  // COLMAP's cameras (one per CameraGroup that has a registered photo), by
+  // group index: their parameters, in the copies' pixels.
+  std::map<int, std::vector<double>> colmap_params;
+  std::vector<std::string> images;  // every photo of the data set (not the left-out files)
   std::vector<std::string> unregistered;
   std::vector<Eigen::Vector3d> points;  // reference frame
   std::vector<std::array<uint8_t, 3>> colors;
   std::vector<int> track_lengths;
-  std::vector<double> reprojection_errors;  // pixels, full resolution
+  std::vector<double> reprojection_errors;  // pixels of the copies COLMAP saw
   double mean_reprojection_error = 0;
   // Median depth (COLMAP's units) of the points the reference view sees:
   // the frame was divided by it.
@@ -135,23 +142,18 @@ SfmResult RunSfm(const SfmOptions& options, const Json& options_record);
 
 // --- building blocks (exposed for tests) ----------------------------------
 
-// Checks the data set: images/ exists, >= 2 photos, each decodes and all
-// have the same size (one shared camera). Returns the image names, sorted,
-// and, when `thumbnails` is given, each photo scaled to a long side of at
-// most 640 px. Throws InputError naming the folder or file.
-std::vector<std::string> CheckImages(const fs::path& data_dir, int* width, int* height,
-                                     std::vector<cv::Mat>* thumbnails = nullptr);
-
-// The cameras and points of `model` in the frame of `reference`: rotation
-// and translation of the reference camera removed, scaled so that the median
-// depth of the points the reference sees is 1. K is COLMAP's pinhole part in
-// our pixel convention. Returns the divisor used.
-double ToReferenceFrame(const ColmapModel& model, const std::string& reference, CameraSet* cameras,
+// The cameras and points of `model` in the frame of `reference`: each camera
+// in its own photo's pixels (`photos`, ToPhotoFrame), the reference camera's
+// rotation and translation removed, scaled so that the median depth of the
+// points the reference sees is 1. Returns the divisor used.
+double ToReferenceFrame(const ColmapModel& model, const PhotoSet& photos,
+                        const std::string& reference, CameraSet* cameras,
                         std::vector<Eigen::Vector3d>* points);
 
-// The photo as the pinhole camera PinholeK() would have taken it (same size,
-// same K); a copy when the camera has no distortion.
-cv::Mat UndistortPhoto(const cv::Mat& photo, const ColmapCamera& camera);
+// The photo as the pinhole camera `K` would have taken it (same size, same
+// K); a copy when there is no distortion.
+cv::Mat UndistortPhoto(const cv::Mat& photo, const Eigen::Matrix3d& K,
+                       const std::array<double, 4>& distortion);
 
 // The cameras.json document of a result.
 Json CamerasJson(const SfmResult& result, const Json& options_record);

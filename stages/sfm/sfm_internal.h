@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "stages/sfm/colmap_model.h"
+#include "stages/sfm/photo_set.h"
 #include "stages/sfm/sfm.h"
 #include "stages/sfm/subprocess.h"
 
@@ -43,7 +44,7 @@ struct Colmap {
   const SfmOptions* options;
   fs::path dir;         // colmap/ workspace
   fs::path database;    // <dir>/database.db
-  fs::path image_dir;   // the data set's images/, absolute
+  fs::path image_dir;   // <dir>/images: the photos' copies (photo_set.h)
   std::string threads;  // --threads as COLMAP takes it
 
   // Runs one COLMAP command, its output into <dir>/<log>; throws when it
@@ -56,21 +57,12 @@ struct Colmap {
   static std::string NotFoundMessage(const std::string& program);
 };
 
-// The photos as the COLMAP steps see them.
-struct Photos {
-  std::vector<std::string> names;  // every image of the data set, sorted
-  int long_side = 0;               // pixels
-  // Keypoints come back at full resolution: a pixel at matching resolution
-  // is this many photo pixels.
-  double matching_scale = 1;
-};
-
 // SIFT features of every photo into the database (feature_extractor).
-void ExtractFeatures(const Colmap& colmap, const Photos& photos);
+void ExtractFeatures(const Colmap& colmap, const PhotoSet& photos);
 
 // Matches between every pair of photos: exact nearest neighbours
 // (matching.h) verified by COLMAP, or COLMAP's own exhaustive matcher.
-void MatchFeatures(const Colmap& colmap, const Photos& photos);
+void MatchFeatures(const Colmap& colmap, const PhotoSet& photos);
 
 // What the mapper made, over its attempts.
 struct Mapping {
@@ -83,7 +75,7 @@ struct Mapping {
 // Incremental mapping into <dir>/attempts/<i>/, retried with other settings
 // (SfmOptions::retry) while the result is implausible; the best attempt
 // (plausible first, in the order tried) wins.
-Mapping MapWithRetries(const Colmap& colmap, const Photos& photos);
+Mapping MapWithRetries(const Colmap& colmap, const PhotoSet& photos);
 
 // Keeps the chosen model as <dir>/sparse/0 (what `colmap model_analyzer` and
 // the GUI expect) and drops the other attempts.

@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "common/camera.h"
+#include "common/json_io.h"
 #include "common/ply.h"
 #include "stages/sfm/subprocess.h"
 #include "tests/sfm/sfm_eval.h"
@@ -122,26 +123,58 @@ TEST_F(SfmCli, FewerThanTwoImages) {
   ExpectFailure(Sfm(Args(tmp_ / "set", out)), 3, "at least 2", out, {});
 }
 
-TEST_F(SfmCli, UnreadableImageIsNamed) {
+TEST_F(SfmCli, FilesThatAreNotPhotosAreLeftOutByName) {
   fs::create_directories(tmp_ / "set" / "images");
   cv::imwrite((tmp_ / "set" / "images" / "a.jpg").string(), Noise(64, 48, 1));
-  cv::imwrite((tmp_ / "set" / "images" / "b.jpg").string(), Noise(64, 48, 2));
   std::ofstream(tmp_ / "set" / "images" / "broken.jpg") << "\xff\xd8 this is not a JPEG";
   std::ofstream(tmp_ / "set" / "images" / "empty.png");
   const fs::path out = tmp_ / "work" / "10_sfm";
   fs::create_directories(out.parent_path());
-  ExpectFailure(Sfm(Args(tmp_ / "set", out)), 3, "broken.jpg", out, {});
-  fs::remove(tmp_ / "set" / "images" / "broken.jpg");
-  ExpectFailure(Sfm(Args(tmp_ / "set", out)), 3, "empty.png", out, {});
+  const CommandResult r = Sfm(Args(tmp_ / "set", out));
+  ExpectFailure(r, 3, "1 photo (2 files left out)", out, {});
+  EXPECT_NE(r.output.find("left out: broken.jpg (not a photo)"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("left out: empty.png (not a photo)"), std::string::npos) << r.output;
 }
 
-TEST_F(SfmCli, PhotosOfDifferentSizes) {
-  fs::create_directories(tmp_ / "set" / "images");
-  cv::imwrite((tmp_ / "set" / "images" / "a.jpg").string(), Noise(64, 48, 1));
-  cv::imwrite((tmp_ / "set" / "images" / "b.jpg").string(), Noise(48, 64, 2));
+// Photos of different sizes get a camera each; a photo turned to portrait
+// shares the camera of its landscape siblings; names keep their spaces and
+// accents in cameras.json while COLMAP works on plain copies (so the exact
+// matcher still runs).
+TEST_F(SfmCli, MixedSizesTurnedPhotosAndSpacedNames) {
+  if (!HaveColmap()) GTEST_SKIP() << "COLMAP not installed";
+  const fs::path data = SmallSet(4);
+  if (data.empty()) GTEST_SKIP() << "no data set with ground truth";
+  std::vector<fs::path> photos;
+  for (const auto& e : fs::directory_iterator(data / "images")) photos.push_back(e.path());
+  std::sort(photos.begin(), photos.end());
+  cv::Mat turned;
+  cv::rotate(cv::imread(photos[1].string()), turned, cv::ROTATE_90_COUNTERCLOCKWISE);
+  cv::imwrite(photos[1].string(), turned);
+  const cv::Mat big = cv::imread(photos[2].string());
+  cv::Mat small;
+  cv::resize(big, small, cv::Size(), 0.75, 0.75, cv::INTER_AREA);
+  cv::imwrite(photos[2].string(), small);
+  const std::string spaced = "Photo 2026-11-28 10.15 \xc3\xa9t\xc3\xa9.jpg";
+  fs::rename(photos[0], data / "images" / spaced);
   const fs::path out = tmp_ / "work" / "10_sfm";
-  fs::create_directories(out.parent_path());
-  ExpectFailure(Sfm(Args(tmp_ / "set", out)), 3, "b.jpg", out, {});
+  const CommandResult r = Sfm(Args(data, out, "--threads 2"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_FALSE(fs::exists(out / "colmap/exhaustive_matcher.log")) << "the exact matcher ran";
+  const CameraSet cameras = ReadCameras(out / "cameras.json");
+  ASSERT_EQ(cameras.views.size(), 4u) << r.output;
+  const PinholeCamera* first = cameras.Find(spaced);
+  const PinholeCamera* portrait = cameras.Find(photos[1].filename().string());
+  const PinholeCamera* reduced = cameras.Find(photos[2].filename().string());
+  ASSERT_TRUE(first && portrait && reduced);
+  EXPECT_EQ(portrait->width, turned.cols);
+  EXPECT_EQ(portrait->height, turned.rows);
+  EXPECT_EQ(reduced->width, small.cols);
+  // One lens: the turned photo has the same focal length, the smaller one
+  // three quarters of it.
+  EXPECT_NEAR(portrait->K(0, 0), first->K(0, 0), 1e-6 * first->K(0, 0));
+  EXPECT_NEAR(reduced->K(0, 0) / first->K(0, 0), 0.75, 0.03);
+  const Json doc = ReadJsonFile(out / "cameras.json");
+  EXPECT_EQ(doc.at("colmap").at("cameras").size(), 2u);
 }
 
 TEST_F(SfmCli, RefThatDoesNotExist) {
@@ -252,22 +285,6 @@ TEST_F(SfmCli, GoodRunThenRefThenFailedRunKeepsTheOutput) {
   std::ifstream after_file(out / "cameras.json");
   const std::string after((std::istreambuf_iterator<char>(after_file)), {});
   EXPECT_EQ(before, after);
-}
-
-// COLMAP's match list splits a pair's names at spaces: such names fall
-// back to its exhaustive matcher, with a note, rather than fail.
-TEST_F(SfmCli, ImageNamesWithSpacesUseColmapsMatcher) {
-  if (!HaveColmap()) GTEST_SKIP() << "COLMAP not installed";
-  const fs::path data = SmallSet();
-  if (data.empty()) GTEST_SKIP() << "no data set with ground truth";
-  const fs::path first = *fs::directory_iterator(data / "images");
-  fs::rename(first, data / "images" / ("my " + first.filename().string()));
-  const fs::path out = tmp_ / "work" / "10_sfm";
-  const CommandResult r = Sfm(Args(data, out, "--threads 2"));
-  ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_NE(r.output.find("exhaustive matcher is used instead"), std::string::npos) << r.output;
-  EXPECT_TRUE(fs::is_regular_file(out / "colmap/exhaustive_matcher.log"));
-  EXPECT_EQ(ReadCameras(out / "cameras.json").views.size(), 3u);
 }
 
 TEST_F(SfmCli, RefNotRegistered) {

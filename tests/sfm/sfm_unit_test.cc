@@ -257,9 +257,17 @@ TEST(ReferenceFrameTest, ReferenceIsIdentityAtMedianDepthOneAndPixelsAreKept) {
   m.points.back().xyz = {0, 0, -30};
   m.points.back().image_ids = {2, 3};
 
+  sfm::PhotoSet photos;
+  for (const char* name : {"v0.jpg", "v1.jpg", "v2.jpg"}) {
+    sfm::PhotoCopy p;
+    p.name = p.colmap_name = name;
+    p.width = p.copy_width = 800;
+    p.height = p.copy_height = 600;
+    photos.photos.push_back(p);
+  }
   CameraSet cams;
   std::vector<Eigen::Vector3d> pts;
-  const double divisor = sfm::ToReferenceFrame(m, "v1.jpg", &cams, &pts);
+  const double divisor = sfm::ToReferenceFrame(m, photos, "v1.jpg", &cams, &pts);
   EXPECT_GT(divisor, 0);
   ASSERT_EQ(cams.views.size(), 3u);
   EXPECT_EQ(cams.reference, "v1.jpg");
@@ -287,7 +295,7 @@ TEST(ReferenceFrameTest, ReferenceIsIdentityAtMedianDepthOneAndPixelsAreKept) {
       EXPECT_LT((before - after).norm(), 1e-9) << c.image;
     }
   }
-  EXPECT_THROW(sfm::ToReferenceFrame(m, "nope.jpg", &cams, &pts), std::invalid_argument);
+  EXPECT_THROW(sfm::ToReferenceFrame(m, photos, "nope.jpg", &cams, &pts), std::invalid_argument);
 }
 
 TEST(ReferenceViewTest, NormalsOfAPlaneAreItsNormal) {
@@ -386,39 +394,6 @@ TEST(ReferenceViewTest, AViewThatSeesPartOfThePageFromBehindLoses) {
   EXPECT_GT(sfm::ReferenceScore(curled, 51.4, off), sfm::ReferenceScore(whole, 51.4, off));
 }
 
-TEST(CheckImagesTest, AcceptsPhotosOfOneSizeAndNamesTheBadOne) {
-  TempDir tmp;
-  fs::create_directories(tmp / "set/images");
-  const cv::Mat a(60, 80, CV_8UC3, cv::Scalar(10, 200, 30));
-  cv::imwrite((tmp / "set/images/b.png").string(), a);
-  cv::imwrite((tmp / "set/images/a.jpg").string(), a);
-  std::ofstream(tmp / "set/images/notes.txt") << "not a photo";
-  int w = 0, h = 0;
-  EXPECT_EQ(sfm::CheckImages(tmp / "set", &w, &h), (std::vector<std::string>{"a.jpg", "b.png"}));
-  EXPECT_EQ(w, 80);
-  EXPECT_EQ(h, 60);
-
-  cv::imwrite((tmp / "set/images/c.png").string(), cv::Mat(61, 80, CV_8UC3, cv::Scalar(0)));
-  try {
-    sfm::CheckImages(tmp / "set", &w, &h);
-    FAIL();
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("c.png"), std::string::npos) << e.what();
-  }
-  fs::remove(tmp / "set/images/c.png");
-  std::ofstream(tmp / "set/images/d.jpg") << "garbage, not a JPEG";
-  try {
-    sfm::CheckImages(tmp / "set", &w, &h);
-    FAIL();
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("d.jpg"), std::string::npos) << e.what();
-  }
-  fs::remove(tmp / "set/images/d.jpg");
-  fs::remove(tmp / "set/images/b.png");
-  EXPECT_THROW(sfm::CheckImages(tmp / "set", &w, &h), InputError);  // 1 photo
-  EXPECT_THROW(sfm::CheckImages(tmp / "nope", &w, &h), InputError);
-}
-
 TEST(UndistortTest, DistortedPixelMovesToThePinholeProjection) {
   // A white dot where the distorted camera sees a 3D point ends up where
   // the pinhole camera (same K) sees it.
@@ -431,7 +406,7 @@ TEST(UndistortTest, DistortedPixelMovesToThePinholeProjection) {
   cv::Mat photo(480, 640, CV_8UC3, cv::Scalar(0, 0, 0));
   cv::circle(photo, cv::Point(int(std::lround(distorted.x())), int(std::lround(distorted.y()))), 3,
              cv::Scalar(255, 255, 255), cv::FILLED);
-  const cv::Mat out = sfm::UndistortPhoto(photo, cam);
+  const cv::Mat out = sfm::UndistortPhoto(photo, cam.PinholeK(), cam.OpenCvDistortion());
   ASSERT_EQ(out.size(), photo.size());
   cv::Mat grey;
   cv::cvtColor(out, grey, cv::COLOR_BGR2GRAY);
@@ -442,7 +417,9 @@ TEST(UndistortTest, DistortedPixelMovesToThePinholeProjection) {
   // A pinhole camera leaves the photo as it is.
   ColmapCamera plain = cam;
   plain.params[3] = 0;
-  EXPECT_EQ(cv::norm(sfm::UndistortPhoto(photo, plain), photo, cv::NORM_INF), 0);
+  EXPECT_EQ(cv::norm(sfm::UndistortPhoto(photo, plain.PinholeK(), plain.OpenCvDistortion()), photo,
+                     cv::NORM_INF),
+            0);
 }
 
 TEST(UndistortTest, LeavesNoDarkFrameAtTheBorder) {
@@ -450,7 +427,8 @@ TEST(UndistortTest, LeavesNoDarkFrameAtTheBorder) {
   // and column a fraction of a pixel past the photo: they must stay paper.
   const cv::Mat photo(480, 640, CV_8UC3, cv::Scalar(200, 200, 200));
   for (const double k : {0.0008, -0.0008, 0.05}) {
-    const cv::Mat out = sfm::UndistortPhoto(photo, SimpleRadial(500, 640, 480, k));
+    const ColmapCamera camera = SimpleRadial(500, 640, 480, k);
+    const cv::Mat out = sfm::UndistortPhoto(photo, camera.PinholeK(), camera.OpenCvDistortion());
     double darkest = 0;
     cv::minMaxLoc(out.reshape(1), &darkest);
     EXPECT_GE(darkest, 195) << "k " << k;
