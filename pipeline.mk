@@ -22,14 +22,18 @@ JOBS ?= 2
 
 # ---- data set ---------------------------------------------------------------
 DATA ?= set01
-# samples/<name>, then data/<name>, then DATA as a path.
-DATA_DIR := $(patsubst %/images,%,$(firstword $(wildcard \
-  $(ROOT)/samples/$(DATA)/images $(ROOT)/data/$(DATA)/images \
-  $(abspath $(DATA))/images)))
-NAME := $(notdir $(patsubst %/,%,$(DATA)))
 WORK_ROOT ?= $(ROOT)/work
-WORK ?= $(WORK_ROOT)/$(NAME)
-IMAGES := $(sort $(wildcard $(DATA_DIR)/images/*))
+# samples/<name>, then data/<name>, then DATA as a path, which may have
+# spaces, accents, "." or "..": scripts/data-dir resolves it (a folder whose
+# path Make cannot carry is reached through the link WORK/.data) and names
+# the work directory after the data set's own folder.
+DATA_RESOLVED := $(shell $(ROOT)/scripts/data-dir '$(ROOT)' '$(WORK_ROOT)' '$(subst ','\'',$(WORK))' '$(subst ','\'',$(DATA))')
+DATA_DIR := $(word 1,$(DATA_RESOLVED))
+NAME := $(word 2,$(DATA_RESOLVED))
+override WORK := $(or $(word 3,$(DATA_RESOLVED)),$(WORK_ROOT)/$(notdir $(DATA)))
+# The photos' names, sizes and times (names may have spaces, which Make's
+# prerequisites cannot): sfm and densify rerun when a photo changes.
+IMAGES_LIST := $(if $(DATA_DIR),$(shell cd '$(DATA_DIR)/images' && ls -lA --time-style=+%s | md5sum))
 
 # ---- stage flags --------------------------------------------------------------
 REF ?=
@@ -75,6 +79,7 @@ $(eval $(call flags_rule,init,$(INIT_FLAGS) points=$(POINTS_FROM)))
 $(eval $(call flags_rule,optimize,$(OPTIMIZE_FLAGS) points=$(POINTS_FROM)))
 $(eval $(call flags_rule,render,$(RENDER_FLAGS)))
 $(eval $(call flags_rule,evaluate,$(EVAL_FLAGS)))
+$(eval $(call flags_rule,images,$(IMAGES_LIST)))
 
 .PHONY: all sfm boundary points features init optimize render evaluate report help clean deps build test bench check-data FORCE
 FORCE:
@@ -123,11 +128,11 @@ all: $(lastword $(IMPLEMENTED)) $(if $(and $(HAS_GT),$(wildcard $(ROOT)/stages/e
 	@echo "docunfold: $(NAME) done; results in $(WORK)$(if $(wildcard $(ROOT)/stages/report),; open $(WORK)/report.html)"
 
 check-data:
-	@test -n "$(DATA_DIR)" || { echo "pipeline.mk: DATA=$(DATA): no data set (looked for images/ in samples/$(DATA), data/$(DATA) and $(abspath $(DATA)))" >&2; exit 3; }
+	@test -n "$(DATA_DIR)" || { echo "pipeline.mk: DATA=$(DATA): no data set (looked for images/ in samples/$(DATA), data/$(DATA) and $(DATA))" >&2; exit 3; }
 
 SFM_OUT := $(addprefix $(WORK)/10_sfm/,cameras.json points.ply reference.png)
 sfm: check-data $(SFM_OUT)
-$(SFM_OUT) &: $(BIN)/sfm $(WORK)/.flags/sfm $(IMAGES) | check-data
+$(SFM_OUT) &: $(BIN)/sfm $(WORK)/.flags/sfm $(WORK)/.flags/images | check-data
 	$(call timed,sfm) $(BIN)/sfm --data $(DATA_DIR) --out $(WORK)/10_sfm $(if $(REF),--ref $(REF)) $(SFM_FLAGS)
 
 BOUNDARY_OUT := $(addprefix $(WORK)/20_boundary/,boundary.json mask.png overlay.png)
@@ -139,7 +144,7 @@ $(BOUNDARY_OUT) &: $(BIN)/segment-boundary $(WORK)/.flags/boundary $(WORK)/10_sf
 
 POINTS_OUT := $(addprefix $(WORK)/25_points/,points.ply points.json overlay.png)
 points: check-data boundary $(POINTS_OUT)
-$(POINTS_OUT) &: $(BIN)/densify $(WORK)/.flags/points $(WORK)/10_sfm/cameras.json $(WORK)/10_sfm/points.ply $(WORK)/10_sfm/reference.png $(WORK)/20_boundary/boundary.json $(WORK)/20_boundary/mask.png $(IMAGES)
+$(POINTS_OUT) &: $(BIN)/densify $(WORK)/.flags/points $(WORK)/10_sfm/cameras.json $(WORK)/10_sfm/points.ply $(WORK)/10_sfm/reference.png $(WORK)/20_boundary/boundary.json $(WORK)/20_boundary/mask.png $(WORK)/.flags/images
 	$(call timed,densify) $(BIN)/densify --data $(DATA_DIR) --sfm $(WORK)/10_sfm --boundary $(WORK)/20_boundary --out $(WORK)/25_points $(DENSIFY_FLAGS)
 
 ifeq ($(FEATURES),)
@@ -238,7 +243,8 @@ help:
 	@echo "  clean          remove work/<name>/"
 	@echo
 	@echo "Variables:"
-	@echo "  DATA=set01     data set: samples/<DATA>, data/<DATA>, or a path (default set01)"
+	@echo "  DATA=set01     data set: samples/<DATA>, data/<DATA>, or a path (default set01;"
+	@echo "                 spaces, accents, . and .. work: DATA=\"My Scans/letter 1\")"
 	@echo "  WORK=dir       work directory (default work/<name>/)"
 	@echo "  WORK_ROOT=dir  where work directories go (default work/)"
 	@echo "  DATASETS=...   data sets for all-samples (default: every samples/*)"
