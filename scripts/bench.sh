@@ -6,8 +6,11 @@
 #
 #   scripts/bench.sh [SET...]      (make -f pipeline.mk bench BENCH_SETS="...")
 #
-# SET is a name (samples/<SET>, data/<SET>) or a path (/work/shared/realistic/r01).
-# Default: every samples/* and data/* with ground_truth/flat.png.
+# SET is a name (samples/<SET>, data/<SET>), a path (/work/shared/realistic/r01)
+# or set01-48mp: set01 with one photo at 8000 x 6000, as a 48 MP phone takes
+# it (made by build/tests/phone-photos into BENCH_WORK/.data/), for the peak
+# memory of every stage on such a photo.
+# Default: every samples/* and data/* with ground_truth/flat.png, and set01-48mp.
 #
 # Environment:
 #   BUILD=dir            build directory with bin/ (default <root>/build)
@@ -66,6 +69,15 @@ esac
 # ---- data sets -----------------------------------------------------------------
 resolve() {  # name or path -> absolute data-set folder ("" if none)
   local s=$1
+  if [[ $s == set01-48mp ]]; then
+    local made=$bench_work/.data/set01-48mp
+    if [[ ! -d $made && -x $BUILD/tests/phone-photos ]]; then
+      mkdir -p "$bench_work/.data"
+      "$BUILD/tests/phone-photos" "$root/samples/set01" "$made" --scale 3:5 >&2 || return
+    fi
+    [[ -d $made/images ]] && (cd "$made" && pwd)
+    return
+  fi
   for d in "$root/samples/$s" "$root/data/$s" "$s"; do
     if [[ -d $d/images ]]; then (cd "$d" && pwd); return; fi
   done
@@ -75,6 +87,7 @@ if [[ ${#sets[@]} -eq 0 ]]; then
   for d in "$root"/samples/*/ "$root"/data/*/; do
     [[ -f $d/ground_truth/flat.png && -d $d/images ]] && sets+=("$d")
   done
+  [[ -d $root/samples/set01 && -x $BUILD/tests/phone-photos ]] && sets+=(set01-48mp)
 fi
 if [[ ${#sets[@]} -eq 0 ]]; then
   echo "bench: no data set with ground truth in samples/ or data/" >&2; exit 3

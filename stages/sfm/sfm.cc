@@ -39,8 +39,8 @@ void DeclareOptions(OptionTable& table, SfmOptions* o) {
   table.Value("ref", &o->reference,
               "image name of the reference view (e.g. view_02.jpg); empty: automatic");
   table.Value("max-image-size", &o->max_image_size, 100, 100000,
-              "long side (px) of the copies features are found on; keypoints and "
-              "reference.png stay at full resolution");
+              "long side (px) of the copies of the photos COLMAP works on; cameras.json and "
+              "reference.png are at each photo's full resolution");
   table.Value("max-features", &o->max_num_features, 100, 1000000, "SIFT features per image");
   table.Choice<std::string>("camera-model", &o->camera_model,
                             {{"SIMPLE_PINHOLE", "SIMPLE_PINHOLE"},

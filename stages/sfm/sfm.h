@@ -40,9 +40,10 @@ struct SfmOptions {
   fs::path out_dir;       // e.g. work/set01/10_sfm
   std::string reference;  // image name forcing the reference view ("" = auto)
 
-  // Long side (pixels) of the copies SIFT runs on; keypoints are scaled back
-  // to full resolution by COLMAP. 1600 keeps the 1600x1200 sets at full
-  // resolution and brings 4000x3000 photos down to the same detail per page.
+  // Long side (pixels) of the copies COLMAP works on (photo_set.h); its
+  // cameras are taken back to each photo's full resolution. 1600 keeps the
+  // 1600x1200 sets at full resolution and brings 4000x3000 photos down to the
+  // same detail per page.
   int max_image_size = 1600;
   int max_num_features = 8192;  // per image
   // COLMAP camera model shared by all views: SIMPLE_PINHOLE, PINHOLE,
