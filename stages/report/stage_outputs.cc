@@ -1,0 +1,81 @@
+#include "stages/report/stage_outputs.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <opencv2/imgproc.hpp>
+#include <vector>
+
+namespace docunfold::report {
+
+namespace fs = std::filesystem;
+
+cv::Mat DrawFeatureLines(const cv::Mat& rectified, const Json& render, const Json& lines) {
+  if (rectified.empty() || !render.is_object() || !lines.is_object() || !lines.contains("lines") ||
+      !render.contains("crop"))
+    return {};
+  const std::string meshes = render.value("/inputs/meshes"_json_pointer, std::string());
+  if (fs::path(meshes).filename() != "50_optimize") return {};
+  const double angle = render.value("rotation_deg", 0.0) * CV_PI / 180;
+  const double scale = render.value("pixels_per_unit", 0.0);
+  const double x0 = render["crop"].value("x0", 0.0), y0 = render["crop"].value("y0", 0.0);
+  const int turns =
+      ((render.value("/orientation/quarter_turns_clockwise"_json_pointer, 0) % 4) + 4) % 4;
+  if (!(scale > 0)) return {};
+  // Size before the quarter turns.
+  const int w = turns % 2 ? rectified.rows : rectified.cols;
+  const int h = turns % 2 ? rectified.cols : rectified.rows;
+  const double c = std::cos(angle), sn = std::sin(angle);
+  auto to_px = [&](const Json& p) {
+    const double fx = p[0].get<double>(), fy = p[1].get<double>();
+    const double u = (c * fx - sn * fy - x0) * scale - 0.5;
+    const double v = (sn * fx + c * fy - y0) * scale - 0.5;
+    switch (turns) {  // as cv::rotate turns the image clockwise
+      case 1:
+        return cv::Point2d(h - 1 - v, u);
+      case 2:
+        return cv::Point2d(w - 1 - u, h - 1 - v);
+      case 3:
+        return cv::Point2d(v, w - 1 - u);
+      default:
+        return cv::Point2d(u, v);
+    }
+  };
+  cv::Mat out = rectified.clone();
+  const int thick = std::max(1, int(std::lround(std::max(out.cols, out.rows) / 600.0)));
+  for (const Json& line : lines["lines"]) {
+    if (!line.contains("flat") || !line["flat"].is_array()) continue;
+    const std::string kind = line.value("kind", "");
+    const cv::Scalar colour = kind == "text"   ? cv::Scalar(40, 40, 230)
+                              : kind == "edge" ? cv::Scalar(230, 160, 0)
+                                               : cv::Scalar(40, 180, 40);
+    std::vector<cv::Point> poly;
+    for (const Json& p : line["flat"]) {
+      const cv::Point2d q = to_px(p);
+      poly.emplace_back(int(std::lround(q.x * 16)), int(std::lround(q.y * 16)));
+    }
+    if (poly.size() >= 2)
+      cv::polylines(out, std::vector<std::vector<cv::Point>>{poly}, false, colour, thick,
+                    cv::LINE_AA, 4);
+  }
+  return out;
+}
+
+std::string LinesNote(const Json& lines) {
+  if (!lines.is_object() || !lines.contains("lines")) return "";
+  std::map<std::string, int> kinds;
+  for (const Json& l : lines["lines"]) kinds[l.value("kind", "?")]++;
+  std::string note = "Feature lines straightened in M':";
+  for (const auto& [k, n] : kinds) note += " " + std::to_string(n) + " " + k;
+  return note + " (50_optimize/lines.json).";
+}
+
+std::string PointsCounts(const Json& points) {
+  if (!points.is_object() || !points.contains("points")) return "";
+  return " " + std::to_string(points["points"].value("sfm_in_region", 0)) +
+         " sfm points on the page, " + std::to_string(points["points"].value("texture", 0)) +
+         " texture, " + std::to_string(points["points"].value("outline", 0)) + " outline.";
+}
+
+}  // namespace docunfold::report
