@@ -39,6 +39,9 @@ packages=(
   # tests (assimp reads our PLYs as an independent check; chromium opens the
   # HTML report)
   googletest libgtest-dev assimp-utils chromium
+  # fuzzing the file readers (pipeline.mk fuzz): clang and its libFuzzer,
+  # ASan and UBSan runtimes
+  clang libclang-rt-14-dev
 )
 
 if [[ "${1:-}" == "--list" ]]; then
