@@ -7,6 +7,8 @@
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
+#include "common/errors.h"
+
 namespace docunfold::report {
 
 namespace fs = std::filesystem;
@@ -44,14 +46,21 @@ cv::Mat DrawFeatureLines(const cv::Mat& rectified, const Json& render, const Jso
   };
   cv::Mat out = rectified.clone();
   const int thick = std::max(1, int(std::lround(std::max(out.cols, out.rows) / 600.0)));
-  for (const Json& line : lines["lines"]) {
+  const Json& all = lines["lines"];
+  if (!all.is_array()) throw InputError("50_optimize/lines.json:/lines: expected an array");
+  for (size_t i = 0; i < all.size(); ++i) {
+    const Json& line = all[i];
     if (!line.contains("flat") || !line["flat"].is_array()) continue;
     const std::string kind = line.value("kind", "");
     const cv::Scalar colour = kind == "text"   ? cv::Scalar(40, 40, 230)
                               : kind == "edge" ? cv::Scalar(230, 160, 0)
                                                : cv::Scalar(40, 180, 40);
     std::vector<cv::Point> poly;
-    for (const Json& p : line["flat"]) {
+    for (size_t k = 0; k < line["flat"].size(); ++k) {
+      const Json& p = line["flat"][k];
+      if (!p.is_array() || p.size() != 2 || !p[0].is_number() || !p[1].is_number())
+        throw InputError("50_optimize/lines.json:/lines/" + std::to_string(i) + "/flat/" +
+                         std::to_string(k) + ": expected [x, y]");
       const cv::Point2d q = to_px(p);
       poly.emplace_back(int(std::lround(q.x * 16)), int(std::lround(q.y * 16)));
     }
