@@ -22,8 +22,14 @@ cv::Mat DrawFeatureLines(const cv::Mat& rectified, const Json& render, const Jso
   const double angle = render.value("rotation_deg", 0.0) * CV_PI / 180;
   const double scale = render.value("pixels_per_unit", 0.0);
   const double x0 = render["crop"].value("x0", 0.0), y0 = render["crop"].value("y0", 0.0);
-  const int turns =
-      ((render.value("/orientation/quarter_turns_clockwise"_json_pointer, 0) % 4) + 4) % 4;
+  // Checked before the conversion: a float too large for an int has none.
+  const Json quarter_turns =
+      render.value("/orientation/quarter_turns_clockwise"_json_pointer, Json(0));
+  if (!quarter_turns.is_number_integer())
+    throw InputError(
+        "60_render/render.json:/orientation/quarter_turns_clockwise: expected an "
+        "integer");
+  const int turns = int(((quarter_turns.get<long long>() % 4) + 4) % 4);
   if (!(scale > 0)) return {};
   // Size before the quarter turns.
   const int w = turns % 2 ? rectified.rows : rectified.cols;
@@ -82,9 +88,15 @@ std::string LinesNote(const Json& lines) {
 
 std::string PointsCounts(const Json& points) {
   if (!points.is_object() || !points.contains("points")) return "";
-  return " " + std::to_string(points["points"].value("sfm_in_region", 0)) +
-         " sfm points on the page, " + std::to_string(points["points"].value("texture", 0)) +
-         " texture, " + std::to_string(points["points"].value("outline", 0)) + " outline.";
+  // Checked before the conversion: a float too large for an int has none.
+  auto count = [&points](const std::string& key) {
+    const Json n = points["points"].value(key, Json(0));
+    if (!n.is_number_integer())
+      throw InputError("25_points/points.json:/points/" + key + ": expected an integer");
+    return std::to_string(n.get<long long>());
+  };
+  return " " + count("sfm_in_region") + " sfm points on the page, " + count("texture") +
+         " texture, " + count("outline") + " outline.";
 }
 
 }  // namespace docunfold::report

@@ -41,5 +41,35 @@ TEST(DrawFeatureLines, RejectsAPointThatIsNotXY) {
                InputError);
 }
 
+// Numbers too large for an int (the fuzzers' render.json and points.json)
+// were converted to one: undefined behaviour.
+TEST(DrawFeatureLines, RejectsQuarterTurnsThatAreNotAnInteger) {
+  const cv::Mat rectified(48, 64, CV_8UC3, cv::Scalar(255, 255, 255));
+  const Json lines =
+      Json::parse(R"({"lines": [{"kind": "text", "flat": [[0.1, 0.2], [0.9, 0.2]]}]})");
+  Json render = kRender;
+  render["orientation"]["quarter_turns_clockwise"] = 1e300;
+  try {
+    DrawFeatureLines(rectified, render, lines);
+    ADD_FAILURE() << "drawn without error";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(),
+                 "60_render/render.json:/orientation/quarter_turns_clockwise: expected an integer");
+  }
+  render["orientation"]["quarter_turns_clockwise"] = -7;  // three turns
+  EXPECT_EQ(DrawFeatureLines(rectified, render, lines).size(), cv::Size(64, 48));
+}
+
+TEST(PointsCounts, RejectsCountsThatAreNotIntegers) {
+  EXPECT_EQ(PointsCounts(Json::parse(R"({"points": {"sfm_in_region": 3, "texture": 4}})")),
+            " 3 sfm points on the page, 4 texture, 0 outline.");
+  try {
+    PointsCounts(Json::parse(R"({"points": {"texture": 1e300}})"));
+    ADD_FAILURE() << "counted without error";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "25_points/points.json:/points/texture: expected an integer");
+  }
+}
+
 }  // namespace
 }  // namespace docunfold::report
