@@ -81,7 +81,7 @@ $(eval $(call flags_rule,render,$(RENDER_FLAGS)))
 $(eval $(call flags_rule,evaluate,$(EVAL_FLAGS)))
 $(eval $(call flags_rule,images,$(IMAGES_LIST)))
 
-.PHONY: all sfm boundary points features init optimize render evaluate report help clean deps build test bench check-data FORCE
+.PHONY: all sfm boundary points features init optimize render evaluate report help clean deps build test bench fuzz check-data FORCE
 FORCE:
 
 # ---- build ----------------------------------------------------------------------
@@ -115,6 +115,18 @@ test: build
 BENCH_SETS ?=
 bench: build
 	$(ROOT)/scripts/bench.sh $(BENCH_SETS)
+
+# libFuzzer targets of fuzz/ (ASan, UBSan) in a clang build of their own; each
+# runs FUZZ_SECONDS on a copy of its seeds, JOBS at a time; any finding fails
+# (scripts/fuzz: logs in build-fuzz/logs/, inputs in build-fuzz/findings/).
+FUZZ_BUILD ?= $(ROOT)/build-fuzz
+FUZZ_SECONDS ?= 600
+FUZZ_TARGETS ?=
+fuzz: deps
+	CC=clang CXX=clang++ cmake -S $(ROOT) -B $(FUZZ_BUILD) -DDOCUNFOLD_FUZZ=ON -DBUILD_TESTING=OFF \
+	  -DCMAKE_BUILD_TYPE=RelWithDebInfo > /dev/null
+	cmake --build $(FUZZ_BUILD) -j$(JOBS)
+	$(ROOT)/scripts/fuzz $(FUZZ_BUILD) $(FUZZ_SECONDS) $(JOBS) $(FUZZ_TARGETS)
 
 # ---- pipeline ---------------------------------------------------------------------
 # The chain of stages, in order. `all` runs every stage whose program exists
@@ -239,6 +251,7 @@ help:
 	@echo "  build          configure and build build/bin/*"
 	@echo "  deps           install missing Debian packages (root) or print the apt-get line"
 	@echo "  bench          time every stage on every sample -> bench/results.md"
+	@echo "  fuzz           build-fuzz/: fuzz every file reader (clang, ASan, UBSan) for FUZZ_SECONDS"
 	@echo "  all-samples    run every sample (or DATASETS=\"a b c\"), in parallel with -j2"
 	@echo "  clean          remove work/<name>/"
 	@echo
@@ -262,5 +275,7 @@ help:
 	@echo "  JOBS=2         parallel build jobs"
 	@echo "  TIMER=file     where per-stage time and peak memory go (default work/<name>/timings.jsonl)"
 	@echo "  BENCH_SETS=... samples for bench (default: all)"
+	@echo "  FUZZ_SECONDS=600    seconds per fuzz target (JOBS targets at a time)"
+	@echo "  FUZZ_TARGETS=...    fuzz only these (ply cameras ...; default: every fuzz/*_fuzzer.cc)"
 	@echo
 	@echo "Changing REF or a *_FLAGS variable reruns that stage and everything after it."

@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <csetjmp>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <memory>
@@ -23,6 +24,21 @@ namespace {
 // largest phone sensor, and a crafted header must not make us allocate
 // gigabytes.
 constexpr double kMaxPixels = 200e6;
+// Nor more pixels than the file's bytes can hold: an evenly white page
+// compresses to about 300 pixels a byte in JPEG, PNG or HEIF; a header that
+// claims more than ten times that is damaged or made up.
+constexpr double kMaxPixelsPerByte = 4000;
+
+// Throws PhotoError when `width` x `height` pixels are implausible for a
+// file of `bytes` bytes.
+void CheckClaimedSize(double width, double height, size_t bytes, const std::string& name) {
+  const double pixels = width * height;
+  if (pixels > kMaxPixels || pixels > kMaxPixelsPerByte * double(bytes))
+    throw PhotoError(name, true,
+                     "its header claims " + std::to_string(long(width)) + "x" +
+                         std::to_string(long(height)) + " pixels in " + std::to_string(bytes) +
+                         " bytes");
+}
 
 bool StartsWith(std::string_view s, std::string_view prefix) {
   return s.size() >= prefix.size() && s.compare(0, prefix.size(), prefix) == 0;
@@ -148,9 +164,10 @@ bool DecodeJpeg(std::string_view bytes, const std::string& name, PhotoColor colo
   for (jpeg_saved_marker_ptr m = cinfo.marker_list; m; m = m->next)
     if (m->marker == JPEG_APP0 + 1 && m->data_length > 6 && !std::memcmp(m->data, "Exif\0\0", 6))
       ParseExif(m->data, m->data_length, &photo->metadata);
-  if (double(cinfo.image_width) * cinfo.image_height > kMaxPixels) {
-    errors.fatal = "the header claims " + std::to_string(cinfo.image_width) + "x" +
-                   std::to_string(cinfo.image_height) + " pixels";
+  try {
+    CheckClaimedSize(cinfo.image_width, cinfo.image_height, bytes.size(), name);
+  } catch (const PhotoError& e) {
+    errors.fatal = e.reason().substr(std::string("damaged: ").size());
     std::longjmp(errors.jump, 1);
   }
   if (cinfo.num_components == 4) {
@@ -213,10 +230,8 @@ void DecodeHeif(std::string_view bytes, const std::string& name, PhotoColor colo
   std::unique_ptr<heif_image_handle, void (*)(const heif_image_handle*)> handle(
       raw_handle, heif_image_handle_release);
   ReadHeifExif(handle.get(), &photo->metadata);
-  if (double(heif_image_handle_get_width(handle.get())) *
-          heif_image_handle_get_height(handle.get()) >
-      kMaxPixels)
-    throw PhotoError(name, true, "the file claims more than 200 megapixels");
+  CheckClaimedSize(heif_image_handle_get_width(handle.get()),
+                   heif_image_handle_get_height(handle.get()), bytes.size(), name);
   heif_image* raw_image = nullptr;
   // libheif applies the file's rotation and mirroring (irot, imir) itself;
   // the EXIF orientation of a HEIF file only repeats them.
@@ -237,6 +252,19 @@ void DecodeHeif(std::string_view bytes, const std::string& name, PhotoColor colo
 
 void DecodeWithOpenCv(std::string_view bytes, const std::string& name, PhotoColor color,
                       Photo* photo) {
+  // PNG's size is at a fixed place in its header: checked before OpenCV
+  // allocates it. For the other formats OpenCV's own limit, set once (a
+  // value the user set wins), caps what a made-up header can claim.
+  if (photo->format == PhotoFormat::kPng && bytes.size() >= 24) {
+    const auto u32 = [&](size_t at) {
+      return double((uint32_t(uint8_t(bytes[at])) << 24) |
+                    (uint32_t(uint8_t(bytes[at + 1])) << 16) |
+                    (uint32_t(uint8_t(bytes[at + 2])) << 8) | uint32_t(uint8_t(bytes[at + 3])));
+    };
+    CheckClaimedSize(u32(16), u32(20), bytes.size(), name);
+  }
+  static const bool limited = setenv("CV_IO_MAX_IMAGE_PIXELS", "200000000", 0) == 0;
+  (void)limited;
   const cv::Mat buffer(1, int(bytes.size()), CV_8UC1, const_cast<char*>(bytes.data()));
   const int flags = (color == PhotoColor::kGray ? cv::IMREAD_GRAYSCALE : cv::IMREAD_COLOR) |
                     cv::IMREAD_IGNORE_ORIENTATION;

@@ -4,6 +4,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 
@@ -380,12 +381,24 @@ class BodyReader {
   bool ascii_, swap_;
 };
 
+// The length of a list property; NaN or absurd lengths are errors, not
+// undefined conversions.
+size_t ReadListLength(BodyReader& body, const HeaderElement& e, const HeaderProperty& p,
+                      const fs::path& path) {
+  const double m = body.Read(p.count_type);
+  if (!(m >= 0 && m <= 1e6)) Fail(path, "bad list length in element " + e.name);
+  return static_cast<size_t>(m);
+}
+
 // The vertex element: x, y, z, optional red, green, blue, and every other
 // scalar property as an extra one (lists are skipped).
 void ReadVertices(const HeaderElement& e, BodyReader& body, const fs::path& path, PlyData* ply) {
   int ix = -1, iy = -1, iz = -1, ir = -1, ig = -1, ib = -1;
+  std::set<std::string> names;
   for (size_t k = 0; k < e.props.size(); ++k) {
     const std::string& nm = e.props[k].name;
+    // A second x would leave the first one's value nowhere to go.
+    if (!names.insert(nm).second) Fail(path, "vertex property '" + nm + "' declared twice");
     if (nm == "x")
       ix = int(k);
     else if (nm == "y")
@@ -411,8 +424,8 @@ void ReadVertices(const HeaderElement& e, BodyReader& body, const fs::path& path
     size_t extra = 0;
     for (size_t k = 0; k < e.props.size(); ++k) {
       if (e.props[k].is_list) {
-        int m = int(body.Read(e.props[k].count_type));
-        for (int j = 0; j < m; ++j) body.Read(e.props[k].type);
+        const size_t m = ReadListLength(body, e, e.props[k], path);
+        for (size_t j = 0; j < m; ++j) body.Read(e.props[k].type);
         continue;
       }
       row[k] = body.Read(e.props[k].type);
@@ -423,7 +436,12 @@ void ReadVertices(const HeaderElement& e, BodyReader& body, const fs::path& path
     ply->vertices[i] = {row[ix], row[iy], row[iz]};
     if (!ply->vertices[i].allFinite())
       Fail(path, "vertex " + std::to_string(i) + " has a non-finite coordinate");
-    if (has_color) ply->colors[i] = {uint8_t(row[ir]), uint8_t(row[ig]), uint8_t(row[ib])};
+    if (has_color) {
+      for (int c : {ir, ig, ib})
+        if (!(row[c] > -1 && row[c] < 256))
+          Fail(path, "vertex " + std::to_string(i) + " has a colour outside 0..255");
+      ply->colors[i] = {uint8_t(row[ir]), uint8_t(row[ig]), uint8_t(row[ib])};
+    }
   }
 }
 
@@ -432,23 +450,27 @@ void ReadVertices(const HeaderElement& e, BodyReader& body, const fs::path& path
 void ReadOtherElement(const HeaderElement& e, BodyReader& body, const fs::path& path,
                       PlyData* ply) {
   const bool is_face = e.name == "face";
+  if (e.props.empty()) return;  // nothing to read, however many it declares
   for (size_t i = 0; i < e.count; ++i) {
     for (const HeaderProperty& p : e.props) {
       if (!p.is_list) {
         body.Read(p.type);
         continue;
       }
-      double m = body.Read(p.count_type);
-      if (m < 0 || m > 1e6) Fail(path, "bad list length in element " + e.name);
-      std::vector<int> idx(static_cast<size_t>(m));
-      for (int& v : idx) v = int(body.Read(p.type));
-      if (is_face && (p.name == "vertex_indices" || p.name == "vertex_index")) {
-        for (int v : idx)
-          if (v < 0 || size_t(v) >= ply->vertices.size())
-            Fail(path,
-                 "face " + std::to_string(i) + " indexes a missing vertex " + std::to_string(v));
-        ply->faces.push_back(std::move(idx));
+      const size_t m = ReadListLength(body, e, p, path);
+      const bool keep = is_face && (p.name == "vertex_indices" || p.name == "vertex_index");
+      std::vector<int> idx;
+      for (size_t j = 0; j < m; ++j) {
+        const double v = body.Read(p.type);
+        // Checked as read: a NaN or huge index has no int to become.
+        if (keep && !(v >= 0 && v < double(ply->vertices.size()))) {
+          std::ostringstream what;
+          what << "face " << i << " indexes a missing vertex " << v;
+          Fail(path, what.str());
+        }
+        if (keep) idx.push_back(int(v));
       }
+      if (keep) ply->faces.push_back(std::move(idx));
     }
   }
 }
@@ -467,6 +489,25 @@ PlyData ReadPly(const fs::path& path) {
   const bool swap = (header.format == "binary_little_endian") != HostIsLittleEndian();
   if (!ascii && header.format != "binary_little_endian" && header.format != "binary_big_endian")
     Fail(path, "unknown format '" + header.format + "'");
+
+  // A count the rest of the file cannot hold would otherwise be allocated
+  // before the data runs out.
+  unsigned long long body_bytes = 0;  // stays 0 when the header ends the file
+  if (f.good()) {
+    const std::streampos body_start = f.tellg();
+    f.seekg(0, std::ios::end);
+    body_bytes = static_cast<unsigned long long>(f.tellg() - body_start);
+    f.seekg(body_start);
+  }
+  for (const HeaderElement& e : header.elements) {
+    size_t item_bytes = 0;  // at least, per item (ASCII: one character per value)
+    for (const HeaderProperty& p : e.props)
+      item_bytes += ascii ? 1 : (p.is_list ? p.count_type.bytes : p.type.bytes);
+    if (item_bytes > 0 && e.count > body_bytes / item_bytes)
+      Fail(path, "element " + e.name + " declares " + std::to_string(e.count) +
+                     " items, more than the file's " + std::to_string(body_bytes) +
+                     " bytes of data can hold");
+  }
 
   BodyReader body(f, path, ascii, swap);
   for (const HeaderElement& e : header.elements) {

@@ -43,6 +43,9 @@ packages=(
   # HTML report; heif-enc, exiftool and jpegtran make phone-like photos)
   googletest libgtest-dev assimp-utils chromium libheif-examples libimage-exiftool-perl
   libjpeg-turbo-progs
+  # fuzzing the file readers (pipeline.mk fuzz): clang and its libFuzzer,
+  # ASan and UBSan runtimes
+  clang libclang-rt-14-dev
 )
 
 if [[ "${1:-}" == "--list" ]]; then

@@ -3,10 +3,12 @@
 #include <cmath>
 #include <memory>
 #include <opencv2/imgcodecs.hpp>
+#include <utility>
 
 #include "common/atomic_file.h"
 #include "common/errors.h"
 #include "common/json_io.h"
+#include "stages/render/lines_file.h"
 #include "stages/render/render.h"
 
 namespace docunfold::render {
@@ -51,32 +53,13 @@ RenderInputs ReadRenderInputs(const fs::path& sfm_dir, const fs::path& boundary_
   if (!fs::is_directory(meshes_dir, ec))
     throw InputError(meshes_dir.string() + ": no such directory (expected mesh3d.ply, mesh2d.ply)");
   in.meshes = ReadMeshPair(meshes_dir);
-  // optimize's lines, for the deskew: each line's direction (its normal
-  // turned, the same modulo 90 degrees) and its extent in M'.
+  // optimize's lines, for the deskew and the page's orientation.
   const fs::path lines_file = meshes_dir / "lines.json";
   if (fs::is_regular_file(lines_file, ec)) {
-    const Json doc = ReadJsonFile(lines_file);
-    const JsonReader r(doc, lines_file);
-    if (!r.At("/lines").is_array()) r.Fail("/lines", "expected an array");
-    if (r.Has("/text_down_flat")) in.text_down = r.Vector2("/text_down_flat");
-    for (size_t i = 0; i < doc["lines"].size(); ++i) {
-      const std::string where = "/lines/" + std::to_string(i);
-      const Eigen::Vector2d n = r.Vector2(where + "/normal");
-      const Eigen::Vector2d along(-n.y(), n.x());
-      const Json& flat = r.At(where + "/flat");
-      if (!flat.is_array()) r.Fail(where + "/flat", "expected [[x, y], ...]");
-      double lo = 1e300, hi = -1e300;
-      for (size_t k = 0; k < flat.size(); ++k) {
-        const double t = along.dot(r.Vector2(where + "/flat/" + std::to_string(k)));
-        lo = std::min(lo, t);
-        hi = std::max(hi, t);
-      }
-      if (hi > lo && std::isfinite(hi - lo)) {
-        in.lines.push_back({std::atan2(n.y(), n.x()) * 180 / M_PI, hi - lo});
-        if (doc["lines"][i].value("kind", "") == "text")
-          in.text_lines.push_back({std::atan2(along.y(), along.x()) * 180 / M_PI, hi - lo});
-      }
-    }
+    LinesFile lines = ReadLinesFile(lines_file);
+    in.lines = std::move(lines.lines);
+    in.text_lines = std::move(lines.text_lines);
+    in.text_down = lines.text_down;
   }
   if (!features_file.empty() && !in.text_down) {
     const FeatureFile features = ReadFeatures(features_file);

@@ -19,6 +19,7 @@
 #include "common/ply.h"
 #include "stages/report/html.h"
 #include "stages/report/mesh_views.h"
+#include "stages/report/stage_outputs.h"
 
 namespace docunfold::report {
 namespace {
@@ -261,11 +262,7 @@ void MeshSection(const ReportOptions& o, const Json& cameras, Page* page, fs::pa
       std::string caption =
           "The points fitted (25_points/overlay.png): sfm's (blue), texture "
           "(green) and outline (magenta) points of densify.";
-      if (counts.is_object() && counts.contains("points"))
-        caption += " " + std::to_string(counts["points"].value("sfm_in_region", 0)) +
-                   " sfm points on the page, " +
-                   std::to_string(counts["points"].value("texture", 0)) + " texture, " +
-                   std::to_string(counts["points"].value("outline", 0)) + " outline.";
+      caption += PointsCounts(counts);
       page->Add(Figure(InlineImage(points_overlay, o.figure_width / 2 + 100, "points"), caption));
     }
     page->Add("<p>M and M' from <code>" + Escape(mesh_dir->filename().string()) +
@@ -382,61 +379,6 @@ std::string FrontEndParagraph(const Json& f) {
   return p + ". " + FrontEndLegend(f.value("thresholds", Json::object())) + "</p>";
 }
 
-// The final feature lines of 50_optimize/lines.json (polylines in M') drawn
-// over rectified.png, through the map render used: the deskew rotation, the
-// crop, the scale and the quarter turns of render.json. Empty when render did
-// not texture optimize's meshes or a file is missing.
-cv::Mat DrawFeatureLines(const cv::Mat& rectified, const Json& render, const Json& lines) {
-  if (rectified.empty() || !render.is_object() || !lines.is_object() || !lines.contains("lines") ||
-      !render.contains("crop"))
-    return {};
-  const std::string meshes = render.value("/inputs/meshes"_json_pointer, std::string());
-  if (fs::path(meshes).filename() != "50_optimize") return {};
-  const double angle = render.value("rotation_deg", 0.0) * CV_PI / 180;
-  const double scale = render.value("pixels_per_unit", 0.0);
-  const double x0 = render["crop"].value("x0", 0.0), y0 = render["crop"].value("y0", 0.0);
-  const int turns =
-      ((render.value("/orientation/quarter_turns_clockwise"_json_pointer, 0) % 4) + 4) % 4;
-  if (!(scale > 0)) return {};
-  // Size before the quarter turns.
-  const int w = turns % 2 ? rectified.rows : rectified.cols;
-  const int h = turns % 2 ? rectified.cols : rectified.rows;
-  const double c = std::cos(angle), sn = std::sin(angle);
-  auto to_px = [&](const Json& p) {
-    const double fx = p[0].get<double>(), fy = p[1].get<double>();
-    const double u = (c * fx - sn * fy - x0) * scale - 0.5;
-    const double v = (sn * fx + c * fy - y0) * scale - 0.5;
-    switch (turns) {  // as cv::rotate turns the image clockwise
-      case 1:
-        return cv::Point2d(h - 1 - v, u);
-      case 2:
-        return cv::Point2d(w - 1 - u, h - 1 - v);
-      case 3:
-        return cv::Point2d(v, w - 1 - u);
-      default:
-        return cv::Point2d(u, v);
-    }
-  };
-  cv::Mat out = rectified.clone();
-  const int thick = std::max(1, int(std::lround(std::max(out.cols, out.rows) / 600.0)));
-  for (const Json& line : lines["lines"]) {
-    if (!line.contains("flat") || !line["flat"].is_array()) continue;
-    const std::string kind = line.value("kind", "");
-    const cv::Scalar colour = kind == "text"   ? cv::Scalar(40, 40, 230)
-                              : kind == "edge" ? cv::Scalar(230, 160, 0)
-                                               : cv::Scalar(40, 180, 40);
-    std::vector<cv::Point> poly;
-    for (const Json& p : line["flat"]) {
-      const cv::Point2d q = to_px(p);
-      poly.emplace_back(int(std::lround(q.x * 16)), int(std::lround(q.y * 16)));
-    }
-    if (poly.size() >= 2)
-      cv::polylines(out, std::vector<std::vector<cv::Point>>{poly}, false, colour, thick,
-                    cv::LINE_AA, 4);
-  }
-  return out;
-}
-
 void ResultSection(const ReportOptions& o, const DataSet& data, const fs::path& mesh_dir,
                    Page* page) {
   page->Section("result", "The rectified page");
@@ -461,14 +403,7 @@ void ResultSection(const ReportOptions& o, const DataSet& data, const fs::path& 
     html += Figure(InlineImage(with_lines, o.figure_width / 2, "rectified with feature lines"),
                    "The final feature lines of M' (50_optimize/lines.json) over the texture: "
                    "text red, edges blue, page sides green");
-  std::string lines_note;
-  if (lines.is_object() && lines.contains("lines")) {
-    std::map<std::string, int> kinds;
-    for (const Json& l : lines["lines"]) kinds[l.value("kind", "?")]++;
-    lines_note = "Feature lines straightened in M':";
-    for (const auto& [k, n] : kinds) lines_note += " " + std::to_string(n) + " " + k;
-    lines_note += " (50_optimize/lines.json).";
-  }
+  const std::string lines_note = LinesNote(lines);
   const cv::Mat flat = TryImage(data.ground_truth("flat.png"));
   if (!flat.empty())
     html += Figure(InlineImage(flat, o.figure_width / 2, "ground truth"),

@@ -88,6 +88,58 @@ TEST(PlyRead, RejectsAwkwardFiles) {
   EXPECT_THROW(ReadPly(dir / "badface.ply"), InputError);
 }
 
+// Inputs the fuzzer (fuzz/ply_fuzzer.cc) made, or ones like them: each is a
+// clean InputError naming the file and the problem, not undefined behaviour.
+void ExpectInputError(const std::filesystem::path& file, const std::string& problem) {
+  try {
+    ReadPly(file);
+    ADD_FAILURE() << file << ": read without error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(file.string() + ": " + problem), std::string::npos)
+        << e.what();
+  }
+}
+
+const char* const kAsciiVertexHeader =
+    "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+    "property float z\n";
+
+TEST(PlyRead, RejectsAPropertyDeclaredTwice) {
+  testing::TempDir dir;
+  // The second x left the first one's value no place among the extras.
+  WriteFile(dir / "twice.ply", std::string(kAsciiVertexHeader) +
+                                   "property float s\nproperty float x\nend_header\n1 2 3 4 5\n");
+  ExpectInputError(dir / "twice.ply", "vertex property 'x' declared twice");
+}
+
+TEST(PlyRead, RejectsValuesWithNoIntegerToBecome) {
+  testing::TempDir dir;
+  const std::string header = kAsciiVertexHeader;
+  WriteFile(dir / "colour.ply", header +
+                                    "property float red\nproperty float green\n"
+                                    "property float blue\nend_header\n0 0 0 300 0 0\n");
+  ExpectInputError(dir / "colour.ply", "vertex 0 has a colour outside 0..255");
+  WriteFile(dir / "index.ply", header +
+                                   "element face 1\nproperty list uchar float vertex_indices\n"
+                                   "end_header\n0 0 0\n3 0 nan 1e30\n");
+  ExpectInputError(dir / "index.ply", "face 0 indexes a missing vertex nan");
+  WriteFile(dir / "list.ply",
+            header + "property list float uchar extra\nend_header\n0 0 0 nan 1\n");
+  ExpectInputError(dir / "list.ply", "bad list length in element vertex");
+}
+
+TEST(PlyRead, RejectsCountsTheFileCannotHold) {
+  testing::TempDir dir;
+  // Declared counts were allocated before the data ran out.
+  WriteFile(dir / "count.ply",
+            "ply\nformat binary_little_endian 1.0\nelement vertex 99999999999999\n"
+            "property float x\nproperty float y\nproperty float z\nend_header\n0123456789ab");
+  ExpectInputError(dir / "count.ply", "element vertex declares 99999999999999 items");
+  WriteFile(dir / "empty.ply", std::string(kAsciiVertexHeader) +
+                                   "element nothing 999999999999999999\nend_header\n0 0 0\n");
+  EXPECT_EQ(ReadPly(dir / "empty.ply").vertices.size(), 1u);
+}
+
 TEST(PlyRead, ReadsDoubleAndBigEndianFromOtherTools) {
   testing::TempDir dir;
   std::string body =

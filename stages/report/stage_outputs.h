@@ -1,0 +1,27 @@
+// What the report draws or says from stages' JSON outputs: optimize's
+// lines.json, render's render.json and densify's points.json. Each takes the
+// parsed document (null when the file is missing or does not parse).
+#pragma once
+
+#include <opencv2/core.hpp>
+#include <string>
+
+#include "common/json_io.h"
+
+namespace docunfold::report {
+
+// The final feature lines of 50_optimize/lines.json (polylines in M') drawn
+// over rectified.png, through the map render used: the deskew rotation, the
+// crop, the scale and the quarter turns of render.json. Empty when render did
+// not texture optimize's meshes or a file is missing.
+cv::Mat DrawFeatureLines(const cv::Mat& rectified, const Json& render, const Json& lines);
+
+// "Feature lines straightened in M': <n> <kind> ..." from lines.json; empty
+// without lines.
+std::string LinesNote(const Json& lines);
+
+// " <n> sfm points on the page, <n> texture, <n> outline." from points.json;
+// empty without counts.
+std::string PointsCounts(const Json& points);
+
+}  // namespace docunfold::report

@@ -1,0 +1,75 @@
+#include "stages/report/stage_outputs.h"
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "common/errors.h"
+
+namespace docunfold::report {
+namespace {
+
+const Json kRender = Json::parse(R"({
+  "inputs": {"meshes": "work/set01/50_optimize"}, "rotation_deg": 0,
+  "pixels_per_unit": 60, "crop": {"x0": 0, "y0": 0}})");
+
+TEST(DrawFeatureLines, DrawsOptimizesLines) {
+  const cv::Mat rectified(48, 64, CV_8UC3, cv::Scalar(255, 255, 255));
+  const Json lines =
+      Json::parse(R"({"lines": [{"kind": "text", "flat": [[0.1, 0.2], [0.9, 0.2]]}]})");
+  const cv::Mat out = DrawFeatureLines(rectified, kRender, lines);
+  ASSERT_EQ(out.size(), rectified.size());
+  EXPECT_NE(cv::norm(out, rectified, cv::NORM_L1), 0);
+  EXPECT_EQ(LinesNote(lines), "Feature lines straightened in M': 1 text (50_optimize/lines.json).");
+}
+
+// The fuzzer's input (fuzz/lines_fuzzer.cc): a point of a line that is not
+// [x, y] was read past the end of its array.
+TEST(DrawFeatureLines, RejectsAPointThatIsNotXY) {
+  const cv::Mat rectified(48, 64, CV_8UC3, cv::Scalar(255, 255, 255));
+  for (const char* point : {"[]", "[0.5]", "[0.5, \"a\"]", "{}"}) {
+    const Json lines = Json::parse(std::string(R"({"lines": [{"kind": "text", "flat": [[0, 0], )") +
+                                   point + "]}]}");
+    try {
+      DrawFeatureLines(rectified, kRender, lines);
+      ADD_FAILURE() << point << ": drawn without error";
+    } catch (const InputError& e) {
+      EXPECT_STREQ(e.what(), "50_optimize/lines.json:/lines/0/flat/1: expected [x, y]");
+    }
+  }
+  EXPECT_THROW(DrawFeatureLines(rectified, kRender, Json::parse(R"({"lines": {"a": 1}})")),
+               InputError);
+}
+
+// Numbers too large for an int (the fuzzers' render.json and points.json)
+// were converted to one: undefined behaviour.
+TEST(DrawFeatureLines, RejectsQuarterTurnsThatAreNotAnInteger) {
+  const cv::Mat rectified(48, 64, CV_8UC3, cv::Scalar(255, 255, 255));
+  const Json lines =
+      Json::parse(R"({"lines": [{"kind": "text", "flat": [[0.1, 0.2], [0.9, 0.2]]}]})");
+  Json render = kRender;
+  render["orientation"]["quarter_turns_clockwise"] = 1e300;
+  try {
+    DrawFeatureLines(rectified, render, lines);
+    ADD_FAILURE() << "drawn without error";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(),
+                 "60_render/render.json:/orientation/quarter_turns_clockwise: expected an integer");
+  }
+  render["orientation"]["quarter_turns_clockwise"] = -7;  // three turns
+  EXPECT_EQ(DrawFeatureLines(rectified, render, lines).size(), cv::Size(64, 48));
+}
+
+TEST(PointsCounts, RejectsCountsThatAreNotIntegers) {
+  EXPECT_EQ(PointsCounts(Json::parse(R"({"points": {"sfm_in_region": 3, "texture": 4}})")),
+            " 3 sfm points on the page, 4 texture, 0 outline.");
+  try {
+    PointsCounts(Json::parse(R"({"points": {"texture": 1e300}})"));
+    ADD_FAILURE() << "counted without error";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "25_points/points.json:/points/texture: expected an integer");
+  }
+}
+
+}  // namespace
+}  // namespace docunfold::report
