@@ -73,10 +73,17 @@ def image_header_size(path):
 
 
 def describe_images(data):
+    """(number of photos, "1600x1200" or, for mixed sizes, "4 × 1600x1200 + 1 × 8000x6000")."""
     images = sorted(n for n in os.listdir(os.path.join(data, "images"))
                     if n.lower().endswith((".jpg", ".jpeg", ".png", ".tif", ".tiff")))
-    size = image_header_size(os.path.join(data, "images", images[0])) if images else None
-    return len(images), ("%dx%d" % size if size else "?")
+    sizes = {}
+    for name in images:
+        size = image_header_size(os.path.join(data, "images", name))
+        key = "%dx%d" % size if size else "?"
+        sizes[key] = sizes.get(key, 0) + 1
+    if len(sizes) <= 1:
+        return len(images), (next(iter(sizes)) if sizes else "?")
+    return len(images), " + ".join("%d × %s" % (n, k) for k, n in sizes.items())
 
 
 def cpu_name():
@@ -173,7 +180,10 @@ def collect_set(name, data, work):
         front_end = {k: doc.get(k) for k in ("reference", "boundary", "features")}
         front_end["evaluate"] = summarize_timing(
             [t for t in row_timings if t["stage"] == "evaluate:front-end"])
-    return {"name": name, "path": data, "views": views, "image_size": size,
+    variant_file = os.path.join(data, "VARIANT")
+    variant_of = open(variant_file).read().strip() if os.path.exists(variant_file) else None
+    return {"name": name, "path": data, "variant_of": variant_of, "views": views,
+            "image_size": size,
             "has_ground_truth": os.path.exists(os.path.join(data, "ground_truth", "flat.png")),
             "pipeline": {"exit": pipeline_exit, "failed_stage": failed_stage},
             "stages": stages, "rows": rows, "front_end": front_end}
@@ -206,6 +216,9 @@ def collect_solvers(work, name):
 
 
 def summarize(sets):
+    # A variant of another set (phone-photos: the same page, its photos changed)
+    # would count that page twice.
+    sets = [s for s in sets if not s.get("variant_of")]
     methods = []
     for s in sets:
         for r in s["rows"]:
@@ -333,7 +346,10 @@ def markdown(result):
                     " |" * (len(FIGURES) - 1))
             else:
                 notes.append((r["method"], r.get("note", ""), s["name"]))
-    lines += ["", "**Means per method** (over the sets where the row exists):", "",
+    variants = [s["name"] for s in sets if s.get("variant_of")]
+    lines += ["", "**Means per method** (over the sets where the row exists%s):" % (
+        "; not over %s, made from another set's photos" % ", ".join(variants) if variants else ""),
+        "",
               "| method | sets | " + " | ".join(t for _, t, _ in FIGURES) + " |",
               "|---|---:|" + "---:|" * len(FIGURES)]
     for e in result["summary"]:
@@ -379,8 +395,9 @@ def markdown(result):
                 total += t["seconds"]
                 cells.append("%.1f / %.0f%s" % (t["seconds"], t["max_rss_mb"],
                                                  "" if t["exit"] == 0 else " (exit %d)" % t["exit"]))
-            lines.append("| %s | %d × %s | %s | %.1f |" % (s["name"], s["views"], s["image_size"],
-                                                          " | ".join(cells), total))
+            images = (s["image_size"] if "×" in s["image_size"]
+                      else "%d × %s" % (s["views"], s["image_size"]))
+            lines.append("| %s | %s | %s | %.1f |" % (s["name"], images, " | ".join(cells), total))
     else:
         lines.append("(no pipeline stage ran)")
     failed = [s for s in sets if s["pipeline"]["exit"]]

@@ -26,7 +26,8 @@ struct PhoneChanges {
   bool sidecar = false;         // an iPhone's IMG_0001.AAE beside the photos
 };
 
-// Makes <to>/images and <to>/ground_truth from the data set at `from`.
+// Makes <to>/images, <to>/ground_truth and <to>/VARIANT (naming `from`) from
+// the data set at `from`.
 // Throws std::runtime_error when a tool (heif-enc, exiftool) fails.
 void MakePhoneSet(const fs::path& from, const fs::path& to, const PhoneChanges& changes);
 
