@@ -82,7 +82,7 @@ TEST_P(SfmAccuracy, MatchesGroundTruth) {
   const Json doc = ReadJsonFile(options.out_dir / "cameras.json");
   std::printf("[sfm] %s: %s; %s f=%.1f px; %.1f s\n", name.c_str(), FormatFigures(f).c_str(),
               doc.at("colmap").at("camera_model").get<std::string>().c_str(),
-              doc.at("colmap").at("params").at(0).get<double>(), seconds);
+              doc.at("colmap").at("cameras").at(0).at("params").at(0).get<double>(), seconds);
   RecordProperty("figures", FormatFigures(f));
 
   EXPECT_EQ(f.registered, f.views) << name;
