@@ -222,6 +222,9 @@ void ReadHeifExif(const heif_image_handle* handle, PhotoMetadata* metadata) {
 
 void DecodeHeif(std::string_view bytes, const std::string& name, PhotoColor color, Photo* photo) {
   HeifContext context(heif_context_alloc());
+  // libheif decodes a grid's tiles in threads; a made-up file with a huge or
+  // broken grid could start a thread per tile. Two serve an iPhone's 48 tiles.
+  heif_context_set_max_decoding_threads(context.get(), 2);
   CheckHeif(heif_context_read_from_memory_without_copy(context.get(), bytes.data(), bytes.size(),
                                                        nullptr),
             name);
@@ -232,6 +235,9 @@ void DecodeHeif(std::string_view bytes, const std::string& name, PhotoColor colo
   ReadHeifExif(handle.get(), &photo->metadata);
   CheckClaimedSize(heif_image_handle_get_width(handle.get()),
                    heif_image_handle_get_height(handle.get()), bytes.size(), name);
+  // As heif-convert does: an image without a bit depth is not decoded.
+  if (heif_image_handle_get_luma_bits_per_pixel(handle.get()) < 0)
+    throw PhotoError(name, true, "the image has no defined bit depth");
   heif_image* raw_image = nullptr;
   // libheif applies the file's rotation and mirroring (irot, imir) itself;
   // the EXIF orientation of a HEIF file only repeats them.

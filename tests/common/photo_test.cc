@@ -116,6 +116,17 @@ TEST(ReadPhoto, NamesDamagedAndForeignFiles) {
   EXPECT_THROW(DecodePhoto(bytes, "cut.jpg"), PhotoError);
 }
 
+// Found by the photo fuzzer: a HEIF whose image has no bit depth made libheif
+// start thread after thread until memory ran out.
+TEST(ReadPhoto, RefusesHeifWithoutBitDepthAtOnce) {
+  try {
+    ReadPhoto(SourceDir() / "tests/data/photos/grid-without-bit-depth.heic");
+    FAIL() << "decoded";
+  } catch (const PhotoError& e) {
+    EXPECT_TRUE(e.damaged()) << e.what();
+  }
+}
+
 TEST(FocalPixelsFrom35mm, UsesTheDiagonal) {
   // A 4:3 photo 4032 px wide at 26 mm equivalent (a common phone main camera).
   EXPECT_NEAR(FocalPixelsFrom35mm(26, 4032, 3024), 26 * 5040 / 43.2666, 0.5);
