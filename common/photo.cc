@@ -29,15 +29,18 @@ constexpr double kMaxPixels = 200e6;
 // claims more than ten times that is damaged or made up.
 constexpr double kMaxPixelsPerByte = 4000;
 
-// Throws PhotoError when `width` x `height` pixels are implausible for a
-// file of `bytes` bytes.
-void CheckClaimedSize(double width, double height, size_t bytes, const std::string& name) {
+// Why `width` x `height` pixels are implausible for a file of `bytes` bytes;
+// "" when they are not.
+std::string ClaimedSizeProblem(double width, double height, size_t bytes) {
   const double pixels = width * height;
-  if (pixels > kMaxPixels || pixels > kMaxPixelsPerByte * double(bytes))
-    throw PhotoError(name, true,
-                     "its header claims " + std::to_string(long(width)) + "x" +
-                         std::to_string(long(height)) + " pixels in " + std::to_string(bytes) +
-                         " bytes");
+  if (pixels <= kMaxPixels && pixels <= kMaxPixelsPerByte * double(bytes)) return "";
+  return "its header claims " + std::to_string(long(width)) + "x" + std::to_string(long(height)) +
+         " pixels in " + std::to_string(bytes) + " bytes";
+}
+
+void CheckClaimedSize(double width, double height, size_t bytes, const std::string& name) {
+  const std::string problem = ClaimedSizeProblem(width, height, bytes);
+  if (!problem.empty()) throw PhotoError(name, true, problem);
 }
 
 bool StartsWith(std::string_view s, std::string_view prefix) {
@@ -164,12 +167,8 @@ bool DecodeJpeg(std::string_view bytes, const std::string& name, PhotoColor colo
   for (jpeg_saved_marker_ptr m = cinfo.marker_list; m; m = m->next)
     if (m->marker == JPEG_APP0 + 1 && m->data_length > 6 && !std::memcmp(m->data, "Exif\0\0", 6))
       ParseExif(m->data, m->data_length, &photo->metadata);
-  try {
-    CheckClaimedSize(cinfo.image_width, cinfo.image_height, bytes.size(), name);
-  } catch (const PhotoError& e) {
-    errors.fatal = e.reason().substr(std::string("damaged: ").size());
-    std::longjmp(errors.jump, 1);
-  }
+  errors.fatal = ClaimedSizeProblem(cinfo.image_width, cinfo.image_height, bytes.size());
+  if (!errors.fatal.empty()) std::longjmp(errors.jump, 1);
   if (cinfo.num_components == 4) {
     cmyk = true;
   } else {

@@ -116,6 +116,24 @@ TEST(ReadPhoto, NamesDamagedAndForeignFiles) {
   EXPECT_THROW(DecodePhoto(bytes, "cut.jpg"), PhotoError);
 }
 
+// A header may claim any size: more pixels than the file's bytes can hold is
+// refused before they are allocated.
+TEST(ReadPhoto, RefusesAHeaderClaimingMorePixelsThanItsBytesHold) {
+  std::vector<uchar> jpeg;
+  cv::imencode(".jpg", Asymmetric(), jpeg);
+  std::string bytes(jpeg.begin(), jpeg.end());
+  const size_t sof = bytes.find("\xFF\xC0");
+  ASSERT_NE(sof, std::string::npos);
+  for (size_t i : {sof + 5, sof + 7}) bytes[i] = char(0xEA), bytes[i + 1] = char(0x60);  // 60000
+  try {
+    DecodePhoto(bytes, "huge.jpg");
+    FAIL() << "decoded";
+  } catch (const PhotoError& e) {
+    EXPECT_NE(std::string(e.what()).find("claims 60000x60000 pixels"), std::string::npos)
+        << e.what();
+  }
+}
+
 // Found by the photo fuzzer: a HEIF whose image has no bit depth made libheif
 // start thread after thread until memory ran out.
 TEST(ReadPhoto, RefusesHeifWithoutBitDepthAtOnce) {
