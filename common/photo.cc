@@ -47,6 +47,11 @@ bool StartsWith(std::string_view s, std::string_view prefix) {
   return s.size() >= prefix.size() && s.compare(0, prefix.size(), prefix) == 0;
 }
 
+// The big-endian 32-bit number at `p` (PNG's header, HEIF's Exif block).
+uint32_t BigEndian32(const unsigned char* p) {
+  return (uint32_t(p[0]) << 24) | (uint32_t(p[1]) << 16) | (uint32_t(p[2]) << 8) | uint32_t(p[3]);
+}
+
 std::string Trim(std::string s) {
   while (!s.empty() && (s.back() == ' ' || s.back() == '\0')) s.pop_back();
   size_t start = s.find_first_not_of(' ');
@@ -193,12 +198,6 @@ bool DecodeJpeg(std::string_view bytes, const std::string& name, PhotoColor colo
 
 // ---- HEIF -----------------------------------------------------------------
 
-template <typename T, void (*Free)(T*)>
-struct HeifDeleter {
-  void operator()(T* p) const { Free(p); }
-};
-using HeifContext = std::unique_ptr<heif_context, HeifDeleter<heif_context, heif_context_free>>;
-
 void CheckHeif(const heif_error& error, const std::string& name) {
   if (error.code != heif_error_Ok)
     throw PhotoError(name, true, error.message ? error.message : "libheif failed");
@@ -211,8 +210,7 @@ void ReadHeifExif(const heif_image_handle* handle, PhotoMetadata* metadata) {
   if (block.size() < 4 || heif_image_handle_get_metadata(handle, id, block.data()).code) return;
   // The block starts with the offset of the TIFF header past these 4 bytes;
   // libexif wants "Exif\0\0" right before that header.
-  const size_t offset = 4 + ((size_t(block[0]) << 24) | (size_t(block[1]) << 16) |
-                             (size_t(block[2]) << 8) | size_t(block[3]));
+  const size_t offset = 4 + size_t(BigEndian32(block.data()));
   if (offset >= block.size()) return;
   std::vector<unsigned char> exif = {'E', 'x', 'i', 'f', 0, 0};
   exif.insert(exif.end(), block.begin() + long(offset), block.end());
@@ -220,7 +218,8 @@ void ReadHeifExif(const heif_image_handle* handle, PhotoMetadata* metadata) {
 }
 
 void DecodeHeif(std::string_view bytes, const std::string& name, PhotoColor color, Photo* photo) {
-  HeifContext context(heif_context_alloc());
+  const std::unique_ptr<heif_context, void (*)(heif_context*)> context(heif_context_alloc(),
+                                                                       heif_context_free);
   // libheif decodes a grid's tiles in threads; a made-up file with a huge or
   // broken grid could start a thread per tile. Two serve an iPhone's 48 tiles.
   heif_context_set_max_decoding_threads(context.get(), 2);
@@ -261,12 +260,8 @@ void DecodeWithOpenCv(std::string_view bytes, const std::string& name, PhotoColo
   // allocates it. For the other formats OpenCV's own limit, set once (a
   // value the user set wins), caps what a made-up header can claim.
   if (photo->format == PhotoFormat::kPng && bytes.size() >= 24) {
-    const auto u32 = [&](size_t at) {
-      return double((uint32_t(uint8_t(bytes[at])) << 24) |
-                    (uint32_t(uint8_t(bytes[at + 1])) << 16) |
-                    (uint32_t(uint8_t(bytes[at + 2])) << 8) | uint32_t(uint8_t(bytes[at + 3])));
-    };
-    CheckClaimedSize(u32(16), u32(20), bytes.size(), name);
+    const auto* header = reinterpret_cast<const unsigned char*>(bytes.data());
+    CheckClaimedSize(BigEndian32(header + 16), BigEndian32(header + 20), bytes.size(), name);
   }
   static const bool limited = setenv("CV_IO_MAX_IMAGE_PIXELS", "200000000", 0) == 0;
   (void)limited;
@@ -342,11 +337,7 @@ Photo DecodePhoto(std::string_view bytes, const std::string& name, PhotoColor co
       DecodeHeif(bytes, name, color, &photo);
       return photo;
     case PhotoFormat::kJpeg:
-      if (DecodeJpeg(bytes, name, color, &photo)) {
-        ApplyOrientation(photo.metadata.exif_orientation, &photo.image);
-        return photo;
-      }
-      DecodeWithOpenCv(bytes, name, color, &photo);
+      if (!DecodeJpeg(bytes, name, color, &photo)) DecodeWithOpenCv(bytes, name, color, &photo);
       ApplyOrientation(photo.metadata.exif_orientation, &photo.image);
       return photo;
     default:
