@@ -124,9 +124,14 @@ void ExtractFeatures(const Colmap& colmap, const PhotoSet& photos) {
   for (size_t g = 0; g < photos.groups.size(); ++g) {
     const CameraGroup& group = photos.groups[g];
     const fs::path list_file = colmap.dir / ("image_list_" + std::to_string(g) + ".txt");
+    long in_group = 0;
     {
       std::ofstream list(list_file);
-      for (const std::string& name : group.colmap_names) list << name << "\n";
+      for (const PhotoCopy& p : photos.photos) {
+        if (p.group != int(g)) continue;
+        list << p.colmap_name << "\n";
+        ++in_group;
+      }
       if (!list) throw OutputError(list_file.string() + ": write failed");
     }
     std::vector<std::string> args = {"--database_path",
@@ -159,7 +164,7 @@ void ExtractFeatures(const Colmap& colmap, const PhotoSet& photos) {
                  if (std::regex_search(line, m, processed))
                    progress.Update(done_before + std::stol(m[1]));
                });
-    done_before += long(group.colmap_names.size());
+    done_before += in_group;
   }
   progress.Done();
 }

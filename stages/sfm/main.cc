@@ -29,7 +29,7 @@ int main(int argc, char** argv) {
   return RunStage("sfm", table, argc, argv, [&] {
     const sfm::SfmResult r = sfm::RunSfm(o, table.Record());
     const size_t left_out = r.photos.left_out.size();
-    Log(std::to_string(r.cameras.views.size()) + "/" + std::to_string(r.images.size()) +
+    Log(std::to_string(r.cameras.views.size()) + "/" + std::to_string(r.photos.photos.size()) +
         " views registered" +
         (left_out ? " (" + std::to_string(left_out) + " files left out)" : std::string()) + ", " +
         std::to_string(r.points.size()) + " points, " + r.camera_model + ", reference " +

@@ -92,7 +92,6 @@ void GroupCameras(PhotoSet* set) {
       set->groups.push_back(g);
     }
     p.group = it->second;
-    set->groups[p.group].colmap_names.push_back(p.colmap_name);
   }
 }
 
@@ -102,6 +101,12 @@ const PhotoCopy* PhotoSet::Find(const std::string& name) const {
   for (const PhotoCopy& p : photos)
     if (p.name == name) return &p;
   return nullptr;
+}
+
+std::vector<std::string> PhotoSet::Names() const {
+  std::vector<std::string> names;
+  for (const PhotoCopy& p : photos) names.push_back(p.name);
+  return names;
 }
 
 PhotoSet PreparePhotos(const fs::path& data_dir, int max_image_size, const fs::path& copy_dir,

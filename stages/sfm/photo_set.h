@@ -37,7 +37,6 @@ struct CameraGroup {
   std::string camera;      // EXIF make and model ("" when absent)
   double focal_35mm = 0;   // EXIF 35 mm equivalent focal length (mm); 0 when absent
   double focal_prior = 0;  // COLMAP's focal length prior from it (copy pixels); 0 = none
-  std::vector<std::string> colmap_names;
 };
 
 // A file of images/ that is not used, and why ("not a photo", "damaged: the
@@ -53,6 +52,7 @@ struct PhotoSet {
   std::vector<LeftOut> left_out;
 
   const PhotoCopy* Find(const std::string& name) const;  // by file name; nullptr if absent
+  std::vector<std::string> Names() const;                // the photos' file names, in order
 };
 
 // Reads every file in <data_dir>/images (hidden files aside): each photo is

@@ -222,7 +222,7 @@ Json CamerasJson(const SfmResult& r, const Json& options_record) {
   }
   doc["colmap"] = {{"camera_model", r.camera_model},
                    {"cameras", cameras},
-                   {"images", r.images.size()},
+                   {"images", r.photos.photos.size()},
                    {"registered", r.cameras.views.size()},
                    {"unregistered", r.unregistered},
                    {"points", r.points.size()},
@@ -244,7 +244,7 @@ namespace {
 std::set<std::string> NoteRegistered(const ColmapModel& model, SfmResult* result) {
   std::set<std::string> registered;
   for (const auto& [id, im] : model.images) registered.insert(im.name);
-  for (const std::string& name : result->images)
+  for (const std::string& name : result->photos.Names())
     if (!registered.count(name)) result->unregistered.push_back(name);
   if (!result->unregistered.empty())
     Log("warning: " + std::to_string(result->unregistered.size()) + " views not registered (" +
@@ -259,9 +259,10 @@ void ChooseReference(const ColmapModel& model, const std::set<std::string>& regi
                      const std::vector<cv::Mat>& thumbnails, const SfmOptions& o,
                      SfmResult* result) {
   std::map<std::string, cv::Mat1b> masks;
-  for (size_t i = 0; i < result->images.size(); ++i)
-    if (registered.count(result->images[i]))
-      masks[result->images[i]] = RoughPageMask(thumbnails[i]);
+  for (size_t i = 0; i < result->photos.photos.size(); ++i) {
+    const std::string& name = result->photos.photos[i].name;
+    if (registered.count(name)) masks[name] = RoughPageMask(thumbnails[i]);
+  }
   result->view_scores = ScoreReferenceViews(model, masks, o.reference_options);
   {
     const std::vector<bool> page = PagePoints(model, masks);
@@ -355,14 +356,13 @@ SfmResult RunSfm(const SfmOptions& o, const Json& options_record) {
   std::vector<cv::Mat> thumbnails;
   result.photos = PreparePhotos(o.data_dir, o.max_image_size, colmap.image_dir, &thumbnails);
   const PhotoSet& photos = result.photos;
-  for (const PhotoCopy& p : photos.photos) result.images.push_back(p.name);
   result.seconds_reading = timer.Mark("reading photos");
   if (photos.groups.size() > 1)
     Log(std::to_string(photos.groups.size()) +
         " cameras (photos of different sizes or from different phones)");
   if (!o.reference.empty() && !photos.Find(o.reference))
     throw InputError("--ref " + o.reference + ": no such photo in " +
-                     (o.data_dir / "images").string() + " (there are " + JoinNames(result.images) +
+                     (o.data_dir / "images").string() + " (there are " + JoinNames(photos.Names()) +
                      ")");
 
   colmap.exe = FindExecutable(o.colmap);

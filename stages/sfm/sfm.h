@@ -118,7 +118,6 @@ struct SfmResult {
   // COLMAP's cameras (one per CameraGroup that has a registered photo), by
   // group index: their parameters, in the copies' pixels.
   std::map<int, std::vector<double>> colmap_params;
-  std::vector<std::string> images;  // every photo of the data set (not the left-out files)
   std::vector<std::string> unregistered;
   std::vector<Eigen::Vector3d> points;  // reference frame
   std::vector<std::array<uint8_t, 3>> colors;
