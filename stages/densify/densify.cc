@@ -270,8 +270,12 @@ WorkingCopies MakeWorkingCopies(const DensifyInputs& in, const DensifyOptions& o
                                 const PinholeCamera& ref_camera, const cv::Mat1b& full_region,
                                 DensifyResult* result) {
   const int num_views = int(in.cameras.views.size());
-  const int long_side = std::max(ref_camera.width, ref_camera.height);
-  result->working_scale = std::min(1.0, double(o.max_image_size) / long_side);
+  // Every view at most max_image_size long: a photo from a larger sensor is
+  // brought down to about the reference's resolution, not kept at its own.
+  const auto scale_of = [&](const PinholeCamera& camera) {
+    return std::min(1.0, double(o.max_image_size) / std::max(camera.width, camera.height));
+  };
+  result->working_scale = scale_of(ref_camera);
   cv::Mat ref_grey;
   cv::cvtColor(in.reference, ref_grey, cv::COLOR_BGR2GRAY);
   const int ref_index = int(in.cameras.Find(in.cameras.reference) - in.cameras.views.data());
@@ -279,12 +283,9 @@ WorkingCopies MakeWorkingCopies(const DensifyInputs& in, const DensifyOptions& o
   w.ref = detail::MakeView(ref_index, ref_camera, ref_grey, {}, result->working_scale);
   for (int i = 0; i < num_views; ++i) {
     if (i == ref_index) continue;
-    // Each view at most max_image_size too: a photo from a larger sensor is
-    // brought down to about the reference's resolution, not kept at its own.
     const PinholeCamera& camera = in.cameras.views[i];
-    const double scale =
-        std::min(1.0, double(o.max_image_size) / std::max(camera.width, camera.height));
-    w.others.push_back(detail::MakeView(i, camera, in.photos[i], in.distortion[i], scale));
+    w.others.push_back(
+        detail::MakeView(i, camera, in.photos[i], in.distortion[i], scale_of(camera)));
   }
   cv::resize(full_region, w.region, w.ref.grey.size(), 0, 0, cv::INTER_NEAREST);
   cv::resize(in.region, w.page, w.ref.grey.size(), 0, 0, cv::INTER_NEAREST);

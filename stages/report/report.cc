@@ -166,15 +166,14 @@ void PhotosSection(const ReportOptions& o, const DataSet& data, const Json& came
         why += "</table>";
       }
     }
+    const Json left_out_files = cameras.contains("left_out") && cameras["left_out"].is_array()
+                                    ? cameras["left_out"]
+                                    : Json::array();
     std::string left_out;
-    if (cameras.contains("left_out") && cameras["left_out"].is_array())
-      for (const Json& l : cameras["left_out"])
-        left_out += "<li>" + Escape(l.value("image", "?")) + " (" + Escape(l.value("reason", "")) +
-                    ")</li>";
-    const size_t photos =
-        data.images.size() - (cameras.contains("left_out") && cameras["left_out"].is_array()
-                                  ? cameras["left_out"].size()
-                                  : 0);
+    for (const Json& l : left_out_files)
+      left_out +=
+          "<li>" + Escape(l.value("image", "?")) + " (" + Escape(l.value("reason", "")) + ")</li>";
+    const size_t photos = data.images.size() - left_out_files.size();
     page->Add("<p>" + std::to_string(cameras.at("views").size()) + " of " + std::to_string(photos) +
               " photos registered. " + why + "</p>" +
               (left_out.empty() ? "" : "<p>Left out:</p><ul>" + left_out + "</ul>"));
