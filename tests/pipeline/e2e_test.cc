@@ -28,8 +28,6 @@
 namespace docunfold::testing {
 namespace {
 
-fs::path E2eDir() { return fs::path(DOCUNFOLD_BIN_DIR).parent_path() / "e2e"; }
-
 // The data sets run_e2e.sh runs, by the name of their work directory.
 std::vector<std::string> E2eSets() {
   std::vector<std::string> names;
@@ -46,26 +44,6 @@ fs::path DataDir(const std::string& name) {
 
 std::string Tool(const std::string& script) {
   return Quote((SourceDir() / "tests/tools" / script).string());
-}
-
-// The benchmark's rows of one set: method -> metrics.
-std::map<std::string, Json> Rows(const std::string& set) {
-  std::map<std::string, Json> rows;
-  const Json results = ReadJsonFile(E2eDir() / "results.json");
-  for (const Json& s : results.at("sets")) {
-    if (s.value("name", "") != set) continue;
-    for (const Json& r : s.at("rows"))
-      if (r.value("status", "") == "ok" && r.contains("metrics") && r["metrics"].is_object())
-        rows[r.at("method").get<std::string>()] = r["metrics"];
-  }
-  return rows;
-}
-
-double Metric(const std::map<std::string, Json>& rows, const std::string& method,
-              const std::string& key) {
-  auto it = rows.find(method);
-  if (it == rows.end() || !it->second.contains(key) || !it->second[key].is_number()) return NAN;
-  return it->second[key].get<double>();
 }
 
 // Similarity taking the true world to sfm's world: x_sfm = s R x_true + t.
@@ -238,7 +216,7 @@ bool AssimpMisreadsBinaryPly(const fs::path& path) {
 }
 
 TEST_P(EndToEnd, MeshesAreCloseToTheTruthAndReadable) {
-  const auto rows = Rows(set_);
+  const auto rows = E2eRows(set_);
   const double init_surface = Metric(rows, "docunfold-init", "surface_mean_pct");
   const double init_iso = Metric(rows, "docunfold-init", "isometry_mean");
   const double final_surface = Metric(rows, "docunfold", "surface_mean_pct");
@@ -308,7 +286,7 @@ TEST_P(EndToEnd, OptimizeLowersFWithinEveryRound) {
 }
 
 TEST_P(EndToEnd, ResultIsBetterThanTheReferenceMethods) {
-  const auto rows = Rows(set_);
+  const auto rows = E2eRows(set_);
   const double ours = Metric(rows, "docunfold", "ms_ssim");
   const double init = Metric(rows, "docunfold-init", "ms_ssim");
   const double homography = Metric(rows, "homography", "ms_ssim");
@@ -423,7 +401,7 @@ TEST(EndToEndSummary, SamplesOnAverage) {
   for (const Json& s : results.at("sets")) {
     const std::string name = s.value("name", "");
     if (!fs::is_directory(SampleDir(name))) continue;
-    const auto rows = Rows(name);
+    const auto rows = E2eRows(name);
     ours += Metric(rows, "docunfold", "ms_ssim");
     oracle += Metric(rows, "oracle", "ms_ssim");
     oracle_seen += Metric(rows, "oracle-seen", "ms_ssim");

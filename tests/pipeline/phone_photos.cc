@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "common/json_io.h"
+#include "tests/support/test_support.h"
 
 namespace docunfold::testing {
 
@@ -25,42 +26,22 @@ void Run(const std::string& command) {
     throw std::runtime_error(command + ": failed (scripts/install-deps.sh installs the tools)");
 }
 
-std::string Quoted(const fs::path& p) {
-  std::string q = "'";
-  for (char c : p.string()) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
-
-Eigen::Matrix3d ReadMatrix(const Json& j) {
-  Eigen::Matrix3d m;
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) m(r, c) = j.at(r).at(c).get<double>();
-  return m;
-}
-
-Json WriteMatrix(const Eigen::Matrix3d& m) {
-  Json j = Json::array();
-  for (int r = 0; r < 3; ++r) j.push_back({m(r, 0), m(r, 1), m(r, 2)});
-  return j;
-}
-
 // A true camera after its photo changed: pixels (edges at 0) map by `B`,
 // the camera frame turns by `Q` about the optical axis.
 void Transform(const Eigen::Matrix3d& B, const Eigen::Matrix3d& Q, int width, int height,
                Json* view) {
-  Eigen::Matrix3d K = ReadMatrix(view->at("K"));
+  const JsonReader read(*view, "ground_truth/cameras.json");
+  Eigen::Matrix3d K = read.Matrix3("/K");
   K(0, 2) += 0.5;
   K(1, 2) += 0.5;
   K = B * K * Q.transpose();
   K(0, 2) -= 0.5;
   K(1, 2) -= 0.5;
-  const Eigen::Matrix3d R = Q * ReadMatrix(view->at("R"));
-  Eigen::Vector3d t;
-  for (int i = 0; i < 3; ++i) t(i) = view->at("t").at(i).get<double>();
-  t = Q * t;
-  (*view)["K"] = WriteMatrix(K);
-  (*view)["R"] = WriteMatrix(R);
-  (*view)["t"] = {t(0), t(1), t(2)};
+  const Eigen::Matrix3d R = Q * read.Matrix3("/R");
+  const Eigen::Vector3d t = Q * read.Vector3("/t");
+  (*view)["K"] = ToJson(K);
+  (*view)["R"] = ToJson(R);
+  (*view)["t"] = ToJson(t);
   (*view)["width"] = width;
   (*view)["height"] = height;
 }
@@ -135,11 +116,11 @@ void MakePhoneSet(const fs::path& from, const fs::path& to, const PhoneChanges& 
         TurnClockwise(view);
       }
       Run("exiftool -n -overwrite_original -Orientation=6 -Make=docunfold -Model='synth phone'" +
-          focal + " " + Quoted(out));
+          focal + " " + Quote(out.string()));
     }
     if (changes.heic.count(i)) {
       const fs::path heic = fs::path(out).replace_extension(".heic");
-      Run("heif-enc -q 92 " + Quoted(out) + " -o " + Quoted(heic));
+      Run("heif-enc -q 92 " + Quote(out.string()) + " -o " + Quote(heic.string()));
       fs::remove(out);
       out = heic;
       name = heic.filename().string();

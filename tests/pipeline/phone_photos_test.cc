@@ -30,24 +30,12 @@ std::map<std::string, std::string> Listing(const fs::path& dir) {
   return out;
 }
 
-// set01's MS-SSIM in the e2e run (the benchmark's docunfold row).
-double Set01Own() {
-  const fs::path results = fs::path(DOCUNFOLD_BIN_DIR).parent_path() / "e2e/results.json";
-  if (!fs::exists(results)) return NAN;
-  const Json doc = ReadJsonFile(results);
-  for (const Json& set : doc.at("sets"))
-    if (set.value("name", "") == "set01")
-      for (const Json& r : set.at("rows"))
-        if (r.value("method", "") == "docunfold" && r.value("status", "") == "ok")
-          return r.at("metrics").at("ms_ssim").get<double>();
-  return NAN;
-}
-
 class PhonePhotos : public ::testing::Test {
  protected:
   void SetUp() override {
     if (!fs::is_directory(SampleDir("set01"))) GTEST_SKIP() << "no sample set01";
-    own_ = Set01Own();
+    ASSERT_TRUE(fs::exists(E2eDir() / "results.json")) << "did the e2e_run fixture run?";
+    own_ = Metric(E2eRows("set01"), "docunfold", "ms_ssim");  // the benchmark's docunfold row
     ASSERT_FALSE(std::isnan(own_)) << "no set01 result in the e2e run";
   }
 

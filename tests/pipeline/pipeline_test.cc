@@ -30,7 +30,7 @@ class Pipeline : public ::testing::Test {
   }
   void SetUp() override {
     if (!fs::is_directory(SampleDir(kSample))) GTEST_SKIP() << "no sample " << kSample;
-    const fs::path e2e = fs::path(DOCUNFOLD_BIN_DIR).parent_path() / "e2e/work" / kSample;
+    const fs::path e2e = E2eDir() / "work" / kSample;
     ASSERT_TRUE(fs::is_directory(e2e)) << e2e << " (did the e2e_run fixture run?)";
     CommandResult copy = RunCommand("cp -a " + Quote(e2e.string()) + " " + Quote(Work().string()));
     ASSERT_EQ(copy.exit_code, 0) << copy.output;

@@ -4,6 +4,7 @@
 #include <sys/wait.h>
 
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <opencv2/imgproc.hpp>
@@ -49,6 +50,27 @@ fs::path RealisticDir() {
   fs::path p = SourceDir().parent_path() / "shared" / "realistic";
   std::error_code ec;
   return fs::is_directory(p, ec) ? p : fs::path();
+}
+
+fs::path E2eDir() { return fs::path(DOCUNFOLD_BIN_DIR).parent_path() / "e2e"; }
+
+std::map<std::string, Json> E2eRows(const std::string& set) {
+  std::map<std::string, Json> rows;
+  const Json results = ReadJsonFile(E2eDir() / "results.json");
+  for (const Json& s : results.at("sets")) {
+    if (s.value("name", "") != set) continue;
+    for (const Json& r : s.at("rows"))
+      if (r.value("status", "") == "ok" && r.contains("metrics") && r["metrics"].is_object())
+        rows[r.at("method").get<std::string>()] = r["metrics"];
+  }
+  return rows;
+}
+
+double Metric(const std::map<std::string, Json>& rows, const std::string& method,
+              const std::string& key) {
+  auto it = rows.find(method);
+  if (it == rows.end() || !it->second.contains(key) || !it->second[key].is_number()) return NAN;
+  return it->second[key].get<double>();
 }
 
 std::string Quote(const std::string& s) {

@@ -4,9 +4,12 @@
 
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
+
+#include "common/json_io.h"
 
 namespace docunfold::testing {
 
@@ -42,6 +45,15 @@ fs::path SampleDir(const std::string& name);
 fs::path RealisticDir();
 
 std::string Quote(const std::string& s);
+
+// build/e2e/: the one run of the whole pipeline the e2e tests share
+// (tests/pipeline/run_e2e.sh, CTest fixture e2e_run).
+fs::path E2eDir();
+// That run's benchmark rows of one set (results.json): method -> metrics.
+std::map<std::string, Json> E2eRows(const std::string& set);
+// rows[method][key], or NaN when absent or not a number.
+double Metric(const std::map<std::string, Json>& rows, const std::string& method,
+              const std::string& key);
 
 // The message of the InputError `f` throws ("" when it throws none).
 std::string ErrorOf(const std::function<void()>& f);
