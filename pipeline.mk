@@ -50,6 +50,7 @@ DENSIFY ?= 1
 INIT_FLAGS ?=
 OPTIMIZE_FLAGS ?=
 RENDER_FLAGS ?=
+PDF_FLAGS ?=
 EVAL_FLAGS ?=
 
 # Every stage runs under scripts/stage-timer, which appends its wall time and
@@ -78,10 +79,11 @@ POINTS_FROM := $(notdir $(patsubst %/points.ply,%,$(POINTS_FILE)))
 $(eval $(call flags_rule,init,$(INIT_FLAGS) points=$(POINTS_FROM)))
 $(eval $(call flags_rule,optimize,$(OPTIMIZE_FLAGS) points=$(POINTS_FROM)))
 $(eval $(call flags_rule,render,$(RENDER_FLAGS)))
+$(eval $(call flags_rule,pdf,$(PDF_FLAGS)))
 $(eval $(call flags_rule,evaluate,$(EVAL_FLAGS)))
 $(eval $(call flags_rule,images,$(IMAGES_LIST)))
 
-.PHONY: all sfm boundary points features init optimize render evaluate report help clean deps build test bench fuzz check-data FORCE
+.PHONY: all sfm boundary points features init optimize render pdf evaluate report book help clean deps build test bench fuzz check-data FORCE
 FORCE:
 
 # ---- build ----------------------------------------------------------------------
@@ -136,7 +138,7 @@ CHAIN := sfm:sfm boundary:segment-boundary points:densify features:detect-featur
   init:init-mesh optimize:optimize render:render
 IMPLEMENTED := $(foreach s,$(CHAIN),$(if $(wildcard $(ROOT)/stages/$(word 2,$(subst :, ,$(s)))),$(word 1,$(subst :, ,$(s)))))
 HAS_GT := $(wildcard $(DATA_DIR)/ground_truth/flat.png)
-all: $(lastword $(IMPLEMENTED)) $(if $(and $(HAS_GT),$(wildcard $(ROOT)/stages/evaluate)),evaluate) $(if $(wildcard $(ROOT)/stages/report),report)
+all: $(lastword $(IMPLEMENTED)) $(if $(wildcard $(ROOT)/stages/pdf),pdf) $(if $(and $(HAS_GT),$(wildcard $(ROOT)/stages/evaluate)),evaluate) $(if $(wildcard $(ROOT)/stages/report),report)
 	@echo "docunfold: $(NAME) done; results in $(WORK)$(if $(wildcard $(ROOT)/stages/report),; open $(WORK)/report.html)"
 
 check-data:
@@ -195,6 +197,12 @@ render: check-data $(if $(wildcard $(ROOT)/stages/optimize),optimize,init) $(REN
 $(RENDER_OUT) &: $(BIN)/render $(WORK)/.flags/render $(WORK)/$(MESH_STAGE)/mesh3d.ply $(WORK)/$(MESH_STAGE)/mesh2d.ply $(SFM_IN) $(BOUNDARY_IN) $(WORK)/30_features/features.json
 	$(call timed,render) $(BIN)/render --sfm $(WORK)/10_sfm --boundary $(WORK)/20_boundary --meshes $(WORK)/$(MESH_STAGE) --out $(WORK)/60_render --images $(DATA_DIR)/images --features $(WORK)/30_features/features.json $(RENDER_FLAGS)
 
+# The searchable PDF at the page's paper size, with ALTO XML and hOCR.
+PDF_OUT := $(addprefix $(WORK)/80_pdf/,$(NAME).pdf $(NAME).alto.xml $(NAME).hocr pdf.json)
+pdf: check-data render $(PDF_OUT)
+$(PDF_OUT) &: $(BIN)/pdf $(WORK)/.flags/pdf $(WORK)/60_render/rectified.png
+	$(call timed,pdf) $(BIN)/pdf --render $(WORK)/60_render --out $(WORK)/80_pdf --name $(NAME) $(PDF_FLAGS)
+
 EVAL_OUT := $(WORK)/70_eval/metrics.json
 # The front end (20_boundary/, 30_features/) against the truth in the
 # reference view, where the data set has a true surface.
@@ -211,8 +219,8 @@ $(WORK)/70_eval/front_end.json: $(BIN)/evaluate $(SFM_IN) $(BOUNDARY_IN) $(WORK)
 REPORT_OUT := $(WORK)/report.html
 report: check-data $(REPORT_OUT)
 STAGE_OUTPUTS := sfm:SFM_OUT boundary:BOUNDARY_OUT points:POINTS_OUT features:FEATURES_OUT init:INIT_OUT \
-  optimize:OPTIMIZE_OUT render:RENDER_OUT
-REPORT_IN := $(foreach s,$(STAGE_OUTPUTS),$(if $(filter $(word 1,$(subst :, ,$(s))),$(IMPLEMENTED)),$($(word 2,$(subst :, ,$(s)))))) \
+  optimize:OPTIMIZE_OUT render:RENDER_OUT pdf:PDF_OUT
+REPORT_IN := $(foreach s,$(STAGE_OUTPUTS),$(if $(filter $(word 1,$(subst :, ,$(s))),$(IMPLEMENTED) $(if $(wildcard $(ROOT)/stages/pdf),pdf)),$($(word 2,$(subst :, ,$(s)))))) \
   $(if $(and $(HAS_GT),$(wildcard $(ROOT)/stages/evaluate)),$(EVAL_OUT) $(FRONT_END_OUT))
 $(REPORT_OUT): $(BIN)/report $(REPORT_IN) | check-data
 	$(BIN)/report --data $(DATA_DIR) --work $(WORK) --out $@
@@ -227,6 +235,21 @@ datasets: build
 	@$(MAKE) --no-print-directory -f $(ROOT)/pipeline.mk NO_BUILD=1 $(addprefix dataset/,$(DATASETS))
 dataset/%:
 	@$(MAKE) --no-print-directory -f $(ROOT)/pipeline.mk NO_BUILD=1 DATA=$* WORK=$(WORK_ROOT)/$(notdir $*) all
+
+# A document of several pages: each data set of DATASETS (in that order) is
+# run as far as its PDF, two at a time with -j2, and the pages are joined into
+# WORK_ROOT/<BOOK>.pdf, with each page's ALTO file and image in
+# WORK_ROOT/<BOOK>.alto/. A page that fails stops the book.
+BOOK ?=
+.PHONY: book-pages
+book: $(if $(NO_BUILD),,build)
+	@test -n "$(BOOK)" || { echo "pipeline.mk: book needs BOOK=<name> and DATASETS=\"page1 page2 ...\"" >&2; exit 2; }
+	@$(MAKE) --no-print-directory -f $(ROOT)/pipeline.mk NO_BUILD=1 book-pages
+	$(ROOT)/scripts/book '$(ROOT)' '$(WORK_ROOT)' '$(BOOK)' $(DATASETS)
+book-pages: $(addprefix book-page/,$(DATASETS))
+book-page/%:
+	@$(MAKE) --no-print-directory -f $(ROOT)/pipeline.mk NO_BUILD=1 DATA=$* pdf || \
+	  { echo "pipeline.mk: book $(BOOK): page $* failed" >&2; exit 1; }
 
 # ---- housekeeping -------------------------------------------------------------------
 clean:
@@ -244,6 +267,7 @@ help:
 	@echo "  init           initial 3D mesh M and flat mesh M' -> 40_init/"
 	@echo "  optimize       joint isometric optimisation with feature lines -> 50_optimize/"
 	@echo "  render         the rectified, cropped page -> 60_render/"
+	@echo "  pdf            searchable PDF at the paper's size, ALTO XML, hOCR -> 80_pdf/"
 	@echo "  evaluate       metrics against ground truth -> 70_eval/ (sets with ground_truth/;"
 	@echo "                 front_end.json: boundary and features in the reference view)"
 	@echo "  report         one HTML page with every stage's output -> work/<name>/report.html"
@@ -253,6 +277,8 @@ help:
 	@echo "  bench          time every stage on every sample -> bench/results.md"
 	@echo "  fuzz           build-fuzz/: fuzz every file reader (clang, ASan, UBSan) for FUZZ_SECONDS"
 	@echo "  all-samples    run every sample (or DATASETS=\"a b c\"), in parallel with -j2"
+	@echo "  book           BOOK=letter DATASETS=\"p1 p2 p3\": one PDF of those pages, in that order,"
+	@echo "                 -> work/letter.pdf (and work/letter.alto/); with -j2 two pages at a time"
 	@echo "  clean          remove work/<name>/"
 	@echo
 	@echo "Variables:"
@@ -271,6 +297,7 @@ help:
 	@echo "  INIT_FLAGS=...      extra flags for build/bin/init-mesh"
 	@echo "  OPTIMIZE_FLAGS=...  extra flags for build/bin/optimize"
 	@echo "  RENDER_FLAGS=...    extra flags for build/bin/render"
+	@echo "  PDF_FLAGS=...       extra flags for build/bin/pdf (e.g. --lang deu, --enhance even-light)"
 	@echo "  EVAL_FLAGS=...      extra flags for build/bin/evaluate"
 	@echo "  JOBS=2         parallel build jobs"
 	@echo "  TIMER=file     where per-stage time and peak memory go (default work/<name>/timings.jsonl)"

@@ -119,16 +119,16 @@ done
 # business (one run per row).
 declare -A program_of=([sfm]=sfm [boundary]=segment-boundary [points]=densify
                        [features]=detect-features [init]=init-mesh [optimize]=optimize
-                       [render]=render)
+                       [render]=render [pdf]=pdf)
 declare -A needs=([sfm]="" [boundary]="sfm" [points]="sfm boundary" [features]="sfm boundary"
                   [init]="sfm boundary"
-                  [optimize]="features init" [render]="sfm boundary init")
+                  [optimize]="features init" [render]="sfm boundary init" [pdf]="render")
 # pipeline.mk renders the optimised meshes as soon as stages/optimize exists.
 [[ -d $root/stages/optimize ]] && needs[render]+=" optimize"
 declare -A runnable=()
 if [[ $frontend == truth ]]; then runnable[sfm]=1 runnable[boundary]=1; fi
 pipeline_targets=() absent=()
-for s in sfm boundary points features init optimize render; do
+for s in sfm boundary points features init optimize render pdf; do
   [[ -n ${runnable[$s]:-} ]] && continue
   ok=1
   [[ -x $bin/${program_of[$s]} ]] || ok=""

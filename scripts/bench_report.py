@@ -22,7 +22,7 @@ import subprocess
 
 # Pipeline stages in chain order (names as pipeline.mk's TIMER records them).
 STAGE_ORDER = ["truth-frontend", "sfm", "segment-boundary", "densify", "detect-features", "init-mesh",
-               "optimize", "render", "evaluate"]
+               "optimize", "render", "pdf", "evaluate"]
 # Figures of a row, in table order: (key in metrics, column title, format).
 FIGURES = [("ms_ssim", "MS-SSIM ↑", "%.4f"), ("ld", "LD ↓", "%.2f"), ("li_d", "Li-D ↓", "%.2f"),
            ("cer", "CER ↓", "%.4f"), ("wer", "WER ↓", "%.4f"),

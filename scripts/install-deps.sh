@@ -28,8 +28,10 @@ packages=(
   # alternative solver. (CGAL, OpenMesh and Ceres are not needed: see the
   # README's dependency table for why.)
   libsuitesparse-dev liblbfgspp-dev
-  # OCR for the CER/WER metrics
-  libtesseract-dev tesseract-ocr-eng
+  # OCR for the CER/WER metrics and the PDF's text layer (Tesseract's own
+  # renderers also write its ALTO and hOCR); qpdf sets the PDF's page size,
+  # embeds the page image and joins pages into a book
+  libtesseract-dev tesseract-ocr-eng libqpdf-dev qpdf
   # fonts for synth's pages
   fonts-dejavu-core fonts-dejavu-extra fonts-liberation2 fonts-freefont-ttf
   # JSON Schema validation of every file the pipeline reads or writes
@@ -40,9 +42,11 @@ packages=(
   # files and functions short)
   universal-ctags
   # tests (assimp reads our PLYs as an independent check; chromium opens the
-  # HTML report; heif-enc, exiftool and jpegtran make phone-like photos)
+  # HTML report; heif-enc, exiftool and jpegtran make phone-like photos;
+  # poppler's pdfinfo, pdftotext and pdftoppm read our PDFs back, xmllint
+  # checks the ALTO files against their schema)
   googletest libgtest-dev assimp-utils chromium libheif-examples libimage-exiftool-perl
-  libjpeg-turbo-progs
+  libjpeg-turbo-progs poppler-utils libxml2-utils
   # fuzzing the file readers (pipeline.mk fuzz): clang and its libFuzzer,
   # ASan and UBSan runtimes
   clang libclang-rt-14-dev

@@ -1,0 +1,338 @@
+#include "stages/pdf/pdf.h"
+
+#include <leptonica/allheaders.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <fstream>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <sstream>
+
+#include "common/atomic_file.h"
+#include "common/cli.h"
+#include "common/errors.h"
+#include "common/shading.h"
+#include "stages/pdf/markup_scale.h"
+#include "stages/pdf/pdf_file.h"
+
+namespace docunfold::pdf {
+namespace {
+
+// A folder inside `out` for what Tesseract and qpdf write before it is
+// renamed into place; removed however Run ends.
+class Staging {
+ public:
+  explicit Staging(const fs::path& out) : dir_(out / (".pdf-staging-" + std::to_string(getpid()))) {
+    std::error_code ec;
+    fs::remove_all(dir_, ec);
+    if (!fs::create_directories(dir_, ec))
+      throw OutputError(dir_.string() + ": cannot create (" + ec.message() + ")");
+  }
+  ~Staging() {
+    std::error_code ec;
+    fs::remove_all(dir_, ec);
+  }
+  const fs::path& dir() const { return dir_; }
+
+ private:
+  fs::path dir_;
+};
+
+std::string ReadText(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error(path.string() + ": Tesseract wrote no file");
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// Tesseract's escaping of the image name it writes into ALTO and hOCR.
+std::string MarkupEscape(const std::string& text) {
+  std::string out;
+  for (char c : text) {
+    switch (c) {
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      case '\'':
+        out += "&#39;";
+        break;
+      default:
+        out += c;
+    }
+  }
+  return out;
+}
+
+// `text` with every `from` replaced by `to`.
+std::string ReplaceAll(std::string text, const std::string& from, const std::string& to) {
+  for (size_t at = text.find(from); at != std::string::npos; at = text.find(from, at + to.size()))
+    text.replace(at, from.size(), to);
+  return text;
+}
+
+void Rename(const fs::path& from, const fs::path& to) {
+  std::error_code ec;
+  fs::rename(from, to, ec);
+  if (ec) throw OutputError(to.string() + ": cannot write (" + ec.message() + ")");
+}
+
+void WriteBytes(const fs::path& path, const void* data, size_t size) {
+  std::ofstream f(path, std::ios::binary);
+  f.write(static_cast<const char*>(data), std::streamsize(size));
+  if (!f.flush()) throw OutputError(path.string() + ": cannot write");
+}
+
+// The page image as the PDF embeds it, and beside it as the file the ALTO
+// names: a JPEG; for black-and-white 1-bit CCITT G4 data (Leptonica's
+// encoder) and a G4 TIFF.
+PageImage EncodePageImage(const cv::Mat& image, bool black_white, int quality,
+                          const fs::path& file) {
+  PageImage encoded;
+  encoded.width = image.cols;
+  encoded.height = image.rows;
+  if (!black_white) {
+    std::vector<uchar> jpeg;
+    if (!cv::imencode(".jpg", image, jpeg,
+                      {cv::IMWRITE_JPEG_QUALITY, quality, cv::IMWRITE_JPEG_OPTIMIZE, 1}))
+      throw std::runtime_error("cannot encode the page as JPEG");
+    encoded.data.assign(jpeg.begin(), jpeg.end());
+    WriteBytes(file, jpeg.data(), jpeg.size());
+    return encoded;
+  }
+  encoded.encoding = PageImage::Encoding::kCcittG4;
+  std::vector<uchar> png;
+  cv::imencode(".png", image, png);
+  Pix* grey = pixReadMem(png.data(), png.size());
+  Pix* bits = grey ? pixConvertTo1(grey, 128) : nullptr;
+  L_COMP_DATA* g4 = nullptr;
+  const bool ok = bits && pixGenerateCIData(bits, L_G4_ENCODE, 0, 0, &g4) == 0 && g4 &&
+                  pixWrite(file.c_str(), bits, IFF_TIFF_G4) == 0;
+  if (ok) encoded.data.assign(reinterpret_cast<const char*>(g4->datacomp), g4->nbytescomp);
+  l_CIDataDestroy(&g4);
+  pixDestroy(&grey);
+  pixDestroy(&bits);
+  if (!ok) throw OutputError(file.string() + ": cannot encode the page as G4");
+  return encoded;
+}
+
+cv::Mat BlackOnWhite(const cv::Mat& even) {
+  cv::Mat grey, bw;
+  if (even.channels() == 3)
+    cv::cvtColor(even, grey, cv::COLOR_BGR2GRAY);
+  else
+    grey = even;
+  cv::threshold(grey, bw, 0, 255, cv::THRESH_BINARY | cv::THRESH_OTSU);
+  return bw;
+}
+
+const char* EnhanceName(Enhance e) {
+  switch (e) {
+    case Enhance::kEvenLight:
+      return "even-light";
+    case Enhance::kBlackWhite:
+      return "black-white";
+    default:
+      return "none";
+  }
+}
+
+// Words and lines read from a copy of the page enlarged by 1 / `scale`, in
+// the page's own pixels.
+void ScaleToPage(double scale, PageReader::Page* page) {
+  if (scale == 1) return;
+  auto rect = [scale](const cv::Rect& r) {
+    const int x0 = int(std::lround(r.x * scale)), y0 = int(std::lround(r.y * scale));
+    return cv::Rect(x0, y0, int(std::lround((r.x + r.width) * scale)) - x0,
+                    int(std::lround((r.y + r.height) * scale)) - y0);
+  };
+  for (Word& w : page->words) w.box = rect(w.box);
+  for (TextLine& l : page->lines) {
+    l.box = rect(l.box);
+    l.baseline_start *= scale;
+    l.baseline_end *= scale;
+  }
+}
+
+Json WordsJson(const std::vector<Word>& words) {
+  Json list = Json::array();
+  for (const Word& w : words)
+    list.push_back({w.box.x, w.box.y, w.box.width, w.box.height,
+                    std::round(w.confidence * 1000) / 1000, w.text});
+  return list;
+}
+
+}  // namespace
+
+void DeclareOptions(OptionTable& table, PdfOptions* o) {
+  table.Value("lang", &o->language,
+              "Tesseract language(s) of the text layer, e.g. deu or eng+fra (each needs its "
+              "Debian package tesseract-ocr-<lang>)");
+  std::vector<std::pair<std::string, std::string>> formats = {{"auto", "auto"}, {"none", "none"}};
+  for (const PaperFormat& f : PaperFormats()) formats.push_back({f.name, f.name});
+  table.Choice("page-format", &o->page.format, formats,
+               "paper size: auto (the format the page's aspect ratio matches within "
+               "--format-tolerance, its member chosen by the print's size), none (the image "
+               "at --dpi), or that format whatever the page's shape");
+  table.Value("format-tolerance", &o->page.aspect_tolerance, 0.0, 0.2,
+              "how far (fraction) the page's aspect ratio may be from a format's");
+  table.Value("dpi", &o->page.dpi, 10.0, 2400.0,
+              "image pixels per inch when the page matches no format (or --page-format none)");
+  table.Choice("enhance", &o->enhance,
+               {{"none", Enhance::kNone},
+                {"even-light", Enhance::kEvenLight},
+                {"black-white", Enhance::kBlackWhite}},
+               "the page as a scanner gives it: none keeps the photo's colours, even-light "
+               "divides the light's shading out (paper one even colour), black-white then "
+               "makes print black on white (1 bit, smallest)");
+  table.Value("jpeg-quality", &o->jpeg_quality, 1, 100, "quality of the embedded JPEG");
+  table.Value("ocr-long-side", &o->ocr_min_long_side, 0, 20000,
+              "OCR reads the page (its shading divided out) enlarged so that its long side has "
+              "at least this many pixels (small print is read much better); the text layer "
+              "and ALTO boxes stay on the page's own pixels");
+}
+
+PdfInputs ReadPdfInputs(const fs::path& render_dir) {
+  PdfInputs in;
+  in.render_dir = render_dir;
+  const fs::path json_path = render_dir / "render.json";
+  const Json doc = ReadJsonFile(json_path);
+  CheckFormat(doc, json_path, "docunfold.render", 1);
+  const JsonReader render(doc, json_path);
+  in.page = ReadImage(render_dir / "rectified.png");
+  const int width = render.Integer("/width"), height = render.Integer("/height");
+  if (width != in.page.cols || height != in.page.rows)
+    throw InputError((render_dir / "rectified.png").string() + ": " + std::to_string(in.page.cols) +
+                     "x" + std::to_string(in.page.rows) + " pixels, but render.json says " +
+                     std::to_string(width) + "x" + std::to_string(height) +
+                     " (rendered separately?)");
+  in.shading_removed = doc.contains("shading") && doc["shading"].value("removed", false);
+  return in;
+}
+
+PdfResult Run(const PdfOptions& o, const PdfInputs& in, const fs::path& out,
+              const std::string& name, const Json& options_record) {
+  StepTimer timer;
+  PageReader reader(o.language);
+  timer.Mark("load_language");
+
+  const cv::Mat even_page = in.shading_removed ? in.page : RemoveShading(in.page).image;
+  const cv::Mat shown = o.enhance == Enhance::kBlackWhite  ? BlackOnWhite(even_page)
+                        : o.enhance == Enhance::kEvenLight ? even_page
+                                                           : in.page;
+  timer.Mark("enhance");
+
+  PdfResult r;
+  const double ocr_scale =
+      std::max(1.0, double(o.ocr_min_long_side) / std::max(in.page.cols, in.page.rows));
+  cv::Mat ocr_page = even_page;
+  if (ocr_scale > 1)
+    cv::resize(even_page, ocr_page,
+               cv::Size(int(std::lround(in.page.cols * ocr_scale)),
+                        int(std::lround(in.page.rows * ocr_scale))),
+               0, 0, cv::INTER_CUBIC);
+  PageReader::Page read = reader.Read(ocr_page);
+  // Measured on the enlarged copy, where word boxes are not rounded to a
+  // few pixels.
+  r.text_size = EstimateTextSize(read.words, read.lines);
+  r.text_size.em_px /= ocr_scale;
+  r.text_size.word_height_px /= ocr_scale;
+  r.text_size.line_pitch_px /= ocr_scale;
+  ScaleToPage(1 / ocr_scale, &read);
+  r.words = std::move(read.words);
+  for (const Word& w : r.words) r.mean_confidence += w.confidence / r.words.size();
+  r.size = ChoosePageSize(in.page.cols, in.page.rows, r.text_size.em_px, o.page);
+  timer.Mark("ocr");
+
+  EnsureDirectory(out);
+  Staging staging(out);
+  const bool black_white = o.enhance == Enhance::kBlackWhite;
+  const std::string image_name = name + (black_white ? ".tif" : ".jpg");
+  const fs::path image_path = staging.dir() / image_name;
+  const PageImage image = EncodePageImage(shown, black_white, o.jpeg_quality, image_path);
+  const int ppi = std::max(1, int(std::lround(ocr_scale * (r.size.dpi_x + r.size.dpi_y) / 2)));
+  reader.Write(staging.dir() / "page", image_path, ppi, name);
+  const double width_pt = r.size.width_mm / kMillimetresPerInch * kPointsPerInch;
+  const double height_pt = r.size.height_mm / kMillimetresPerInch * kPointsPerInch;
+  const std::string tesseract = "Tesseract " + PageReader::Version();
+  FitPage(
+      staging.dir() / "page.pdf", staging.dir() / "fitted.pdf", width_pt, height_pt, image,
+      {name, std::string("docunfold ") + ProgramVersion(), tesseract + ", qpdf " + QpdfVersion()});
+  timer.Mark("write_pdf");
+
+  // The ALTO and hOCR files name the page image beside them, not the
+  // staging folder it was read from.
+  // Both are in the pixels of the enlarged copy read: mapped onto the page's.
+  const std::string staged = MarkupEscape(image_path.string());
+  const std::string alto = ScaleAltoPixels(
+      ReplaceAll(ReadText(staging.dir() / "page.xml"), staged, MarkupEscape(image_name)),
+      1 / ocr_scale);
+  const std::string hocr = ScaleHocrPixels(
+      ReplaceAll(ReadText(staging.dir() / "page.hocr"), staged, MarkupEscape(image_name)),
+      1 / ocr_scale, ppi, int(std::lround((r.size.dpi_x + r.size.dpi_y) / 2)));
+  Rename(image_path, out / image_name);
+  WriteTextAtomic(out / (name + ".alto.xml"), alto);
+  WriteTextAtomic(out / (name + ".hocr"), hocr);
+  r.pdf_file = out / (name + ".pdf");
+  r.pdf_bytes = fs::file_size(staging.dir() / "fitted.pdf");
+  Rename(staging.dir() / "fitted.pdf", r.pdf_file);
+  timer.Mark("write_files");
+
+  Json& j = r.report;
+  j = MakeHeader("docunfold.pdf", 1, "pdf", options_record);
+  j["inputs"] = {{"render", in.render_dir.string()}};
+  j["page"] = {{"format", r.size.format},
+               {"rule", r.size.rule},
+               {"width_mm", r.size.width_mm},
+               {"height_mm", r.size.height_mm},
+               {"width_pt", width_pt},
+               {"height_pt", height_pt},
+               {"page_aspect", r.size.page_aspect},
+               {"aspect_error", r.size.aspect_error},
+               {"text_pt", r.size.text_pt},
+               {"dpi", {r.size.dpi_x, r.size.dpi_y}}};
+  j["image"] = {{"file", image_name},
+                {"width", in.page.cols},
+                {"height", in.page.rows},
+                {"encoding", black_white ? "ccitt-g4" : "jpeg"},
+                {"bytes", image.data.size()},
+                {"enhance", EnhanceName(o.enhance)},
+                {"shading_removed_by_render", in.shading_removed}};
+  if (!black_white) j["image"]["jpeg_quality"] = o.jpeg_quality;
+  j["text"] = {{"engine", tesseract},
+               {"language", o.language},
+               {"read_from", "the page with the light's shading divided out"},
+               {"read_scale", ocr_scale},
+               {"words", r.words.size()},
+               {"mean_confidence", r.mean_confidence},
+               {"size",
+                {{"cue", r.text_size.cue},
+                 {"em_px", r.text_size.em_px},
+                 {"body_words", r.text_size.words},
+                 {"word_height_px", r.text_size.word_height_px},
+                 {"line_pitch_px", r.text_size.line_pitch_px}}}};
+  j["files"] = {{"pdf", name + ".pdf"},
+                {"pdf_bytes", r.pdf_bytes},
+                {"alto", name + ".alto.xml"},
+                {"hocr", name + ".hocr"},
+                {"image", image_name}};
+  j["words"] = WordsJson(r.words);
+  Json timing = Json::object();
+  for (const auto& [step, s] : timer.steps()) timing[step] = s;
+  timing["total"] = timer.Total();
+  j["timing_s"] = timing;
+  WriteJsonAtomic(out / "pdf.json", j);
+  return r;
+}
+
+}  // namespace docunfold::pdf

@@ -1,0 +1,47 @@
+// Finishing Tesseract's one-page text-layer PDF with qpdf: the page set to its
+// paper size with the text layer scaled onto it, the page image embedded as
+// compressed (its pixels are placed by a PDF transform, never resampled), and
+// the document's own description.
+#pragma once
+
+#include <filesystem>
+#include <string>
+
+namespace docunfold::pdf {
+
+namespace fs = std::filesystem;
+
+struct DocumentInfo {
+  std::string title;
+  std::string creator;   // the program that made the document
+  std::string producer;  // the libraries that wrote it
+};
+
+// The page image as it goes into the PDF, already compressed.
+struct PageImage {
+  enum class Encoding { kJpeg, kCcittG4 };
+  Encoding encoding = Encoding::kJpeg;
+  std::string data;  // a JPEG (3 components) or CCITT G4 data (1 bit)
+  int width = 0;
+  int height = 0;
+};
+
+struct FittedPage {
+  double width_pt = 0;  // the page as written
+  double height_pt = 0;
+  double scale_x = 1;  // how the renderer's page was stretched onto it
+  double scale_y = 1;
+};
+
+// Reads the one-page PDF `in` (Tesseract's text layer), sets its page to
+// width_pt x height_pt with the text stretched to fill it, draws `image`
+// under it over the whole page, replaces the document information and writes
+// `out` (the same bytes for the same input). Throws std::runtime_error when
+// qpdf cannot read or write.
+FittedPage FitPage(const fs::path& in, const fs::path& out, double width_pt, double height_pt,
+                   const PageImage& image, const DocumentInfo& info);
+
+// "11.3.0"
+std::string QpdfVersion();
+
+}  // namespace docunfold::pdf

@@ -1,0 +1,51 @@
+// How large the page's body text is, in pixels to the em, from what
+// Tesseract read: the height of confidently read words, or, where Tesseract
+// boxes a small print's words taller than its lines are apart (it does on
+// pages whose lines are ~15 px apart), the distance between lines.
+#pragma once
+
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+namespace docunfold::pdf {
+
+struct Word {
+  cv::Rect box;           // image pixels
+  double confidence = 0;  // 0..1
+  std::string text;       // UTF-8
+};
+
+struct TextLine {
+  int block = 0;  // Tesseract's block, counted from 0
+  cv::Rect box;   // image pixels
+  cv::Point2d baseline_start, baseline_end;
+};
+
+struct TextSizeOptions {
+  // Body words: two or more characters with a lower-case letter, read with
+  // at least this confidence; fewer than min_words of them and the text's
+  // size is not measured.
+  double min_confidence = 0.8;
+  size_t min_words = 20;
+  // Median body-word box height and distance between a paragraph's
+  // baselines, as multiples of the font size.
+  double word_height_em = 0.75;
+  double line_pitch_em = 1.35;
+  // Word boxes this close to the line pitch or taller span more than a line.
+  double max_word_height_of_pitch = 0.9;
+  size_t min_line_pairs = 5;
+};
+
+struct TextSize {
+  double em_px = 0;           // 0: not measured
+  std::string cue;            // "word height", "line pitch" or why not measured
+  size_t words = 0;           // body words
+  double word_height_px = 0;  // median
+  double line_pitch_px = 0;   // median over neighbouring lines of a block (0: too few)
+};
+
+TextSize EstimateTextSize(const std::vector<Word>& words, const std::vector<TextLine>& lines,
+                          const TextSizeOptions& options = {});
+
+}  // namespace docunfold::pdf

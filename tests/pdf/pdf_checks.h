@@ -1,0 +1,57 @@
+// Checks of a PDF and its ALTO file through independent tools: poppler's
+// pdfinfo, pdftotext and pdftoppm, qpdf --check, xmllint with the ALTO
+// schema; shared by the pdf stage's cli and e2e tests.
+#pragma once
+
+#include <filesystem>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+namespace docunfold::testing {
+
+namespace fs = std::filesystem;
+
+struct PdfPage {
+  double width_pt = 0;
+  double height_pt = 0;
+};
+
+// The pages' sizes as pdfinfo reports them (empty when pdfinfo fails).
+std::vector<PdfPage> PdfPages(const fs::path& pdf);
+
+// pdftotext -layout of page `page` (1-based; 0: all pages).
+std::string PdfText(const fs::path& pdf, int page = 0);
+
+// Page `page` rendered by pdftoppm at `size` pixels (BGR).
+cv::Mat RenderPdfPage(const fs::path& pdf, int page, cv::Size size);
+
+// qpdf --check passes.
+bool QpdfCheckPasses(const fs::path& pdf, std::string* output = nullptr);
+
+// xmllint against schemas/alto/alto-3-0.xsd (offline); "" when valid, else
+// xmllint's output.
+std::string AltoSchemaErrors(const fs::path& alto);
+
+struct AltoWord {
+  cv::Rect box;
+  std::string text;
+};
+// The <String> elements of an ALTO file.
+std::vector<AltoWord> AltoWords(const fs::path& alto);
+
+// The words whose box is not darker (mean grey) than the page's background
+// (the median grey of the page).
+std::vector<AltoWord> WordsNotDarkerThanPaper(const cv::Mat& page,
+                                              const std::vector<AltoWord>& words);
+
+// Character error rate of `text` against `reference`, whitespace collapsed.
+double CharacterErrorRate(const std::string& reference, const std::string& text);
+
+// Tesseract's text of an image file (English, automatic segmentation).
+std::string TesseractText(const fs::path& image);
+
+// DocUNet's MS-SSIM of two equally sized images.
+double MsSsimOf(const cv::Mat& a, const cv::Mat& b);
+
+}  // namespace docunfold::testing

@@ -1,0 +1,225 @@
+// The pdf program on pages made from ground truth (a replacement render
+// writing the same files): the PDF at its paper size, its text layer and
+// ALTO file against independent tools, the size of a 300 dpi page, the
+// enhancements, and bad input.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <memory>
+#include <opencv2/imgcodecs.hpp>
+
+#include "common/json_io.h"
+#include "tests/pdf/pdf_checks.h"
+#include "tests/support/test_support.h"
+
+namespace docunfold::testing {
+namespace {
+
+// A render folder as the render stage leaves it: rectified.png and the
+// render.json fields the pdf stage reads.
+fs::path WriteRenderDir(const fs::path& work, const cv::Mat& page) {
+  const fs::path dir = work / "60_render";
+  fs::create_directories(dir);
+  cv::imwrite((dir / "rectified.png").string(), page);
+  std::ofstream(dir / "render.json") << Json{
+      {"format", "docunfold.render"},
+      {"version", 1},
+      {"width", page.cols},
+      {"height", page.rows}}.dump();
+  return dir;
+}
+
+std::string ReadFile(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+class PdfCli : public ::testing::Test {
+ protected:
+  // set06's true flat page (A4 at 150 dpi), read once by the pdf program.
+  static void SetUpTestSuite() {
+    shared_ = std::make_unique<TempDir>();
+    page_ = cv::imread((SampleDir("set06") / "ground_truth/flat.png").string());
+    render_ = WriteRenderDir(shared_->path() / "letter", page_);
+    run_ = std::make_unique<CommandResult>(Pdf(render_, shared_->path() / "letter/80_pdf"));
+  }
+  static void TearDownTestSuite() {
+    run_.reset();
+    shared_.reset();
+  }
+
+  static CommandResult Pdf(const fs::path& render, const fs::path& out,
+                           const std::string& flags = "") {
+    return RunCommand(Quote(StageBinary("pdf").string()) + " --render " + Quote(render.string()) +
+                      " --out " + Quote(out.string()) + " " + flags);
+  }
+  static fs::path Out() { return shared_->path() / "letter/80_pdf"; }
+
+  TempDir dir_;
+  static std::unique_ptr<TempDir> shared_;
+  static cv::Mat page_;
+  static fs::path render_;
+  static std::unique_ptr<CommandResult> run_;
+};
+
+std::unique_ptr<TempDir> PdfCli::shared_;
+cv::Mat PdfCli::page_;
+fs::path PdfCli::render_;
+std::unique_ptr<CommandResult> PdfCli::run_;
+
+TEST_F(PdfCli, WritesTheFilesNamedAfterTheWorkDirectory) {
+  ASSERT_EQ(run_->exit_code, 0) << run_->output;
+  EXPECT_NE(run_->output.find("pdf: wrote"), std::string::npos) << run_->output;
+  for (const char* f : {"letter.pdf", "letter.alto.xml", "letter.hocr", "letter.jpg", "pdf.json"})
+    EXPECT_TRUE(fs::is_regular_file(Out() / f)) << f;
+  // Nothing else: the staging folder is gone.
+  EXPECT_EQ(std::distance(fs::directory_iterator(Out()), fs::directory_iterator()), 5);
+  const CommandResult v = RunCommand(Quote((SourceDir() / "scripts/validate-json").string()) + " " +
+                                     Quote((Out() / "pdf.json").string()));
+  EXPECT_EQ(v.exit_code, 0) << v.output;
+  const Json report = ReadJsonFile(Out() / "pdf.json");
+  EXPECT_EQ(report["page"]["format"], "a4");
+  EXPECT_NEAR(report["page"]["dpi"][0].get<double>(), 150, 0.5);
+  EXPECT_GT(report["text"]["words"].get<int>(), 150);
+  EXPECT_EQ(report["words"].size(), report["text"]["words"].get<size_t>());
+}
+
+TEST_F(PdfCli, PageIsA4ForPdfinfoAndPassesQpdfCheck) {
+  ASSERT_EQ(run_->exit_code, 0) << run_->output;
+  const std::vector<PdfPage> pages = PdfPages(Out() / "letter.pdf");
+  ASSERT_EQ(pages.size(), 1u);
+  EXPECT_NEAR(pages[0].width_pt, 210 / 25.4 * 72, 0.01);
+  EXPECT_NEAR(pages[0].height_pt, 297 / 25.4 * 72, 0.01);
+  std::string check;
+  EXPECT_TRUE(QpdfCheckPasses(Out() / "letter.pdf", &check)) << check;
+}
+
+TEST_F(PdfCli, TextLayerReadsAsWellAsTesseractOnTheImage) {
+  ASSERT_EQ(run_->exit_code, 0) << run_->output;
+  const std::string truth = ReadFile(SampleDir("set06") / "ground_truth/text.txt");
+  const double pdf_cer = CharacterErrorRate(truth, PdfText(Out() / "letter.pdf"));
+  const double image_cer = CharacterErrorRate(truth, TesseractText(render_ / "rectified.png"));
+  EXPECT_LE(pdf_cer, image_cer + 0.02) << "pdftotext " << pdf_cer << ", image " << image_cer;
+}
+
+TEST_F(PdfCli, RenderedBackTheImageIsThePage) {
+  ASSERT_EQ(run_->exit_code, 0) << run_->output;
+  const cv::Mat back = RenderPdfPage(Out() / "letter.pdf", 1, page_.size());
+  ASSERT_EQ(back.size(), page_.size());
+  EXPECT_GE(MsSsimOf(page_, back), 0.99);
+}
+
+TEST_F(PdfCli, AltoIsValidAndItsWordsLieOnPrint) {
+  ASSERT_EQ(run_->exit_code, 0) << run_->output;
+  const fs::path alto = Out() / "letter.alto.xml";
+  EXPECT_EQ(AltoSchemaErrors(alto), "");
+  EXPECT_NE(ReadFile(alto).find("<fileName>letter.jpg</fileName>"), std::string::npos);
+  const std::vector<AltoWord> words = AltoWords(alto);
+  ASSERT_GT(words.size(), 150u);
+  const cv::Mat image = cv::imread((Out() / "letter.jpg").string());
+  ASSERT_EQ(image.size(), page_.size());
+  const std::vector<AltoWord> light = WordsNotDarkerThanPaper(image, words);
+  EXPECT_TRUE(light.empty()) << light.size() << " words on paper, e.g. '" << light[0].text << "'";
+}
+
+TEST_F(PdfCli, A300DpiA4PageInColourFitsInOneAndAHalfMegabytes) {
+  // synth's page at 300 dpi with a photo's sensor noise: a 2480 x 3508 page.
+  const CommandResult synth =
+      RunCommand(Quote(StageBinary("synth").string()) + " --out " + Quote((dir_ / "set").string()) +
+                 " --flat-dpi 300 --views 2 --seed 7");
+  ASSERT_EQ(synth.exit_code, 0) << synth.output;
+  cv::Mat page = cv::imread((dir_ / "set/ground_truth/flat.png").string());
+  cv::Mat noise(page.size(), CV_16SC3);
+  cv::randn(noise, 0, 3);
+  page.convertTo(page, CV_16SC3);
+  cv::add(page, noise, page);
+  page.convertTo(page, CV_8UC3);
+  const CommandResult r = Pdf(WriteRenderDir(dir_ / "page300", page), dir_ / "out");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const Json report = ReadJsonFile(dir_ / "out/pdf.json");
+  EXPECT_EQ(report["page"]["format"], "a4");
+  EXPECT_NEAR(report["page"]["dpi"][1].get<double>(), 300, 1);
+  EXPECT_LE(fs::file_size(dir_ / "out/page300.pdf"), 1500u * 1000u);
+}
+
+TEST_F(PdfCli, BlackWhiteEmbedsOneBitPrint) {
+  const CommandResult r = Pdf(render_, dir_ / "out", "--enhance black-white --name bw");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const CommandResult images =
+      RunCommand("pdfimages -list " + Quote((dir_ / "out/bw.pdf").string()));
+  EXPECT_NE(images.output.find("ccitt"), std::string::npos) << images.output;
+  EXPECT_TRUE(fs::is_regular_file(dir_ / "out/bw.tif"));
+  EXPECT_LT(fs::file_size(dir_ / "out/bw.pdf"), fs::file_size(Out() / "letter.pdf"));
+  EXPECT_EQ(AltoSchemaErrors(dir_ / "out/bw.alto.xml"), "");
+}
+
+TEST_F(PdfCli, PageFormatNoneTakesTheImageAtTheGivenDpi) {
+  const CommandResult r = Pdf(render_, dir_ / "out", "--page-format none --dpi 100");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::vector<PdfPage> pages = PdfPages(dir_ / "out/letter.pdf");
+  ASSERT_EQ(pages.size(), 1u);
+  EXPECT_NEAR(pages[0].width_pt, page_.cols / 100.0 * 72, 0.01);
+  EXPECT_NEAR(pages[0].height_pt, page_.rows / 100.0 * 72, 0.01);
+}
+
+TEST_F(PdfCli, NoRenderedPageIsBadInput) {
+  const CommandResult r = Pdf(dir_ / "nothing", dir_ / "out");
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("render.json"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(dir_ / "out"));
+}
+
+TEST_F(PdfCli, ARenderJsonOfAnotherImageIsBadInput) {
+  const fs::path render = WriteRenderDir(dir_ / "w", page_);
+  cv::imwrite((render / "rectified.png").string(), cv::Mat(100, 80, CV_8UC3, cv::Scalar::all(255)));
+  const CommandResult r = Pdf(render, dir_ / "out");
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("rectified.png"), std::string::npos) << r.output;
+}
+
+TEST_F(PdfCli, AMissingLanguageNamesItsPackageAndLeavesTheOldPdf) {
+  fs::copy(Out(), dir_ / "out");
+  const std::string before = ReadFile(dir_ / "out/letter.pdf");
+  const CommandResult r = Pdf(render_, dir_ / "out", "--lang xyz --name letter");
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("tesseract-ocr-xyz"), std::string::npos) << r.output;
+  EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
+  EXPECT_EQ(ReadFile(dir_ / "out/letter.pdf"), before);
+}
+
+TEST_F(PdfCli, AnUnwritableFolderExitsFour) {
+  std::ofstream(dir_ / "file") << "x";
+  const CommandResult r = Pdf(render_, dir_ / "file/out");
+  EXPECT_EQ(r.exit_code, 4) << r.output;
+  EXPECT_NE(r.output.find("file/out"), std::string::npos) << r.output;
+}
+
+TEST_F(PdfCli, BadFlagsAreUsageErrors) {
+  EXPECT_EQ(Pdf(render_, dir_ / "out", "--page-format b5").exit_code, 2);
+  EXPECT_EQ(Pdf(render_, dir_ / "out", "--jpeg-quality 0").exit_code, 2);
+  EXPECT_FALSE(fs::exists(dir_ / "out"));
+}
+
+TEST_F(PdfCli, HelpListsEveryOption) {
+  const CommandResult r = RunCommand(Quote(StageBinary("pdf").string()) + " --help");
+  EXPECT_EQ(r.exit_code, 0);
+  for (const char* flag :
+       {"--render", "--out", "--name", "--lang", "--page-format", "--format-tolerance", "--dpi",
+        "--enhance", "--jpeg-quality", "--ocr-long-side"})
+    EXPECT_NE(r.output.find(flag), std::string::npos) << flag;
+}
+
+TEST_F(PdfCli, ABookStopsAtAFailedPageNamingIt) {
+  const CommandResult r = RunCommand(
+      "make -s -f " + Quote((SourceDir() / "pipeline.mk").string()) +
+      " NO_BUILD=1 BUILD=" + Quote(StageBinary("pdf").parent_path().parent_path().string()) +
+      " WORK_ROOT=" + Quote(dir_.path().string()) +
+      " book BOOK=letter DATASETS='no-such-set set01' 2>&1");
+  EXPECT_NE(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("page no-such-set failed"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(dir_ / "letter.pdf"));
+  EXPECT_FALSE(fs::exists(dir_ / "set01"));
+}
+
+}  // namespace
+}  // namespace docunfold::testing

@@ -1,0 +1,100 @@
+// The pipeline's PDFs (e2e run, tests/pipeline/run_e2e.sh) on the sample with
+// phone-sized photos and the independently rendered text pages: the true
+// paper format, a text layer that reads as well as Tesseract reads the
+// rectified image, the image itself, a valid ALTO file on the words; and a
+// book of three samples made with -j2.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <opencv2/imgcodecs.hpp>
+
+#include "common/json_io.h"
+#include "tests/pdf/pdf_checks.h"
+#include "tests/support/test_support.h"
+
+namespace docunfold::testing {
+namespace {
+
+std::string ReadFile(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+// The data set of a name: samples/<name>, else the realistic set.
+fs::path DataSet(const std::string& name) {
+  if (fs::is_directory(SampleDir(name))) return SampleDir(name);
+  return RealisticDir().empty() ? fs::path() : RealisticDir() / name;
+}
+
+class PdfE2e : public ::testing::TestWithParam<std::string> {
+ protected:
+  void SetUp() override {
+    data_ = DataSet(GetParam());
+    if (data_.empty() || !fs::is_directory(data_)) GTEST_SKIP() << GetParam() << " is absent";
+    work_ = E2eDir() / "work" / GetParam();
+    pdf_ = work_ / "80_pdf" / (GetParam() + ".pdf");
+    ASSERT_TRUE(fs::is_regular_file(pdf_)) << pdf_;
+  }
+  fs::path data_, work_, pdf_;
+};
+
+TEST_P(PdfE2e, PageHasTheTrueFormat) {
+  const Json truth = ReadJsonFile(data_ / "ground_truth/page.json");
+  const double width_pt = truth["width_m"].get<double>() * 1000 / 25.4 * 72;
+  const double height_pt = truth["height_m"].get<double>() * 1000 / 25.4 * 72;
+  const std::vector<PdfPage> pages = PdfPages(pdf_);
+  ASSERT_EQ(pages.size(), 1u);
+  EXPECT_NEAR(pages[0].width_pt / width_pt, 1, 0.01) << pages[0].width_pt;
+  EXPECT_NEAR(pages[0].height_pt / height_pt, 1, 0.01) << pages[0].height_pt;
+}
+
+TEST_P(PdfE2e, TextLayerReadsAsWellAsTesseractOnTheImage) {
+  const std::string truth = ReadFile(data_ / "ground_truth/text.txt");
+  const double pdf_cer = CharacterErrorRate(truth, PdfText(pdf_));
+  const double image_cer =
+      CharacterErrorRate(truth, TesseractText(work_ / "60_render/rectified.png"));
+  RecordProperty("pdf_cer", std::to_string(pdf_cer));
+  RecordProperty("image_cer", std::to_string(image_cer));
+  EXPECT_LE(pdf_cer, image_cer + 0.02) << "pdftotext " << pdf_cer << ", image " << image_cer;
+}
+
+TEST_P(PdfE2e, RenderedBackItIsTheRectifiedPage) {
+  const cv::Mat page = cv::imread((work_ / "60_render/rectified.png").string());
+  const cv::Mat back = RenderPdfPage(pdf_, 1, page.size());
+  ASSERT_EQ(back.size(), page.size());
+  EXPECT_GE(MsSsimOf(page, back), 0.99);
+  std::string check;
+  EXPECT_TRUE(QpdfCheckPasses(pdf_, &check)) << check;
+}
+
+TEST_P(PdfE2e, AltoIsValidAndItsWordsLieOnPrint) {
+  const fs::path alto = work_ / "80_pdf" / (GetParam() + ".alto.xml");
+  EXPECT_EQ(AltoSchemaErrors(alto), "");
+  const std::vector<AltoWord> words = AltoWords(alto);
+  ASSERT_FALSE(words.empty());
+  const cv::Mat image = cv::imread((work_ / "80_pdf" / (GetParam() + ".jpg")).string());
+  const std::vector<AltoWord> light = WordsNotDarkerThanPaper(image, words);
+  EXPECT_TRUE(light.empty()) << light.size() << " of " << words.size()
+                             << " word boxes on bare paper, e.g. '" << light[0].text << "'";
+}
+
+INSTANTIATE_TEST_SUITE_P(Sets, PdfE2e, ::testing::Values("set06", "r01", "r02", "r04"));
+
+TEST(PdfBook, ThreeSamplesInTheOrderGiven) {
+  const std::vector<std::string> order = {"set06", "set01", "set04"};
+  const fs::path book = E2eDir() / "work/e2e-book.pdf";
+  ASSERT_TRUE(fs::is_regular_file(book)) << book;
+  ASSERT_EQ(PdfPages(book).size(), order.size());
+  for (size_t i = 0; i < order.size(); ++i) {
+    const fs::path page = E2eDir() / "work" / order[i] / "80_pdf" / (order[i] + ".pdf");
+    EXPECT_EQ(PdfText(book, int(i) + 1), PdfText(page)) << "page " << i + 1;
+    EXPECT_TRUE(
+        fs::is_regular_file(E2eDir() / "work/e2e-book.alto" /
+                            (std::to_string(1001 + i).substr(1) + "-" + order[i] + ".alto.xml")));
+  }
+  std::string check;
+  EXPECT_TRUE(QpdfCheckPasses(book, &check)) << check;
+}
+
+}  // namespace
+}  // namespace docunfold::testing

@@ -1,0 +1,173 @@
+// The pdf stage's pure parts: paper size from shape and print size, the
+// print's size from what Tesseract read, ALTO and hOCR mapped back onto the
+// page's pixels.
+#include <gtest/gtest.h>
+
+#include "common/errors.h"
+#include "stages/pdf/markup_scale.h"
+#include "stages/pdf/page_size.h"
+#include "stages/pdf/text_size.h"
+
+namespace docunfold::pdf {
+namespace {
+
+// Pixels to the em of `pt`-point text on a page `long_mm` long drawn
+// `long_px` pixels long.
+double EmPx(double pt, double long_px, double long_mm) {
+  return pt * kMillimetresPerInch / kPointsPerInch * long_px / long_mm;
+}
+
+TEST(PageSize, IsoShapeWithBodyTextIsA4) {
+  const PageSize s = ChoosePageSize(1240, 1754, EmPx(10, 1754, 297), {});
+  EXPECT_EQ(s.format, "a4");
+  EXPECT_DOUBLE_EQ(s.width_mm, 210);
+  EXPECT_DOUBLE_EQ(s.height_mm, 297);
+  EXPECT_NEAR(s.dpi_x, 150, 0.1);
+  EXPECT_NEAR(s.text_pt, 10, 1e-9);
+  EXPECT_EQ(s.rule, "aspect ratio and text size");
+}
+
+TEST(PageSize, LandscapeKeepsItsOrientation) {
+  const PageSize s = ChoosePageSize(1754, 1240, 0, {});
+  EXPECT_EQ(s.format, "a4");
+  EXPECT_DOUBLE_EQ(s.width_mm, 297);
+  EXPECT_DOUBLE_EQ(s.height_mm, 210);
+}
+
+TEST(PageSize, PrintSizeNamesTheIsoMember) {
+  // A4 unless the text would be smaller than 7.6 pt or larger than 14.5 pt
+  // there: 11 pt print on an A5 page (15.6 pt on A4) is A5, 10 pt (14.1 pt
+  // on A4) is taken for A4, the more common paper.
+  EXPECT_EQ(ChoosePageSize(1240, 1754, EmPx(11, 1754, 210), {}).format, "a5");
+  EXPECT_EQ(ChoosePageSize(1240, 1754, EmPx(10, 1754, 210), {}).format, "a4");
+  EXPECT_EQ(ChoosePageSize(1240, 1754, EmPx(10, 1754, 420), {}).format, "a3");
+  EXPECT_EQ(ChoosePageSize(1240, 1754, EmPx(10, 1754, 148), {}).format, "a6");
+}
+
+TEST(PageSize, WithoutTextTheMostCommonMember) {
+  const PageSize s = ChoosePageSize(1240, 1754, 0, {});
+  EXPECT_EQ(s.format, "a4");
+  EXPECT_EQ(s.text_pt, 0);
+  EXPECT_NE(s.rule.find("no text"), std::string::npos);
+}
+
+TEST(PageSize, LetterAndLegal) {
+  EXPECT_EQ(ChoosePageSize(1275, 1650, 0, {}).format, "letter");
+  EXPECT_EQ(ChoosePageSize(1275, 2100, 0, {}).format, "legal");
+}
+
+TEST(PageSize, AspectWithinTheTolerance) {
+  // 1.5 % longer than A4's ratio: still A4, exactly; 2.5 %: no format.
+  const PageSize close = ChoosePageSize(1000, int(1000 * 1.41429 * 1.014), 0, {});
+  EXPECT_EQ(close.format, "a4");
+  EXPECT_NEAR(close.aspect_error, 0.014, 0.001);
+  EXPECT_DOUBLE_EQ(close.height_mm, 297);
+  const PageSize off = ChoosePageSize(1000, int(1000 * 1.41429 * 1.025), 0, {});
+  EXPECT_EQ(off.format, "none");
+  EXPECT_EQ(off.rule, "dpi");
+  EXPECT_NEAR(off.width_mm, 1000 / 300.0 * 25.4, 1e-9);
+}
+
+TEST(PageSize, ReceiptsKeepTheirLengthAtTheRollWidth) {
+  // 80 x 200 mm at 5 px/mm with 8.5 pt print: the 80 mm roll.
+  const PageSize s = ChoosePageSize(400, 1000, EmPx(8.5, 400, 80), {});
+  EXPECT_EQ(s.format, "receipt-80");
+  EXPECT_DOUBLE_EQ(s.width_mm, 80);
+  EXPECT_DOUBLE_EQ(s.height_mm, 200);
+  EXPECT_EQ(s.aspect_error, 0);
+  // On a 58 mm roll the same pixels are finer: 10 pt print there would be
+  // 13.8 pt on an 80 mm roll (8.5 pt there, 11.7 pt, is taken for 80 mm).
+  EXPECT_EQ(ChoosePageSize(400, 1000, EmPx(10, 400, 58), {}).format, "receipt-58");
+  EXPECT_EQ(ChoosePageSize(400, 1000, EmPx(8.5, 400, 58), {}).format, "receipt-80");
+  EXPECT_EQ(ChoosePageSize(400, 1000, 0, {}).format, "receipt-80");
+}
+
+TEST(PageSize, GivenFormatOrDpi) {
+  PageSizeOptions o;
+  o.format = "letter";
+  const PageSize letter = ChoosePageSize(1240, 1754, 0, o);
+  EXPECT_EQ(letter.format, "letter");
+  EXPECT_EQ(letter.rule, "given");
+  EXPECT_GT(letter.aspect_error, 0.05);
+  o.format = "none";
+  o.dpi = 100;
+  const PageSize none = ChoosePageSize(1240, 1754, EmPx(10, 1754, 297), o);
+  EXPECT_EQ(none.format, "none");
+  EXPECT_NEAR(none.width_mm, 12.4 * 25.4, 1e-9);
+  EXPECT_NEAR(none.dpi_y, 100, 1e-9);
+  o.format = "b5";
+  EXPECT_THROW(ChoosePageSize(1240, 1754, 0, o), UsageError);
+}
+
+std::vector<Word> BodyWords(int n, int height) {
+  std::vector<Word> words;
+  for (int i = 0; i < n; ++i) words.push_back({cv::Rect(10 * i, 0, 40, height), 0.95, "word"});
+  return words;
+}
+
+std::vector<TextLine> Lines(int n, double pitch) {
+  std::vector<TextLine> lines;
+  for (int i = 0; i < n; ++i)
+    lines.push_back(
+        {0, cv::Rect(100, int(i * pitch), 800, 20), {100, i * pitch + 15}, {900, i * pitch + 16}});
+  return lines;
+}
+
+TEST(TextSize, FromWordHeights) {
+  const TextSize s = EstimateTextSize(BodyWords(30, 24), Lines(10, 40));
+  EXPECT_EQ(s.cue, "word height");
+  EXPECT_DOUBLE_EQ(s.em_px, 24 / 0.75);
+  EXPECT_EQ(s.words, 30u);
+  EXPECT_NEAR(s.line_pitch_px, 40, 1e-9);
+}
+
+TEST(TextSize, FromLinePitchWhenWordBoxesSpanLines) {
+  const TextSize s = EstimateTextSize(BodyWords(30, 28), Lines(10, 16));
+  EXPECT_EQ(s.cue, "line pitch");
+  EXPECT_NEAR(s.em_px, 16 / 1.35, 1e-9);
+}
+
+TEST(TextSize, NotMeasuredFromFewOrDoubtfulWords) {
+  EXPECT_EQ(EstimateTextSize(BodyWords(10, 24), Lines(10, 40)).em_px, 0);
+  std::vector<Word> doubtful = BodyWords(30, 24);
+  for (Word& w : doubtful) w.confidence = 0.5;
+  EXPECT_EQ(EstimateTextSize(doubtful, {}).em_px, 0);
+  std::vector<Word> numbers = BodyWords(30, 24);
+  for (Word& w : numbers) w.text = "12.50";
+  EXPECT_EQ(EstimateTextSize(numbers, {}).em_px, 0);
+}
+
+TEST(TextSize, LinesOfDifferentBlocksOrColumnsAreNotNeighbours) {
+  std::vector<TextLine> lines = Lines(10, 16);
+  for (size_t i = 0; i < lines.size(); ++i) lines[i].block = int(i);
+  EXPECT_EQ(EstimateTextSize(BodyWords(30, 10), lines).line_pitch_px, 0);
+  lines = Lines(10, 16);
+  for (size_t i = 1; i < lines.size(); i += 2) lines[i].box.x += 2000;
+  EXPECT_EQ(EstimateTextSize(BodyWords(30, 10), lines).line_pitch_px, 0);
+}
+
+TEST(MarkupScale, AltoPositionsAndSizes) {
+  const std::string alto =
+      R"(<Page WIDTH="2000" HEIGHT="3000" PHYSICAL_IMG_NR="0" ID="page_0">)"
+      R"(<String ID="string_3" HPOS="101" VPOS="40" WIDTH="60" HEIGHT="21" WC="0.96" CONTENT="WIDTH"/>)";
+  EXPECT_EQ(
+      ScaleAltoPixels(alto, 0.5),
+      R"(<Page WIDTH="1000" HEIGHT="1500" PHYSICAL_IMG_NR="0" ID="page_0">)"
+      R"(<String ID="string_3" HPOS="51" VPOS="20" WIDTH="30" HEIGHT="11" WC="0.96" CONTENT="WIDTH"/>)");
+  EXPECT_EQ(ScaleAltoPixels(alto, 1), alto);
+}
+
+TEST(MarkupScale, HocrBoxesBaselinesAndResolution) {
+  const std::string hocr =
+      "title='image \"p.jpg\"; bbox 0 0 2000 3000; ppageno 0; scan_res 600 600'>"
+      "title=\"bbox 100 40 900 62; baseline 0.002 -6; x_size 22; x_descenders 5.5; x_ascenders 6\""
+      "title='bbox 100 40 160 61; x_wconf 96'";
+  EXPECT_EQ(ScaleHocrPixels(hocr, 0.5, 600, 300),
+            "title='image \"p.jpg\"; bbox 0 0 1000 1500; ppageno 0; scan_res 300 300'>"
+            "title=\"bbox 50 20 450 31; baseline 0.002 -3; x_size 11.0000; x_descenders "
+            "2.7500; x_ascenders 3.0000\""
+            "title='bbox 50 20 80 31; x_wconf 96'");
+}
+
+}  // namespace
+}  // namespace docunfold::pdf
