@@ -444,6 +444,29 @@ void ResultSection(const ReportOptions& o, const DataSet& data, const fs::path& 
   page->End();
 }
 
+// The searchable PDF: a link to it, its size, and the words it holds over
+// the page.
+void PdfSection(const ReportOptions& o, Page* page) {
+  page->Section("pdf", "The searchable PDF");
+  const Json pdf = TryJson(o.work / "80_pdf/pdf.json");
+  const std::string summary = PdfSummary(pdf);
+  if (summary.empty()) {
+    page->Add(Missing("pdf has not run yet."));
+    page->End();
+    return;
+  }
+  const std::string file = "80_pdf/" + pdf.value("/files/pdf"_json_pointer, std::string());
+  page->Add("<p><a href=\"" + Escape(file) + "\">" + Escape(file) + "</a>: " + summary + "</p>");
+  const std::string svg = PdfWordsSvg(
+      TryImage(o.work / "80_pdf" / pdf.value("/files/image"_json_pointer, std::string())), pdf,
+      o.figure_width / 2);
+  if (!svg.empty())
+    page->Add(Figure(svg,
+                     "The words of the text layer in their boxes (blue; red below 0.6 "
+                     "confidence), as Tesseract read them"));
+  page->End();
+}
+
 void StagesSection(const ReportOptions& o, Page* page) {
   page->Section("stages", "Stages: time, memory and flags");
   const auto timings = StageTimings(o.work);
@@ -498,6 +521,7 @@ ReportResult Run(const ReportOptions& o) {
   MeshSection(o, cameras, &page, &mesh_dir);
   ConvergenceSection(o, &page);
   ResultSection(o, data, mesh_dir, &page);
+  PdfSection(o, &page);
   StagesSection(o, &page);
 
   const std::time_t now = std::time(nullptr);

@@ -4,10 +4,13 @@
 #include <cmath>
 #include <filesystem>
 #include <map>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
+#include "common/cli.h"
 #include "common/errors.h"
+#include "stages/report/html.h"
 
 namespace docunfold::report {
 
@@ -97,6 +100,52 @@ std::string PointsCounts(const Json& points) {
   };
   return " " + count("sfm_in_region") + " sfm points on the page, " + count("texture") +
          " texture, " + count("outline") + " outline.";
+}
+
+std::string PdfWordsSvg(const cv::Mat& page_image, const Json& pdf, int width) {
+  if (page_image.empty() || !pdf.is_object() || !pdf.contains("words") || !pdf["words"].is_array())
+    return {};
+  std::vector<unsigned char> jpeg;
+  cv::Mat shown;
+  const double scale = std::min(1.0, 2.0 * width / page_image.cols);
+  cv::resize(page_image, shown, cv::Size(), scale, scale, cv::INTER_AREA);
+  cv::imencode(".jpg", shown, jpeg, {cv::IMWRITE_JPEG_QUALITY, 80});
+  const std::string w = std::to_string(page_image.cols), h = std::to_string(page_image.rows);
+  std::string svg = "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" + std::to_string(width) +
+                    "\" viewBox=\"0 0 " + w + " " + h + "\"><image width=\"" + w + "\" height=\"" +
+                    h + "\" href=\"data:image/jpeg;base64," + Base64(jpeg) + "\"/>";
+  for (const Json& word : pdf["words"]) {
+    if (!word.is_array() || word.size() != 6 || !word[5].is_string()) continue;
+    const double x = word[0].get<double>(), y = word[1].get<double>();
+    const double bw = word[2].get<double>(), bh = word[3].get<double>();
+    const char* colour = word[4].get<double>() < 0.6 ? "#d62728" : "#1f77b4";
+    svg += "<rect x=\"" + Fixed(x, 0) + "\" y=\"" + Fixed(y, 0) + "\" width=\"" + Fixed(bw, 0) +
+           "\" height=\"" + Fixed(bh, 0) + "\" fill=\"white\" fill-opacity=\"0.75\"/>" +
+           "<text x=\"" + Fixed(x, 0) + "\" y=\"" + Fixed(y + 0.85 * bh, 1) + "\" font-size=\"" +
+           Fixed(bh, 1) + "\" textLength=\"" + Fixed(bw, 0) +
+           "\" lengthAdjust=\"spacingAndGlyphs\" fill=\"" + colour + "\">" +
+           Escape(word[5].get<std::string>()) + "</text>";
+  }
+  return svg + "</svg>";
+}
+
+std::string PdfSummary(const Json& pdf) {
+  if (!pdf.is_object() || pdf.value("format", "") != "docunfold.pdf") return {};
+  const Json page = pdf.value("page", Json::object()), text = pdf.value("text", Json::object());
+  std::string format = page.value("format", "none");
+  if (format.rfind("receipt-", 0) == 0)
+    format = format.substr(8) + " mm receipt roll";
+  else
+    std::transform(format.begin(), format.begin() + 1, format.begin(), ::toupper);
+  const Json dpi = page.value("dpi", Json::array());
+  return (format == "None" ? std::string("No standard paper format") : "Paper " + format) + ", " +
+         Fixed(page.value("width_mm", 0.0), 1) + " × " + Fixed(page.value("height_mm", 0.0), 1) +
+         " mm (" + Escape(page.value("rule", "")) + "), " +
+         (dpi.size() == 2 ? Fixed(dpi[0].get<double>(), 0) : std::string("?")) + " dpi; " +
+         std::to_string(text.value("words", 0)) + " words read (" +
+         Escape(text.value("language", "")) + "), mean confidence " +
+         Fixed(text.value("mean_confidence", 0.0), 2) + "; " +
+         std::to_string(pdf.value("/files/pdf_bytes"_json_pointer, 0) / 1024) + " KB.";
 }
 
 }  // namespace docunfold::report

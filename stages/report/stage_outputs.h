@@ -20,6 +20,15 @@ cv::Mat DrawFeatureLines(const cv::Mat& rectified, const Json& render, const Jso
 // without lines.
 std::string LinesNote(const Json& lines);
 
+// The page image of 80_pdf/ with the words of pdf.json over it, each in its
+// box (an inline <svg>, `width` pixels wide; red: confidence below 0.6).
+// Empty when pdf.json has no words list or the image is missing.
+std::string PdfWordsSvg(const cv::Mat& page_image, const Json& pdf, int width);
+
+// "A4, 210 x 297 mm (aspect ratio and text size), 221 dpi, 230 words ..."
+// from pdf.json; empty when it is not one.
+std::string PdfSummary(const Json& pdf);
+
 // " <n> sfm points on the page, <n> texture, <n> outline." from points.json;
 // empty without counts.
 std::string PointsCounts(const Json& points);

@@ -5,7 +5,8 @@
 # the checks compare against (homography, oracle and its crop to what the
 # photos see, docunfold-init, and both
 # with the light's shading removed), through
-# scripts/bench.sh; two sets side by side. OCR is left out (the metrics
+# scripts/bench.sh; two sets side by side; then a book of three samples'
+# PDFs. OCR is left out (the metrics
 # reference test covers it). Exits non-zero only when the run itself fails;
 # each set's outcome is for the tests to judge.
 set -uo pipefail
@@ -22,5 +23,8 @@ BUILD=$build BENCH_WORK=$out/work BENCH_OUT=$out BENCH_JOBS=${E2E_JOBS:-2} \
   BENCH_ONLY="homography oracle oracle-seen docunfold docunfold-init oracle-deshaded docunfold-deshaded" BENCH_EVAL_FLAGS=--no-ocr \
   BENCH_OCR_SIZE=native "$src/scripts/bench.sh" "${sets[@]}" > "$out/bench.log" 2>&1
 rc=$?
+# A book of three samples' PDFs (made above), joined in the order given.
+make -s -j2 -f "$src/pipeline.mk" NO_BUILD=1 BUILD="$build" WORK_ROOT="$out/work" book \
+  BOOK=e2e-book DATASETS="set06 set01 set04" >> "$out/bench.log" 2>&1 || rc=1
 tail -n 40 "$out/bench.log"
 exit $rc
