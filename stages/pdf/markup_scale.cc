@@ -22,7 +22,10 @@ std::string ReplaceMatches(const std::string& text, const std::regex& pattern,
   return out;
 }
 
-std::string Int(double v) { return std::to_string(std::lround(v)); }
+// Positions round down and extents up, so that a box mapped onto fewer
+// pixels still covers what it boxed (a 1-pixel mark read at 3x is not lost).
+std::string Floor(double v) { return std::to_string(long(std::floor(v + 1e-9))); }
+std::string Ceil(double v) { return std::to_string(long(std::ceil(v - 1e-9))); }
 
 std::string Decimal(double v, int decimals) {
   char buf[32];
@@ -36,7 +39,9 @@ std::string ScaleAltoPixels(const std::string& alto, double scale) {
   if (scale == 1) return alto;
   static const std::regex attribute(R"re(\b(HPOS|VPOS|WIDTH|HEIGHT)="(-?[0-9]+(?:\.[0-9]+)?)")re");
   return ReplaceMatches(alto, attribute, [scale](const std::smatch& m) {
-    return m[1].str() + "=\"" + Int(std::stod(m[2].str()) * scale) + "\"";
+    const std::string key = m[1].str();
+    const double v = std::stod(m[2].str()) * scale;
+    return key + "=\"" + (key == "WIDTH" || key == "HEIGHT" ? Ceil(v) : Floor(v)) + "\"";
   });
 }
 
@@ -48,11 +53,11 @@ std::string ScaleHocrPixels(const std::string& hocr, double scale, int read_dpi,
   std::string out = hocr;
   if (scale != 1) {
     out = ReplaceMatches(out, bbox, [scale](const std::smatch& m) {
-      return "bbox " + Int(std::stod(m[1]) * scale) + " " + Int(std::stod(m[2]) * scale) + " " +
-             Int(std::stod(m[3]) * scale) + " " + Int(std::stod(m[4]) * scale);
+      return "bbox " + Floor(std::stod(m[1]) * scale) + " " + Floor(std::stod(m[2]) * scale) + " " +
+             Ceil(std::stod(m[3]) * scale) + " " + Ceil(std::stod(m[4]) * scale);
     });
     out = ReplaceMatches(out, baseline, [scale](const std::smatch& m) {
-      return "baseline " + m[1].str() + " " + Int(std::stod(m[2]) * scale);
+      return "baseline " + m[1].str() + " " + std::to_string(std::lround(std::stod(m[2]) * scale));
     });
     out = ReplaceMatches(out, size, [scale](const std::smatch& m) {
       return m[1].str() + " " + Decimal(std::stod(m[2]) * scale, 4);

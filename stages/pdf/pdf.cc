@@ -151,10 +151,11 @@ const char* EnhanceName(Enhance e) {
 // the page's own pixels.
 void ScaleToPage(double scale, PageReader::Page* page) {
   if (scale == 1) return;
+  // Down for the start, up for the end: a box still covers what it boxed.
   auto rect = [scale](const cv::Rect& r) {
-    const int x0 = int(std::lround(r.x * scale)), y0 = int(std::lround(r.y * scale));
-    return cv::Rect(x0, y0, int(std::lround((r.x + r.width) * scale)) - x0,
-                    int(std::lround((r.y + r.height) * scale)) - y0);
+    const int x0 = int(std::floor(r.x * scale)), y0 = int(std::floor(r.y * scale));
+    return cv::Rect(x0, y0, int(std::ceil((r.x + r.width) * scale)) - x0,
+                    int(std::ceil((r.y + r.height) * scale)) - y0);
   };
   for (Word& w : page->words) w.box = rect(w.box);
   for (TextLine& l : page->lines) {

@@ -82,6 +82,7 @@ std::vector<AltoWord> AltoWords(const fs::path& alto) {
       if (key == "VPOS") w.box.y = std::stoi(value);
       if (key == "WIDTH") w.box.width = std::stoi(value);
       if (key == "HEIGHT") w.box.height = std::stoi(value);
+      if (key == "WC") w.confidence = std::stod(value);
       if (key == "CONTENT") w.text = value;
     }
     words.push_back(w);
@@ -89,20 +90,44 @@ std::vector<AltoWord> AltoWords(const fs::path& alto) {
   return words;
 }
 
-std::vector<AltoWord> WordsNotDarkerThanPaper(const cv::Mat& page,
-                                              const std::vector<AltoWord>& words) {
+namespace {
+
+// The q-quantile (0..1) of a grey image's values.
+double Quantile(const cv::Mat& grey, double q) {
+  std::vector<uchar> v;
+  for (int r = 0; r < grey.rows; ++r)
+    v.insert(v.end(), grey.ptr<uchar>(r), grey.ptr<uchar>(r) + grey.cols);
+  const size_t k = std::min(v.size() - 1, size_t(q * v.size()));
+  std::nth_element(v.begin(), v.begin() + k, v.end());
+  return v[k];
+}
+
+}  // namespace
+
+std::vector<AltoWord> WordsWithoutPrint(const cv::Mat& page, const std::vector<AltoWord>& words,
+                                        double contrast) {
   cv::Mat grey;
   cv::cvtColor(page, grey, cv::COLOR_BGR2GRAY);
-  std::vector<uchar> all(grey.begin<uchar>(), grey.end<uchar>());
-  std::nth_element(all.begin(), all.begin() + all.size() / 2, all.end());
-  const double paper = all[all.size() / 2];
-  std::vector<AltoWord> light;
+  std::vector<AltoWord> bare;
   const cv::Rect inside(0, 0, grey.cols, grey.rows);
   for (const AltoWord& w : words) {
     const cv::Rect box = w.box & inside;
-    if (box.area() == 0 || cv::mean(grey(box))[0] >= paper) light.push_back(w);
+    if (box.area() == 0) {
+      bare.push_back(w);
+      continue;
+    }
+    // The ground around the word (a photo's light varies across the page):
+    // the median of the box grown by its height on every side.
+    const int grow = std::max(2, w.box.height);
+    const cv::Rect around =
+        cv::Rect(w.box.x - grow, w.box.y - grow, w.box.width + 2 * grow, w.box.height + 2 * grow) &
+        inside;
+    const double ground = Quantile(grey(around), 0.5);
+    const bool dark_print = Quantile(grey(box), 0.1) <= ground - contrast;
+    const bool light_print = Quantile(grey(box), 0.9) >= ground + contrast;
+    if (!dark_print && !light_print) bare.push_back(w);
   }
-  return light;
+  return bare;
 }
 
 double CharacterErrorRate(const std::string& reference, const std::string& text) {

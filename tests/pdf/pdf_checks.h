@@ -35,15 +35,18 @@ std::string AltoSchemaErrors(const fs::path& alto);
 
 struct AltoWord {
   cv::Rect box;
+  double confidence = 0;  // WC
   std::string text;
 };
 // The <String> elements of an ALTO file.
 std::vector<AltoWord> AltoWords(const fs::path& alto);
 
-// The words whose box is not darker (mean grey) than the page's background
-// (the median grey of the page).
-std::vector<AltoWord> WordsNotDarkerThanPaper(const cv::Mat& page,
-                                              const std::vector<AltoWord>& words);
+// The words whose box holds no print: none of its darkest tenth of pixels
+// `contrast` grey levels darker than the ground around it (the median of the
+// box grown by its height on every side), nor, for light print on a dark
+// ground, its brightest tenth that much lighter.
+std::vector<AltoWord> WordsWithoutPrint(const cv::Mat& page, const std::vector<AltoWord>& words,
+                                        double contrast = 20);
 
 // Character error rate of `text` against `reference`, whitespace collapsed.
 double CharacterErrorRate(const std::string& reference, const std::string& text);

@@ -118,8 +118,9 @@ TEST_F(PdfCli, AltoIsValidAndItsWordsLieOnPrint) {
   ASSERT_GT(words.size(), 150u);
   const cv::Mat image = cv::imread((Out() / "letter.jpg").string());
   ASSERT_EQ(image.size(), page_.size());
-  const std::vector<AltoWord> light = WordsNotDarkerThanPaper(image, words);
-  EXPECT_TRUE(light.empty()) << light.size() << " words on paper, e.g. '" << light[0].text << "'";
+  const std::vector<AltoWord> light = WordsWithoutPrint(image, words);
+  EXPECT_TRUE(light.empty()) << light.size() << " words without print, e.g. '" << light[0].text
+                             << "'";
 }
 
 TEST_F(PdfCli, A300DpiA4PageInColourFitsInOneAndAHalfMegabytes) {

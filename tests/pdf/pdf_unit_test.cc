@@ -153,7 +153,7 @@ TEST(MarkupScale, AltoPositionsAndSizes) {
   EXPECT_EQ(
       ScaleAltoPixels(alto, 0.5),
       R"(<Page WIDTH="1000" HEIGHT="1500" PHYSICAL_IMG_NR="0" ID="page_0">)"
-      R"(<String ID="string_3" HPOS="51" VPOS="20" WIDTH="30" HEIGHT="11" WC="0.96" CONTENT="WIDTH"/>)");
+      R"(<String ID="string_3" HPOS="50" VPOS="20" WIDTH="30" HEIGHT="11" WC="0.96" CONTENT="WIDTH"/>)");
   EXPECT_EQ(ScaleAltoPixels(alto, 1), alto);
 }
 
@@ -167,6 +167,8 @@ TEST(MarkupScale, HocrBoxesBaselinesAndResolution) {
             "title=\"bbox 50 20 450 31; baseline 0.002 -3; x_size 11.0000; x_descenders "
             "2.7500; x_ascenders 3.0000\""
             "title='bbox 50 20 80 31; x_wconf 96'");
+  // A mark 1 pixel wide read at 3x keeps a pixel.
+  EXPECT_EQ(ScaleAltoPixels(R"(HPOS="301" WIDTH="1")", 1.0 / 3), R"(HPOS="100" WIDTH="1")");
 }
 
 }  // namespace
