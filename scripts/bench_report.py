@@ -17,6 +17,7 @@ import json
 import math
 import os
 import platform
+import re
 import struct
 import subprocess
 
@@ -437,6 +438,16 @@ def markdown(result):
     return "\n".join(lines) + "\n"
 
 
+def kept_sections(path):
+    """Sections other scripts own in results.md (scripts/bench-batch's, between
+    <!-- <name>:begin --> and <!-- <name>:end -->), carried over as they are."""
+    if not os.path.exists(path):
+        return ""
+    text = open(path, encoding="utf-8").read()
+    pattern = r"\n<!-- ([a-z-]+):begin -->\n.*?\n<!-- \1:end -->\n"
+    return "".join(m.group(0) for m in re.finditer(pattern, text, re.S))
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--root", required=True)
@@ -475,7 +486,7 @@ def main():
         json.dump(result, f, indent=1, ensure_ascii=False, allow_nan=False)
         f.write("\n")
     os.replace(os.path.join(a.out, "results.json.tmp"), os.path.join(a.out, "results.json"))
-    text = markdown(result)
+    text = markdown(result) + kept_sections(os.path.join(a.out, "results.md"))
     with open(os.path.join(a.out, "results.md.tmp"), "w") as f:
         f.write(text)
     os.replace(os.path.join(a.out, "results.md.tmp"), os.path.join(a.out, "results.md"))

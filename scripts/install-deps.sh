@@ -47,6 +47,9 @@ packages=(
   # checks the ALTO files against their schema)
   googletest libgtest-dev assimp-utils chromium libheif-examples libimage-exiftool-perl
   libjpeg-turbo-progs poppler-utils libxml2-utils
+  # batches on a cluster (workflow/): Snakemake, and Slurm with munge for the
+  # test that starts a single-node cluster
+  snakemake slurm-wlm munge
   # fuzzing the file readers (pipeline.mk fuzz): clang and its libFuzzer,
   # ASan and UBSan runtimes
   clang libclang-rt-14-dev
