@@ -34,6 +34,8 @@ int main(int argc, char** argv) {
     if (name.empty())
       name = fs::absolute(render).lexically_normal().parent_path().filename().string();
     if (name.empty() || name == "." || name == "..") name = "page";
+    if (name.find('/') != std::string::npos)
+      throw UsageError("--name " + name + ": a file name, without '/'");
     const pdf::PdfResult r = pdf::Run(o, in, out, name, table.Record());
     Log("wrote " + r.pdf_file.string() + " (" + std::to_string(r.pdf_bytes / 1024) + " KB, " +
         (r.size.format == "none" ? std::string("no standard format") : r.size.format) + " " +

@@ -449,17 +449,23 @@ void ResultSection(const ReportOptions& o, const DataSet& data, const fs::path& 
 void PdfSection(const ReportOptions& o, Page* page) {
   page->Section("pdf", "The searchable PDF");
   const Json pdf = TryJson(o.work / "80_pdf/pdf.json");
-  const std::string summary = PdfSummary(pdf);
+  std::string summary, svg, file;
+  try {
+    summary = PdfSummary(pdf);
+    if (!summary.empty()) file = "80_pdf/" + pdf.value("/files/pdf"_json_pointer, std::string());
+    if (!summary.empty())
+      svg = PdfWordsSvg(
+          TryImage(o.work / "80_pdf" / pdf.value("/files/image"_json_pointer, std::string())), pdf,
+          o.figure_width / 2);
+  } catch (const Json::exception& e) {
+    throw InputError((o.work / "80_pdf/pdf.json").string() + ": " + e.what());
+  }
   if (summary.empty()) {
     page->Add(Missing("pdf has not run yet."));
     page->End();
     return;
   }
-  const std::string file = "80_pdf/" + pdf.value("/files/pdf"_json_pointer, std::string());
   page->Add("<p><a href=\"" + Escape(file) + "\">" + Escape(file) + "</a>: " + summary + "</p>");
-  const std::string svg = PdfWordsSvg(
-      TryImage(o.work / "80_pdf" / pdf.value("/files/image"_json_pointer, std::string())), pdf,
-      o.figure_width / 2);
   if (!svg.empty())
     page->Add(Figure(svg,
                      "The words of the text layer in their boxes (blue; red below 0.6 "
