@@ -452,11 +452,12 @@ void PdfSection(const ReportOptions& o, Page* page) {
   std::string summary, svg, file;
   try {
     summary = PdfSummary(pdf);
-    if (!summary.empty()) file = "80_pdf/" + pdf.value("/files/pdf"_json_pointer, std::string());
-    if (!summary.empty())
+    if (!summary.empty()) {
+      file = "80_pdf/" + pdf.value("/files/pdf"_json_pointer, std::string());
       svg = PdfWordsSvg(
           TryImage(o.work / "80_pdf" / pdf.value("/files/image"_json_pointer, std::string())), pdf,
           o.figure_width / 2);
+    }
   } catch (const Json::exception& e) {
     throw InputError((o.work / "80_pdf/pdf.json").string() + ": " + e.what());
   }

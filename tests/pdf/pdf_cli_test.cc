@@ -29,11 +29,6 @@ fs::path WriteRenderDir(const fs::path& work, const cv::Mat& page) {
   return dir;
 }
 
-std::string ReadFile(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), {});
-}
-
 class PdfCli : public ::testing::Test {
  protected:
   // set06's true flat page (A4 at 150 dpi), read once by the pdf program.
@@ -96,7 +91,7 @@ TEST_F(PdfCli, PageIsA4ForPdfinfoAndPassesQpdfCheck) {
 
 TEST_F(PdfCli, TextLayerReadsAsWellAsTesseractOnTheImage) {
   ASSERT_EQ(run_->exit_code, 0) << run_->output;
-  const std::string truth = ReadFile(SampleDir("set06") / "ground_truth/text.txt");
+  const std::string truth = ReadFileText(SampleDir("set06") / "ground_truth/text.txt");
   const double pdf_cer = CharacterErrorRate(truth, PdfText(Out() / "letter.pdf"));
   const double image_cer = CharacterErrorRate(truth, TesseractText(render_ / "rectified.png"));
   EXPECT_LE(pdf_cer, image_cer + 0.02) << "pdftotext " << pdf_cer << ", image " << image_cer;
@@ -113,7 +108,7 @@ TEST_F(PdfCli, AltoIsValidAndItsWordsLieOnPrint) {
   ASSERT_EQ(run_->exit_code, 0) << run_->output;
   const fs::path alto = Out() / "letter.alto.xml";
   EXPECT_EQ(AltoSchemaErrors(alto), "");
-  EXPECT_NE(ReadFile(alto).find("<fileName>letter.jpg</fileName>"), std::string::npos);
+  EXPECT_NE(ReadFileText(alto).find("<fileName>letter.jpg</fileName>"), std::string::npos);
   const std::vector<AltoWord> words = AltoWords(alto);
   ASSERT_GT(words.size(), 150u);
   const cv::Mat image = cv::imread((Out() / "letter.jpg").string());
@@ -180,12 +175,12 @@ TEST_F(PdfCli, ARenderJsonOfAnotherImageIsBadInput) {
 
 TEST_F(PdfCli, AMissingLanguageNamesItsPackageAndLeavesTheOldPdf) {
   fs::copy(Out(), dir_ / "out");
-  const std::string before = ReadFile(dir_ / "out/letter.pdf");
+  const std::string before = ReadFileText(dir_ / "out/letter.pdf");
   const CommandResult r = Pdf(render_, dir_ / "out", "--lang xyz --name letter");
   EXPECT_EQ(r.exit_code, 3) << r.output;
   EXPECT_NE(r.output.find("tesseract-ocr-xyz"), std::string::npos) << r.output;
   EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
-  EXPECT_EQ(ReadFile(dir_ / "out/letter.pdf"), before);
+  EXPECT_EQ(ReadFileText(dir_ / "out/letter.pdf"), before);
 }
 
 TEST_F(PdfCli, AnUnwritableFolderExitsFour) {

@@ -5,7 +5,6 @@
 // book of three samples made with -j2.
 #include <gtest/gtest.h>
 
-#include <fstream>
 #include <opencv2/imgcodecs.hpp>
 
 #include "common/json_io.h"
@@ -14,11 +13,6 @@
 
 namespace docunfold::testing {
 namespace {
-
-std::string ReadFile(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), {});
-}
 
 // The data set of a name: samples/<name>, else the realistic set.
 fs::path DataSet(const std::string& name) {
@@ -49,7 +43,7 @@ TEST_P(PdfE2e, PageHasTheTrueFormat) {
 }
 
 TEST_P(PdfE2e, TextLayerReadsAsWellAsTesseractOnTheImage) {
-  const std::string truth = ReadFile(data_ / "ground_truth/text.txt");
+  const std::string truth = ReadFileText(data_ / "ground_truth/text.txt");
   const double pdf_cer = CharacterErrorRate(truth, PdfText(pdf_));
   const double image_cer =
       CharacterErrorRate(truth, TesseractText(work_ / "60_render/rectified.png"));

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <fstream>
 #include <opencv2/imgproc.hpp>
 #include <random>
 
@@ -28,6 +29,11 @@ TempDir::~TempDir() {
   if (std::getenv("DOCUNFOLD_KEEP_TEST_DIRS")) return;
   std::error_code ec;
   fs::remove_all(path_, ec);
+}
+
+std::string ReadFileText(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
 }
 
 CommandResult RunCommand(const std::string& command_line) {

@@ -33,6 +33,9 @@ struct CommandResult {
   std::string output;  // stdout and stderr together
 };
 
+// The whole content of a file ("" when it cannot be read).
+std::string ReadFileText(const fs::path& path);
+
 // Runs a shell command line (arguments already quoted) and captures output.
 CommandResult RunCommand(const std::string& command_line);
 

@@ -3,10 +3,8 @@
 // photo submitted through the Slurm profile, each data set one Slurm job.
 #include <gtest/gtest.h>
 
-#include <fstream>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
-#include <sstream>
 
 #include "common/json_io.h"
 #include "tests/support/test_support.h"
@@ -14,13 +12,6 @@
 
 namespace docunfold::testing {
 namespace {
-
-std::string ReadFile(const fs::path& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 // A data set whose second photo was cut short: one photo is left, too few.
 fs::path BrokenDataSet(const fs::path& dir) {
@@ -88,11 +79,12 @@ TEST(Workflow, SlurmRunsEachDataSetAsAJob) {
   EXPECT_NE(broken["message"].get<std::string>().find("photo"), std::string::npos)
       << broken["message"];
 
-  const std::string summary = ReadFile(work / "batch/summary.csv");
+  const std::string summary = ReadFileText(work / "batch/summary.csv");
   for (const std::string& s : samples)
     EXPECT_NE(summary.find("\n" + s + ",ok,"), std::string::npos);
   EXPECT_NE(summary.find("\nbroken,failed,sfm,"), std::string::npos) << summary;
-  EXPECT_NE(ReadFile(work / "batch/index.html").find("failed in <b>sfm</b>"), std::string::npos);
+  EXPECT_NE(ReadFileText(work / "batch/index.html").find("failed in <b>sfm</b>"),
+            std::string::npos);
 
   // A rerun does only what failed.
   const CommandResult again = RunCommand(snakemake + " -n 2>&1");
