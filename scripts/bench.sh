@@ -10,7 +10,8 @@
 # or set01-48mp: set01 with one photo at 8000 x 6000, as a 48 MP phone takes
 # it (made by build/tests/phone-photos into BENCH_WORK/.data/), for the peak
 # memory of every stage on such a photo.
-# Default: every samples/* and data/* with ground_truth/flat.png, and set01-48mp.
+# Default: every samples/*, data/*, ../shared/realistic/* and
+# ../shared/realistic-hard/* with ground_truth/flat.png, and set01-48mp.
 #
 # Environment:
 #   BUILD=dir            build directory with bin/ (default <root>/build)
@@ -36,9 +37,10 @@
 #
 # Per set, the front end (20_boundary/, 30_features/) is measured against the
 # truth in sfm's reference view (evaluate --front-end -> 70_eval/front_end.json).
-# Rows per set: homography, oracle and oracle-seen (build/bin/baseline),
-# docunfold (60_render/rectified.png) when render ran, and, when the binaries exist,
-# docunfold-init (render on 40_init), docunfold-nofeatures and
+# Rows per set: homography, oracle, oracle-seen and oracle-multiview
+# (build/bin/baseline), docunfold (60_render/rectified.png) when render ran,
+# and, when the binaries exist, docunfold-reference (render --texture
+# reference), docunfold-init (render on 40_init), docunfold-nofeatures and
 # docunfold-boundary (optimize --no-feature-lines / --boundary-only, then render),
 # and docunfold-deshaded and oracle-deshaded (render / baseline --shading
 # remove: the light's shading divided out of the final meshes' rendering and
@@ -84,7 +86,9 @@ resolve() {  # name or path -> absolute data-set folder ("" if none)
 }
 sets=("$@")
 if [[ ${#sets[@]} -eq 0 ]]; then
-  for d in "$root"/samples/*/ "$root"/data/*/; do
+  # The independent renderer's sets beside the repository, when present.
+  for d in "$root"/samples/*/ "$root"/data/*/ "$root"/../shared/realistic/*/ \
+           "$root"/../shared/realistic-hard/*/; do
     [[ -f $d/ground_truth/flat.png && -d $d/images ]] && sets+=("$d")
   done
   [[ -d $root/samples/set01 && -x $BUILD/tests/phone-photos ]] && sets+=(set01-48mp)
@@ -177,6 +181,16 @@ make_row_oracle-seen() {
   timed oracle-seen "$bin/baseline" --method oracle --crop-to-seen --data "$data" \
     --work "$work" --out "$image"
 }
+# The true surface textured from every photo through the true cameras by
+# render's texture fusion, cropped like oracle-seen to the part some photo
+# sees: the ceiling for texturing from all the photos.
+make_row_oracle-multiview() {
+  [[ -f $work/10_sfm/cameras.json ]] || { reason="no 10_sfm/cameras.json"; return 1; }
+  [[ -f $data/ground_truth/mesh.ply ]] || { reason="no ground_truth/mesh.ply"; return 1; }
+  image=$work/bench/oracle-multiview.png
+  timed oracle-multiview "$bin/baseline" --method oracle-multiview --crop-to-seen \
+    --data "$data" --work "$work" --out "$image"
+}
 make_row_docunfold() {
   [[ -f $work/60_render/rectified.png ]] || { reason="render did not run"; return 1; }
   image=$work/60_render/rectified.png
@@ -200,6 +214,19 @@ make_row_oracle-deshaded() {
   image=$work/bench/oracle-deshaded.png
   timed oracle-deshaded "$bin/baseline" --method oracle --data "$data" --work "$work" \
     --out "$image" --shading remove
+}
+# The final meshes textured from the reference photo alone (render
+# --texture reference), as the paper does: what texture fusion adds.
+make_row_docunfold-reference() {
+  have render || { reason="no render binary"; return 1; }
+  local meshes=$work/50_optimize
+  [[ -f $meshes/mesh3d.ply ]] || meshes=$work/40_init
+  [[ -f $meshes/mesh3d.ply ]] || { reason="no meshes"; return 1; }
+  mesh_dir=$meshes
+  timed docunfold-reference "$bin/render" --sfm "$work/10_sfm" --boundary "$work/20_boundary" \
+    --meshes "$meshes" --out "$work/60_render_reference" --images "$data/images" \
+    --features "$work/30_features/features.json" --texture reference || return
+  image=$work/60_render_reference/rectified.png
 }
 make_row_docunfold-init() {
   have render || { reason="no render binary"; return 1; }
@@ -232,8 +259,8 @@ optimize_variant() {  # optimize_variant <row> <suffix> <optimize flag>
 make_row_docunfold-nofeatures() { optimize_variant docunfold-nofeatures nofeatures --no-feature-lines; }
 make_row_docunfold-boundary() { optimize_variant docunfold-boundary boundary --boundary-only; }
 
-ROWS=(homography oracle oracle-seen docunfold docunfold-init docunfold-nofeatures docunfold-boundary
-      oracle-deshaded docunfold-deshaded)
+ROWS=(homography oracle oracle-seen oracle-multiview docunfold docunfold-reference docunfold-init
+      docunfold-nofeatures docunfold-boundary oracle-deshaded docunfold-deshaded)
 if [[ -n ${BENCH_ONLY:-} ]]; then read -r -a ROWS <<< "$BENCH_ONLY"; fi
 read -r -a extra_rows <<< "${BENCH_ROWS:-}"
 

@@ -29,7 +29,8 @@ FIGURES = [("ms_ssim", "MS-SSIM ↑", "%.4f"), ("ld", "LD ↓", "%.2f"), ("li_d"
            ("cer", "CER ↓", "%.4f"), ("wer", "WER ↓", "%.4f"),
            ("surface_mean_pct", "surface mean % ↓", "%.3f"),
            ("isometry_mean", "isometry ↓", "%.4f")]
-ROW_ORDER = ["homography", "oracle", "oracle-seen", "docunfold", "docunfold-init", "docunfold-nofeatures",
+ROW_ORDER = ["homography", "oracle", "oracle-seen", "oracle-multiview", "docunfold",
+             "docunfold-reference", "docunfold-init", "docunfold-nofeatures",
              "docunfold-boundary", "oracle-deshaded", "docunfold-deshaded"]
 
 
@@ -324,7 +325,11 @@ def markdown(result):
               "for one-view texturing); `oracle-seen` = the oracle cropped to the part of the page "
               "some photo sees (the same image where the page is seen whole; the ceiling for a "
               "method that has only the photos when a page is cut off in all of them); "
-              "`docunfold` = 60_render/rectified.png; `-deshaded` = "
+              "`oracle-multiview` = the true surface textured from every photo through the true "
+              "cameras by render's texture fusion, cropped like `oracle-seen` (the ceiling for "
+              "texturing from all the photos); `docunfold` = 60_render/rectified.png (texture fusion); "
+              "`docunfold-reference` = the same meshes textured from the reference photo alone "
+              "(render `--texture reference`, the paper's way); `-deshaded` = "
               "the same with the light's shading divided out (render/baseline `--shading "
               "remove`): compare `docunfold-deshaded` with `oracle-deshaded`, not with "
               "`oracle`." % (

@@ -239,6 +239,41 @@ cv::Rect SeenPageRect(const std::vector<PinholeCamera>& cameras, const PlyData& 
   return cv::Rect(x0, y0, x1 - x0, y1 - y0);
 }
 
+FusedTexture FuseFromTruth(const std::vector<FusionView>& views, const PlyData& mesh,
+                           cv::Size size) {
+  if (!mesh.FindProperty("s") || !mesh.FindProperty("t"))
+    throw InputError("true mesh has no per-vertex s, t");
+  const auto& s = mesh.FindProperty("s")->values;
+  const auto& t = mesh.FindProperty("t")->values;
+  FusionSurface surface;
+  surface.world = mesh.vertices;
+  surface.triangles = Triangulate(mesh.faces);
+  surface.width = size.width;
+  surface.height = size.height;
+  for (size_t i = 0; i < mesh.vertices.size(); ++i)
+    surface.pixel.emplace_back(s[i] * size.width - 0.5, t[i] * size.height - 0.5);
+  FusedTexture fused = FuseTexture(surface, views);
+  // The paper's colour where no photo sees the page (or the mesh stops
+  // short of the page's edge).
+  const cv::Mat1b empty = fused.seen == 0;
+  if (cv::countNonZero(fused.seen) > 0) {
+    std::vector<cv::Mat> planes;
+    cv::split(fused.image, planes);
+    cv::Scalar paper;
+    for (int c = 0; c < 3; ++c) {
+      cv::Mat1b values;
+      planes[c].copyTo(values);
+      std::vector<double> seen;
+      for (int y = 0; y < values.rows; ++y)
+        for (int x = 0; x < values.cols; ++x)
+          if (fused.seen(y, x) && (x + y) % 3 == 0) seen.push_back(values(y, x));
+      paper[c] = Median(seen);
+    }
+    fused.image.setTo(paper, empty);
+  }
+  return fused;
+}
+
 namespace {
 
 // The reference view warped by its four page corners (BaselineOptions).
@@ -316,9 +351,28 @@ BaselineResult Oracle(const BaselineInputs& in, const BaselineOptions& options,
         cv::Size(options.width,
                  std::max(1, int(std::lround(double(options.width) * size.height / size.width))));
   BaselineResult out;
-  out.image = TextureFromTruth(photo, *camera, mesh, size);
-  out.summary = "oracle: " + cameras.reference + " through the true surface and camera, " +
-                std::to_string(size.width) + "x" + std::to_string(size.height);
+  if (options.method == Method::kOracleMultiview) {
+    // The reference first, then every other photo with its true camera.
+    std::vector<FusionView> views = {{*camera, {}, photo, {}, cameras.reference}};
+    for (const PinholeCamera& view : truth.views) {
+      if (view.image == cameras.reference) continue;
+      const fs::path path = MustExist(in.data / "images" / view.image, "oracle-multiview");
+      views.push_back({view, {}, ReadViewPhoto(path, view, gt / "cameras.json"), {}, view.image});
+    }
+    const FusedTexture fused = FuseFromTruth(views, mesh, size);
+    out.image = fused.image;
+    std::string shares;
+    for (const FusionViewReport& v : fused.views)
+      shares += (shares.empty() ? "" : ", ") + v.name + " " + Fixed(100 * v.share, 1) + " %";
+    out.summary = "oracle-multiview: " + std::to_string(views.size()) +
+                  " photos through the true surface and cameras (" + shares + ", unseen " +
+                  Fixed(100 * fused.unseen, 1) + " %), " + std::to_string(size.width) + "x" +
+                  std::to_string(size.height);
+  } else {
+    out.image = TextureFromTruth(photo, *camera, mesh, size);
+    out.summary = "oracle: " + cameras.reference + " through the true surface and camera, " +
+                  std::to_string(size.width) + "x" + std::to_string(size.height);
+  }
   if (options.crop_to_seen) {
     const cv::Rect seen = SeenPageRect(truth.views, mesh, size);
     if (seen.empty())
@@ -337,7 +391,9 @@ BaselineResult Oracle(const BaselineInputs& in, const BaselineOptions& options,
 void DeclareOptions(OptionTable& table, BaselineOptions* o) {
   table
       .Choice("method", &o->method,
-              {{"homography", Method::kHomography}, {"oracle", Method::kOracle}},
+              {{"homography", Method::kHomography},
+               {"oracle", Method::kOracle},
+               {"oracle-multiview", Method::kOracleMultiview}},
               "the reference method")
       ->required();
   table.Value("width", &o->width, 0, std::numeric_limits<int>::max(),
@@ -358,8 +414,8 @@ void DeclareOptions(OptionTable& table, BaselineOptions* o) {
 }
 
 BaselineResult Run(const BaselineInputs& in, const BaselineOptions& options) {
-  if (options.crop_to_seen && options.method != Method::kOracle)
-    throw UsageError("--crop-to-seen applies to --method oracle only");
+  if (options.crop_to_seen && options.method == Method::kHomography)
+    throw UsageError("--crop-to-seen applies to the oracles only");
   const fs::path sfm_cameras = MustExist(in.work / "10_sfm" / "cameras.json", "run sfm first");
   const CameraSet cameras = ReadCameras(sfm_cameras);
   if (cameras.reference.empty())

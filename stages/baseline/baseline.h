@@ -5,7 +5,10 @@
 //  - oracle: the page textured from the reference photo through the TRUE
 //    surface and TRUE camera (the ceiling for any single-view texturing);
 //    cropped to the part of the page some photo sees (`crop_to_seen`), the
-//    ceiling for a method that cannot know how far a cut-off page goes.
+//    ceiling for a method that cannot know how far a cut-off page goes;
+//  - oracle-multiview: the true surface textured from every photo through
+//    the true cameras by render's texture fusion (common/texture_fusion.h):
+//    the ceiling for texturing from all the photos.
 #pragma once
 
 #include <Eigen/Core>
@@ -19,6 +22,7 @@
 #include "common/camera.h"
 #include "common/option_table.h"
 #include "common/ply.h"
+#include "common/texture_fusion.h"
 
 namespace docunfold::baseline {
 
@@ -54,7 +58,14 @@ cv::Mat TextureFromTruth(const cv::Mat& photo, const PinholeCamera& camera, cons
 cv::Rect SeenPageRect(const std::vector<PinholeCamera>& cameras, const PlyData& mesh,
                       cv::Size size);
 
-enum class Method { kHomography, kOracle };
+// The true surface textured from `photos` (views[0]: the reference)
+// through their true cameras by texture fusion; where no photo sees the
+// page, the median colour of the rest (the paper). `mesh` as for
+// TextureFromTruth.
+FusedTexture FuseFromTruth(const std::vector<FusionView>& views, const PlyData& mesh,
+                           cv::Size size);
+
+enum class Method { kHomography, kOracle, kOracleMultiview };
 
 struct BaselineOptions {
   Method method = Method::kHomography;
@@ -67,7 +78,7 @@ struct BaselineOptions {
   // (common/shading.h), as render --shading remove does: the ceiling for
   // results rendered that way.
   bool remove_shading = false;
-  // Oracle: keep only SeenPageRect over all true cameras. Where no photo
+  // Oracles: keep only SeenPageRect over all true cameras. Where no photo
   // sees some part of the page (cut-off pages), no method working from the
   // photos can know where the page ends: the plain oracle knows it from the
   // true surface. The same image as the plain oracle on a page seen whole.

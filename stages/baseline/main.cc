@@ -1,4 +1,4 @@
-// baseline: reference methods of the benchmark (homography, oracle).
+// baseline: reference methods of the benchmark (homography, the oracles).
 #include "common/atomic_file.h"
 #include "common/cli.h"
 #include "stages/baseline/baseline.h"
@@ -13,8 +13,11 @@ int main(int argc, char** argv) {
       "(ground_truth/page.json, else estimated from the corners and K). "
       "oracle: the photo images/<reference> textured through the TRUE surface "
       "and camera (ground_truth/mesh.ply, cameras.json) at the size of "
-      "flat.png: the ceiling for any method that textures from one view; with "
-      "--crop-to-seen, only the part of the page some photo sees."};
+      "flat.png: the ceiling for any method that textures from one view. "
+      "oracle-multiview: the true surface textured from every photo through the "
+      "true cameras by render's texture fusion: the ceiling for texturing from "
+      "all the photos. With --crop-to-seen, only the part of the page some photo "
+      "sees."};
   OptionTable table(app);
   baseline::BaselineInputs in;
   baseline::BaselineOptions options;

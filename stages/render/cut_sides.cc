@@ -10,7 +10,7 @@
 
 #include "common/raster.h"
 #include "common/statistics.h"
-#include "stages/render/texture_sampler.h"
+#include "common/texture_sampler.h"
 
 namespace docunfold::render {
 

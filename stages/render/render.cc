@@ -153,19 +153,13 @@ OutputFrame FrameOutput(const RenderOptions& options, const CropRect& crop,
 // r->other_view_fraction).
 void TexturePastMesh(const RenderOptions& options, const RenderInputs& in,
                      const std::vector<ViewMask>& self_view, const SizeChoice& size,
-                     cv::Mat3b* image_io, cv::Mat1b* state_io, RenderResult* r, StepTimer* timer) {
+                     const std::vector<cv::Mat>& photos, cv::Mat3b* image_io, cv::Mat1b* state_io,
+                     RenderResult* r, StepTimer* timer) {
   cv::Mat3b& image = *image_io;
   cv::Mat1b& state = *state_io;
   std::vector<const ExtensionStrip*> strips;
   for (const CutSideEdge& e : r->cut_edges)
     if (!e.strip.flat.empty()) strips.push_back(&e.strip);
-  std::vector<cv::Mat> photos(in.views.size());
-  if (!strips.empty() && options.texture_cut_sides)
-    for (size_t v = 0; v < in.views.size(); ++v) {
-      const ViewMask& view = in.views[v];
-      if (view.photo.empty()) continue;
-      photos[v] = ReadViewPhoto(view.photo, view.camera, in.cameras_file);
-    }
   // The margin reached past M's border, from the reference photo itself.
   std::vector<const ExtensionStrip*> reached_strips;
   for (const CutSideEdge& e : r->reached_sides)
@@ -264,6 +258,7 @@ Json Orient(const RenderOptions& options, const RenderInputs& in, const PixelToS
       r->rectified = Turn(r->rectified, o.quarter_turns);
       r->rectified_grid = Turn(r->rectified_grid, o.quarter_turns);
       r->page_mask = Turn(r->page_mask, o.quarter_turns);
+      if (!r->texture_labels.empty()) r->texture_labels = Turn(r->texture_labels, o.quarter_turns);
       Log("turned the page " + std::to_string(90 * o.quarter_turns) +
           " degrees clockwise so that its text reads upright");
     }
@@ -301,13 +296,22 @@ RenderResult Run(const RenderOptions& options, const RenderInputs& in) {
   const OutputFrame frame = FrameOutput(options, crop.crop, crop.flat, pm, &r);
   timer.Mark("rasterize");
 
+  const bool fusion = options.texture == Texture::kFusion;
+  const bool past_mesh = options.texture_cut_sides &&
+                         std::any_of(r.cut_edges.begin(), r.cut_edges.end(),
+                                     [](const CutSideEdge& e) { return !e.strip.flat.empty(); });
+  const std::vector<cv::Mat> photos = ReadViewPhotos(in, fusion || past_mesh);
+  timer.Mark("read_photos");
   cv::Mat3b image;
   cv::Mat1b state;
-  const SampleStats stats = SamplePixels(options, in, pm, crop.flat, frame.raster, lookup.raster(),
-                                         frame.size.scale, &image, &state);
+  const SampleStats stats =
+      fusion ? FusePixels(options, in, pm, crop.flat, frame.raster, lookup.raster(),
+                          frame.size.scale, photos, &image, &state, &r)
+             : SamplePixels(options, in, pm, crop.flat, frame.raster, lookup.raster(),
+                            frame.size.scale, &image, &state);
   timer.Mark("sample");
 
-  TexturePastMesh(options, in, crop.self_view, frame.size, &image, &state, &r, &timer);
+  TexturePastMesh(options, in, crop.self_view, frame.size, photos, &image, &state, &r, &timer);
   FillAndDrawGrid(options, in, crop.flat, frame.size, stats, paper_fill, fixed_fill, image, state,
                   &r, &timer);
   timer.Mark("fill_and_grid");

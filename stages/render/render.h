@@ -22,6 +22,7 @@
 #include "common/option_table.h"
 #include "common/page_files.h"
 #include "common/shading.h"
+#include "common/texture_fusion.h"
 #include "stages/render/cut_sides.h"
 
 namespace docunfold::render {
@@ -35,6 +36,9 @@ inline constexpr double kLegalAspect = 14.0 / 8.5;        // US Legal
 
 // Which lines the deskew turn follows (RenderOptions::deskew_by).
 enum class DeskewBy { kLines, kSides };
+
+// Which photos colour the page (RenderOptions::texture).
+enum class Texture { kFusion, kReference };
 
 // What becomes of the light's shading (RenderOptions::shading).
 enum class Shading { kKeep, kRemove };
@@ -128,6 +132,12 @@ struct RenderOptions {
   // as the benchmark's oracle does).
   Shading shading = Shading::kKeep;
   ShadingOptions shading_removal;
+  // kFusion: every photo that sees a part of the page better than the
+  // reference does colours it there (common/texture_fusion.h: levelled,
+  // registered, seams where the photos agree); kReference: the reference
+  // photo alone, as the paper's method renders it.
+  Texture texture = Texture::kFusion;
+  FusionOptions fusion;
   // Grid overlay colour (BGR) and minimum spacing of drawn grid lines in
   // output pixels (denser grids are drawn every k-th line).
   cv::Scalar grid_color = cv::Scalar(40, 40, 230);
@@ -217,7 +227,14 @@ struct RenderResult {
   // Clockwise quarter turns applied to the images after rendering (the crop
   // and pixels_per_unit above refer to the unturned image).
   int quarter_turns = 0;
-  std::vector<std::pair<std::string, double>> timings;  // seconds per step
+  // kFusion: which photo coloured each pixel of M' (texture_fusion.h's
+  // labels, indices into RenderInputs' views with the reference first),
+  // turned as `rectified`; and what each photo contributed.
+  cv::Mat1b texture_labels;
+  std::vector<FusionViewReport> texture_views;
+  double texture_unseen = 0;  // fraction of M' in the crop no photo sees
+  std::vector<std::pair<std::string, double>> texture_timings;  // the fusion's steps
+  std::vector<std::pair<std::string, double>> timings;          // seconds per step
   Json orientation;  // how the page was turned upright (render.json's "orientation")
 };
 
@@ -251,8 +268,9 @@ RenderResult Run(const RenderOptions& options, const RenderInputs& inputs);
 Json RenderReport(const RenderOptions& options, const RenderInputs& inputs,
                   const RenderResult& result, const Json& options_record);
 
-// Writes rectified.png, rectified_grid.png and `report` as render.json into
-// `out_dir`: all three or none (OutputError).
+// Writes rectified.png, rectified_grid.png, texture_labels.png (kFusion:
+// DrawLabels of the labels) and `report` as render.json into `out_dir`: all
+// or none (OutputError).
 void WriteRenderOutputs(const fs::path& out_dir, const RenderResult& result, const Json& report);
 
 }  // namespace docunfold::render

@@ -75,6 +75,22 @@ SampleStats SamplePixels(const RenderOptions& options, const RenderInputs& in,
                          const RasterResult& out_raster, const RasterResult& ref_raster,
                          double scale, cv::Mat3b* image, cv::Mat1b* state);
 
+// The photos of in.views (empty where a view has none, or when `needed`
+// is false), read once for texture fusion and the page past cut sides.
+std::vector<cv::Mat> ReadViewPhotos(const RenderInputs& in, bool needed);
+
+// The texture from every photo (options.texture == kFusion,
+// common/texture_fusion.h) over the same output pixels as SamplePixels,
+// with the same states: kPage where some photo sees M, kHidden where none
+// does (with --sample-hidden, the reference photo's colour there,
+// kHiddenSampled). r->texture_labels and r->texture_views; r->timings gets
+// the fusion's steps.
+SampleStats FusePixels(const RenderOptions& options, const RenderInputs& in,
+                       const ProjectedMesh& pm, const std::vector<Eigen::Vector2d>& flat,
+                       const RasterResult& out_raster, const RasterResult& ref_raster, double scale,
+                       const std::vector<cv::Mat>& photos, cv::Mat3b* image, cv::Mat1b* state,
+                       RenderResult* r);
+
 // Per-channel median colour of the page pixels (the paper, on a document).
 cv::Vec3b MedianColour(const cv::Mat3b& image, const cv::Mat1b& state);
 

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <memory>
 #include <opencv2/imgcodecs.hpp>
+#include <optional>
 #include <utility>
 
 #include "common/atomic_file.h"
@@ -167,6 +168,22 @@ Json RenderReport(const RenderOptions& options, const RenderInputs& in, const Re
                     {"agreement", g.agreement},
                     {"used", g.used}});
   doc["other_views"] = regs;
+  Json texture = {{"method", options.texture == Texture::kFusion ? "fusion" : "reference"}};
+  if (options.texture == Texture::kFusion) {
+    Json views = Json::array();
+    for (const FusionViewReport& v : r.texture_views)
+      views.push_back({{"view", v.name},
+                       {"seen", v.seen},
+                       {"share", v.share},
+                       {"gain_bgr", {v.gain[0], v.gain[1], v.gain[2]}},
+                       {"flow_p95_px", v.flow_p95}});
+    texture["views"] = views;
+    texture["unseen_fraction"] = r.texture_unseen;
+    Json steps = Json::object();
+    for (const auto& [step, seconds] : r.texture_timings) steps[step] = seconds;
+    texture["timing_s"] = steps;
+  }
+  doc["texture"] = texture;
   doc["grid_line_step"] = r.grid_line_step;
   Json timing = Json::object();
   double total = 0;
@@ -186,17 +203,20 @@ void WriteRenderOutputs(const fs::path& out_dir, const RenderResult& result, con
   EnsureDirectory(out_dir);
   // A target that exists as something other than a file (a directory in the
   // way) would fail its rename after the others were renamed: refuse first.
-  for (const char* name : {"rectified.png", "rectified_grid.png", "render.json"}) {
+  for (const char* name :
+       {"rectified.png", "rectified_grid.png", "texture_labels.png", "render.json"}) {
     std::error_code ec;
     const fs::path target = out_dir / name;
     if (fs::exists(fs::symlink_status(target, ec)) && !fs::is_regular_file(target, ec))
       throw OutputError(target.string() + ": exists and is not a regular file");
   }
-  // Everything goes to temporary files first; only when all three are
+  // Everything goes to temporary files first; only when all are
   // complete are they renamed into place.
   AtomicOutput rectified(out_dir / "rectified.png");
   AtomicOutput grid(out_dir / "rectified_grid.png");
   AtomicOutput report_file(out_dir / "render.json");
+  std::optional<AtomicOutput> labels;
+  if (!result.texture_labels.empty()) labels.emplace(out_dir / "texture_labels.png");
   // Light PNG compression: the files are large and written on every run.
   const std::vector<int> png = {cv::IMWRITE_PNG_COMPRESSION, 3};
   auto write_image = [&](const AtomicOutput& out, const cv::Mat& image) {
@@ -210,6 +230,7 @@ void WriteRenderOutputs(const fs::path& out_dir, const RenderResult& result, con
   };
   write_image(rectified, result.rectified);
   write_image(grid, result.rectified_grid);
+  if (labels) write_image(*labels, DrawLabels(result.texture_labels));
   {
     // WriteJsonAtomic would commit on its own; write the text by hand.
     FILE* f = std::fopen(report_file.temp_path().c_str(), "wb");
@@ -221,7 +242,11 @@ void WriteRenderOutputs(const fs::path& out_dir, const RenderResult& result, con
   }
   rectified.Commit();
   grid.Commit();
+  if (labels) labels->Commit();
   report_file.Commit();
+  // A label map of an earlier fusion run would describe another image.
+  std::error_code ec;
+  if (!labels) fs::remove(out_dir / "texture_labels.png", ec);
 }
 
 }  // namespace docunfold::render

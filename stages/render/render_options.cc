@@ -75,6 +75,14 @@ void DeclareOptions(OptionTable& table, RenderOptions* o) {
   table.Value("side-snap", &o->side_snap,
               "boundary samples up to this far outside M (fraction of the image diagonal) are "
               "mapped onto the plane of the nearest face");
+  table.Choice("texture", &o->texture,
+               {{"fusion", Texture::kFusion}, {"reference", Texture::kReference}},
+               "fusion: each part of the page from the photo that sees it best (levelled, "
+               "registered, seams where the photos agree); reference: the reference photo alone, "
+               "as the paper renders it");
+  table.Value("reference-preference", &o->fusion.reference_preference, 1.0, 100.0,
+              "fusion: another photo colours a part of the page only where it resolves it this "
+              "many times more finely than the reference photo");
   table.Switch("sample-hidden", &o->sample_hidden,
                "sample the reference image also where it does not see the page");
   table.Choice("shading", &o->shading, {{"keep", Shading::kKeep}, {"remove", Shading::kRemove}},

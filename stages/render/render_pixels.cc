@@ -9,8 +9,8 @@
 
 #include "common/errors.h"
 #include "common/statistics.h"
+#include "common/texture_sampler.h"
 #include "stages/render/render_internal.h"
-#include "stages/render/texture_sampler.h"
 
 namespace docunfold::render {
 namespace {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <ctime>
 #include <fstream>
 #include <map>
@@ -17,6 +18,7 @@
 #include "common/json_io.h"
 #include "common/photo.h"
 #include "common/ply.h"
+#include "common/texture_fusion.h"
 #include "stages/report/html.h"
 #include "stages/report/mesh_views.h"
 #include "stages/report/stage_outputs.h"
@@ -395,9 +397,27 @@ void ResultSection(const ReportOptions& o, const DataSet& data, const fs::path& 
     html +=
         Figure(InlineImage(grid, o.figure_width / 2, "rectified with M'"),
                "The same with the edges of M' (from " + Escape(mesh_dir.filename().string()) + ")");
+  const cv::Mat labels = TryImage(o.work / "60_render/texture_labels.png");
+  const Json render_json = TryJson(o.work / "60_render/render.json");
+  if (!labels.empty() && render_json.is_object() && render_json.contains("texture")) {
+    std::string legend;
+    const Json& views = render_json["texture"].value("views", Json::array());
+    for (size_t v = 0; v < views.size(); ++v) {
+      const cv::Vec3b c = LabelColour(int(v));
+      char hex[8];
+      std::snprintf(hex, sizeof hex, "#%02x%02x%02x", c[2], c[1], c[0]);
+      legend += std::string(v == 0 ? "" : ", ") + "<span style=\"color:" + hex + "\">■</span> " +
+                Escape(views[v].value("view", "?")) + (v == 0 ? " (reference) " : " ") +
+                Fixed(100 * views[v].value("share", 0.0), 1) + " %";
+    }
+    html += Figure(
+        InlineImage(labels, o.figure_width / 2, "texture labels"),
+        "Which photo coloured each part of the page (60_render/texture_labels.png): " + legend +
+            "; grey: no photo sees it (" +
+            Fixed(100 * render_json["texture"].value("unseen_fraction", 0.0), 1) + " %, filled)");
+  }
   const Json lines = TryJson(o.work / "50_optimize/lines.json");
-  const cv::Mat with_lines =
-      DrawFeatureLines(rectified, TryJson(o.work / "60_render/render.json"), lines);
+  const cv::Mat with_lines = DrawFeatureLines(rectified, render_json, lines);
   if (!with_lines.empty())
     html += Figure(InlineImage(with_lines, o.figure_width / 2, "rectified with feature lines"),
                    "The final feature lines of M' (50_optimize/lines.json) over the texture: "

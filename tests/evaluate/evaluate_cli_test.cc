@@ -246,7 +246,7 @@ TEST(BaselineCli, MissingInputsNameTheFile) {
   EXPECT_EQ(r.exit_code, 2) << r.output;
   r = RunCommand(Baseline("--method homography --crop-to-seen" + common));
   EXPECT_EQ(r.exit_code, 2) << r.output;
-  EXPECT_NE(r.output.find("--crop-to-seen applies to --method oracle only"), std::string::npos)
+  EXPECT_NE(r.output.find("--crop-to-seen applies to the oracles only"), std::string::npos)
       << r.output;
 }
 

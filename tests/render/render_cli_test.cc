@@ -79,13 +79,17 @@ TEST_F(RenderCli, WritesTheImagesAndAValidReport) {
   const CommandResult v = RunCommand(Quote((SourceDir() / "scripts/validate-json").string()) + " " +
                                      Quote((out / "render.json").string()));
   EXPECT_EQ(v.exit_code, 0) << v.output;
-  // Nothing but the three outputs (no temporary files left behind).
+  // Nothing but the four outputs (no temporary files left behind).
   int files = 0;
   for (const auto& e : fs::directory_iterator(out)) {
     (void)e;
     ++files;
   }
-  EXPECT_EQ(files, 3);
+  EXPECT_EQ(files, 4);
+  // The label map: which photo coloured each pixel, the size of the page.
+  const cv::Mat labels = cv::imread((out / "texture_labels.png").string());
+  EXPECT_EQ(labels.size(), image.size());
+  EXPECT_EQ(report["texture"]["method"], "fusion");
 }
 
 TEST_F(RenderCli, WidthFlagSetsTheOutputWidth) {

@@ -1,6 +1,6 @@
-// Sampling the reference image for an output pixel whose footprint in the
-// reference image is the parallelogram spanned by the columns of a 2x2
-// Jacobian J (reference pixels per output pixel along output x and y).
+// Sampling a photo for an output pixel whose footprint in the photo is
+// the parallelogram spanned by the columns of a 2x2 Jacobian J (photo pixels per output pixel along
+// output x and y).
 //
 // Magnification (footprint <= 1.25 pixels): one bicubic sample (Keys,
 // a = -0.5). Minification: the footprint is an ellipse with axes
@@ -17,7 +17,7 @@
 
 #include "common/raster.h"
 
-namespace docunfold::render {
+namespace docunfold {
 
 class TextureSampler {
  public:
@@ -26,7 +26,7 @@ class TextureSampler {
   // `image`: 8-bit, 3 channels. Builds pyramid levels down to ~8 pixels.
   explicit TextureSampler(const cv::Mat& image);
 
-  // Colour at reference pixel (u, v) (centres at integers; clamped to the
+  // Colour at photo pixel (u, v) (centres at integers; clamped to the
   // image) for footprint J = [du/dx du/dy; dv/dx dv/dy]. `antialias` false
   // gives plain bicubic whatever J. Returns whether pre-filtering was used.
   bool Sample(float u, float v, const float J[4], bool antialias, float out[3]) const;
@@ -49,4 +49,4 @@ std::vector<Eigen::Matrix<double, 3, 2>> SurfacePerOutputPixel(
     const std::vector<Eigen::Vector3d>& surface, const std::vector<Eigen::Vector2d>& flat,
     const std::vector<Triangle>& triangles, double scale);
 
-}  // namespace docunfold::render
+}  // namespace docunfold

@@ -1,11 +1,11 @@
-#include "stages/render/texture_sampler.h"
+#include "common/texture_sampler.h"
 
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 
-namespace docunfold::render {
+namespace docunfold {
 namespace {
 
 // Keys' cubic convolution kernel with a = -0.5 (Catmull-Rom): interpolating,
@@ -79,7 +79,7 @@ bool TextureSampler::Sample(float u, float v, const float J[4], bool antialias,
     Bicubic(0, u, v, 1, out);
     return false;
   }
-  // Major axis of the footprint in the reference image.
+  // Major axis of the footprint in the photo.
   float ex = 1, ey = 0;
   {
     const float l1 = mean + dev;
@@ -142,4 +142,4 @@ std::vector<Eigen::Matrix<double, 3, 2>> SurfacePerOutputPixel(
   return out;
 }
 
-}  // namespace docunfold::render
+}  // namespace docunfold

@@ -1,0 +1,70 @@
+// Texture fusion in render: M and the output frame handed to
+// common/texture_fusion.h with the reference photo and the other views'.
+#include <opencv2/imgproc.hpp>
+
+#include "common/cli.h"
+#include "stages/render/render_internal.h"
+
+namespace docunfold::render {
+
+std::vector<cv::Mat> ReadViewPhotos(const RenderInputs& in, bool needed) {
+  std::vector<cv::Mat> photos(in.views.size());
+  if (!needed) return photos;
+  for (size_t v = 0; v < in.views.size(); ++v) {
+    const ViewMask& view = in.views[v];
+    if (!view.photo.empty()) photos[v] = ReadViewPhoto(view.photo, view.camera, in.cameras_file);
+  }
+  return photos;
+}
+
+SampleStats FusePixels(const RenderOptions& options, const RenderInputs& in,
+                       const ProjectedMesh& pm, const std::vector<Eigen::Vector2d>& flat,
+                       const RasterResult& out_raster, const RasterResult& ref_raster, double scale,
+                       const std::vector<cv::Mat>& photos, cv::Mat3b* image, cv::Mat1b* state,
+                       RenderResult* r) {
+  const int W = out_raster.face.cols, H = out_raster.face.rows;
+  FusionSurface surface;
+  surface.world = in.meshes.mesh3d;
+  surface.triangles = pm.triangles;
+  surface.width = W;
+  surface.height = H;
+  // The same output pixels as the flat rasterization (FrameOutput).
+  for (const Eigen::Vector2d& q : flat)
+    surface.pixel.emplace_back((q.x() - r->crop_x0) * scale - 0.5,
+                               (q.y() - r->crop_y0) * scale - 0.5);
+  // The reference first: reference.png, undistorted; its outline is where
+  // M comes from, so it needs no mask.
+  std::vector<FusionView> views = {{in.camera, {}, in.reference, {}, in.camera.image}};
+  for (size_t v = 0; v < in.views.size(); ++v)
+    if (!photos[v].empty())
+      views.push_back({in.views[v].camera, in.views[v].distortion, photos[v], in.views[v].mask,
+                       in.views[v].camera.image});
+  FusionOptions fusion = options.fusion;
+  fusion.antialias = options.antialias;
+  FusedTexture fused = FuseTexture(surface, views, fusion);
+  r->texture_timings = fused.timings;
+
+  *image = fused.image;
+  *state = cv::Mat1b(H, W, kOutside);
+  state->setTo(kPage, fused.seen);
+  state->setTo(kHidden, fused.label == kFusionUnseen);
+  SampleStats stats;
+  stats.page = cv::countNonZero(fused.seen);
+  stats.hidden = cv::countNonZero(fused.label == kFusionUnseen);
+  stats.minified = cv::countNonZero(fused.minified);
+  if (options.sample_hidden && stats.hidden > 0) {
+    cv::Mat3b reference_image;
+    cv::Mat1b reference_state;
+    SamplePixels(options, in, pm, flat, out_raster, ref_raster, scale, &reference_image,
+                 &reference_state);
+    const cv::Mat1b sampled = (*state == kHidden) & (reference_state == kHiddenSampled);
+    reference_image.copyTo(*image, sampled);
+    state->setTo(kHiddenSampled, sampled);
+  }
+  r->texture_labels = fused.label;
+  r->texture_views = fused.views;
+  r->texture_unseen = fused.unseen;
+  return stats;
+}
+
+}  // namespace docunfold::render
