@@ -58,6 +58,13 @@ fs::path RealisticDir() {
   return fs::is_directory(p, ec) ? p : fs::path();
 }
 
+fs::path RealisticHardDir() {
+  if (const char* env = std::getenv("DOCUNFOLD_REALISTIC_HARD_DIR")) return env;
+  fs::path p = SourceDir().parent_path() / "shared" / "realistic-hard";
+  std::error_code ec;
+  return fs::is_directory(p, ec) ? p : fs::path();
+}
+
 fs::path E2eDir() { return fs::path(DOCUNFOLD_BIN_DIR).parent_path() / "e2e"; }
 
 std::map<std::string, Json> E2eRows(const std::string& set) {

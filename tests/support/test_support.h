@@ -46,6 +46,8 @@ fs::path SourceDir();
 fs::path SampleDir(const std::string& name);
 // ../shared/realistic relative to the source tree, or "" when absent.
 fs::path RealisticDir();
+// ../shared/realistic-hard (panels past upright, flaps, receipts), or "".
+fs::path RealisticHardDir();
 
 std::string Quote(const std::string& s);
 
