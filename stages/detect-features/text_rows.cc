@@ -15,6 +15,7 @@ constexpr double kMaxTurn = 3.0 * kDegree;   // the joint line against the rows 
 constexpr double kMaxOffset = 0.15;          // of the x-height: rows lie a line apart
 constexpr double kMaxHeightRatio = 1.25;     // one font size: digits against letters
 constexpr int kNeighbours = 8;               // pieces around one that tell the rows' direction
+constexpr double kMaxDrift = 1.5;            // text heights a line may drift over a gap (3 sigma)
 
 double Cross(cv::Point2d u, cv::Point2d v) { return u.x * v.y - u.y * v.x; }
 
@@ -72,11 +73,11 @@ bool Continues(const Group& a, const Group& b, cv::Point2d d, double rows_a, dou
     if (angle > std::max(kMaxAngle, 3 * sigma)) return false;
     // Two short pieces fit some line whatever rows they are on: one of them
     // must tell the direction well enough that its line, carried to the
-    // far end of the other, could not reach the next row (two text heights
-    // or more away) within the angle allowed.
+    // far end of the other, stays short of the next row (two text heights
+    // or more away) within three standard deviations.
     double reach = 0;
     for (const cv::Point2d& p : all) reach = std::max(reach, std::abs((p - centre).dot(d)));
-    direction_known |= 3 * sigma * reach <= x_height;
+    direction_known |= 3 * sigma * reach <= kMaxDrift * x_height;
   }
   if (!direction_known) return false;
   return SplitWhereBent(all, tolerance).size() == 1;
