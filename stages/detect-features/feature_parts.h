@@ -63,6 +63,14 @@ std::vector<std::vector<int>> JoinBaselinePieces(const std::vector<BaselinePiece
                                                  cv::Point2d d, double x_height, double tolerance,
                                                  double max_gap, const GapTest& blank = nullptr);
 
+// A GapTest over `ink`: the band from 2.2 text heights (`x_height`) under
+// the baseline to 0.6 over it (`up`: from the baseline into the letters)
+// crosses no component reaching across the text (direction `d`) farther
+// than 2.5 `char_height` (a column rule) and none long (8 text heights) and
+// thin (0.3) along it (a row rule under the row).
+GapTest BlankGapTest(const InkComponents& ink, cv::Point2d d, cv::Point2d up, double x_height,
+                     double char_height);
+
 // Centre lines of thin dark lines (and, if asked, single step edges) found by
 // LSD in `grey`, inside `region`, that are not character strokes.
 std::vector<Segment> DetectEdgeSegments(const cv::Mat1b& grey, const cv::Mat1b& ink,

@@ -1,7 +1,10 @@
 // Baseline pieces of one text row joined across wide gaps: a receipt's item
-// and its price lie far apart on one baseline, each too short to keep alone.
+// and its price lie far apart on one baseline, each too short to keep alone
+// (docs/decisions/detect-features.md, "Receipt rows joined across their gap").
 #include <algorithm>
 #include <cmath>
+#include <memory>
+#include <opencv2/imgproc.hpp>
 
 #include "common/statistics.h"
 #include "stages/detect-features/feature_parts.h"
@@ -105,6 +108,46 @@ std::vector<double> RowAngles(const std::vector<BaselinePiece>& pieces,
 }
 
 }  // namespace
+
+GapTest BlankGapTest(const InkComponents& ink, cv::Point2d d, cv::Point2d up, double x_height,
+                     double char_height) {
+  // Rules are told from characters by their extent across the text or, along
+  // it, by being long and thin.
+  const cv::Point2d n = up;
+  std::vector<double> a0(size_t(ink.count), 1e300), a1(size_t(ink.count), -1e300);
+  std::vector<double> c0 = a0, c1 = a1;
+  for (int y = 0; y < ink.labels.rows; ++y) {
+    const int* row = ink.labels.ptr<int>(y);
+    for (int x = 0; x < ink.labels.cols; ++x) {
+      if (row[x] == 0) continue;
+      const size_t l = size_t(row[x]);
+      const double a = x * d.x + y * d.y, c = x * n.x + y * n.y;
+      a0[l] = std::min(a0[l], a);
+      a1[l] = std::max(a1[l], a);
+      c0[l] = std::min(c0[l], c);
+      c1[l] = std::max(c1[l], c);
+    }
+  }
+  auto blocks = std::make_shared<std::vector<char>>(size_t(ink.count), 0);
+  for (size_t l = 1; l < size_t(ink.count); ++l) {
+    const double across = c1[l] - c0[l] + 1, along = a1[l] - a0[l] + 1;
+    const double area = ink.stats(int(l), cv::CC_STAT_AREA);
+    (*blocks)[l] =
+        across > 2.5 * char_height || (along > 8 * x_height && area < 0.3 * x_height * along);
+  }
+  const cv::Mat1i& labels = ink.labels;
+  return [blocks, up, x_height, &labels](const cv::Point2d& from, const cv::Point2d& to) {
+    const int steps = std::max(1, int(cv::norm(to - from)));
+    for (double lift = -2.2 * x_height; lift <= 0.6 * x_height; lift += 1.0)
+      for (int k = 0; k <= steps; ++k) {
+        const cv::Point2d p = from + (to - from) * (double(k) / steps) + up * lift;
+        const int x = int(std::lround(p.x)), y = int(std::lround(p.y));
+        if (x < 0 || y < 0 || x >= labels.cols || y >= labels.rows) continue;
+        if ((*blocks)[size_t(labels(y, x))]) return false;
+      }
+    return true;
+  };
+}
 
 std::vector<std::vector<int>> JoinBaselinePieces(const std::vector<BaselinePiece>& pieces,
                                                  cv::Point2d d, double x_height, double tolerance,

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
-#include <memory>
 #include <numeric>
 #include <opencv2/imgproc.hpp>
 
@@ -580,50 +579,6 @@ void AddBaselinePieces(const TextLines& lines, const std::vector<int>& chain, do
   }
 }
 
-// Whether the gap between two points of a baseline (`from`, `to`) is
-// blank: no ink but characters over it (a table's column rule crosses it)
-// and no line along it just under it (a table's row rule: the cells of a
-// row are separate lines). Rules are told from characters by their extent
-// across the text (over 2.5 median character heights) or, along it, by
-// being long (8 text heights) and thin.
-GapTest BlankGapTest(const InkComponents& ink, const TextLines& lines, double h_med, double sign) {
-  const cv::Point2d d = lines.d, n = lines.n;
-  const double x_height = lines.x_height;
-  std::vector<double> a0(size_t(ink.count), 1e300), a1(size_t(ink.count), -1e300);
-  std::vector<double> c0 = a0, c1 = a1;
-  for (int y = 0; y < ink.labels.rows; ++y) {
-    const int* row = ink.labels.ptr<int>(y);
-    for (int x = 0; x < ink.labels.cols; ++x) {
-      if (row[x] == 0) continue;
-      const size_t l = size_t(row[x]);
-      const double a = x * d.x + y * d.y, c = x * n.x + y * n.y;
-      a0[l] = std::min(a0[l], a);
-      a1[l] = std::max(a1[l], a);
-      c0[l] = std::min(c0[l], c);
-      c1[l] = std::max(c1[l], c);
-    }
-  }
-  auto blocks = std::make_shared<std::vector<char>>(size_t(ink.count), 0);
-  for (size_t l = 1; l < size_t(ink.count); ++l) {
-    const double across = c1[l] - c0[l] + 1, along = a1[l] - a0[l] + 1;
-    const double area = ink.stats(int(l), cv::CC_STAT_AREA);
-    (*blocks)[l] = across > 2.5 * h_med || (along > 8 * x_height && area < 0.3 * x_height * along);
-  }
-  const cv::Point2d up = -sign * n;  // from the baseline into the letters
-  const cv::Mat1i& labels = ink.labels;
-  return [blocks, up, x_height, &labels](const cv::Point2d& from, const cv::Point2d& to) {
-    const int steps = std::max(1, int(cv::norm(to - from)));
-    for (double lift = -2.2 * x_height; lift <= 0.6 * x_height; lift += 1.0)
-      for (int k = 0; k <= steps; ++k) {
-        const cv::Point2d p = from + (to - from) * (double(k) / steps) + up * lift;
-        const int x = int(std::lround(p.x)), y = int(std::lround(p.y));
-        if (x < 0 || y < 0 || x >= labels.cols || y >= labels.rows) continue;
-        if ((*blocks)[size_t(labels(y, x))]) return false;
-      }
-    return true;
-  };
-}
-
 // Step 7: one segment per group of pieces (JoinBaselinePieces), fitted to
 // all of their samples, if long enough and chained from enough characters.
 void AddBaselineSegments(const std::vector<BaselinePiece>& pieces,
@@ -700,9 +655,9 @@ TextResult DetectTextSegments(const InkComponents& ink, const FeaturesOptions& o
   // if long enough.
   std::vector<std::vector<int>> groups;
   if (options.row_gap > 0) {
-    groups =
-        JoinBaselinePieces(pieces, lines.d, lines.x_height, tolerance,
-                           options.row_gap * lines.x_height, BlankGapTest(ink, lines, h_med, sign));
+    groups = JoinBaselinePieces(pieces, lines.d, lines.x_height, tolerance,
+                                options.row_gap * lines.x_height,
+                                BlankGapTest(ink, lines.d, -sign * lines.n, lines.x_height, h_med));
   } else {
     for (int k = 0; k < int(pieces.size()); ++k) groups.push_back({k});
   }
