@@ -56,6 +56,9 @@ void DeclareOptions(OptionTable& table, FeaturesOptions* o) {
               "text: judge the bend on the baseline's running median over this many text "
               "heights either way (0 = on every sample)");
   table.Value("max-gap", &o->max_gap, 0.1, 10.0, "text: largest gap chained, in text heights");
+  table.Value("row-gap", &o->row_gap, 0.0, 1000.0,
+              "text: join straight pieces of one baseline across gaps up to this many text "
+              "heights (a receipt's item and price); 0 = off");
   table.Value("min-text-length", &o->min_text_length, 0.0, 1000.0,
               "text: shortest segment, in text heights");
   table.Value("min-length", &o->min_length_px, 0.0, 10000.0, "shortest segment of any kind (px)");

@@ -43,6 +43,9 @@ struct FeaturesOptions {
   double bend_window = 1.0;
   // Text: neighbours are chained across gaps up to this many text heights.
   double max_gap = 1.0;
+  // Text: straight pieces of one baseline are joined across blank gaps up
+  // to this many text heights (a receipt's item and its price); 0 = off.
+  double row_gap = 60.0;
   // Shortest segment kept, in text heights (text) or pixels (both).
   double min_text_length = 5.0;
   double min_length_px = 20.0;

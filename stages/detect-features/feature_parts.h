@@ -2,6 +2,7 @@
 // to the stage; tests may call them).
 #pragma once
 
+#include <functional>
 #include <opencv2/core.hpp>
 #include <vector>
 
@@ -36,6 +37,39 @@ struct TextResult {
   std::vector<char> is_character;  // per component label: chained as text
 };
 TextResult DetectTextSegments(const InkComponents& ink, const FeaturesOptions& options);
+
+// A straight piece of one chain's baseline, before the shortest are left
+// out: pieces of one row may still be joined across a wide gap.
+struct BaselinePiece {
+  std::vector<cv::Point2d> samples;  // the baseline points its line is fitted to
+  cv::Point2d first, last;           // its ends on the baseline, in text order
+  int characters = 0;
+  double height = 0;  // its tallest character across the line (px)
+  int chain = 0;      // which chain of characters it is a piece of
+};
+
+// Groups of pieces (indices, in text order) that continue one straight
+// baseline across gaps of up to `max_gap` pixels: about the same character
+// height, one line fitted to all of their samples within half `tolerance`
+// (RMS), each group's own direction within about 1 degree of it, no bend
+// beyond `tolerance` (SplitWhereBent) and no offset beyond a small fraction
+// of `x_height` (the next row lies a whole line away). Pieces joined to
+// nothing come back as groups of one. `d`: the text direction (unit).
+// `blank`, if given, tells whether the gap between two baseline points is
+// free of ink other than characters (a table's column rule crosses it: the
+// cells of a row are separate lines).
+using GapTest = std::function<bool(const cv::Point2d& from, const cv::Point2d& to)>;
+std::vector<std::vector<int>> JoinBaselinePieces(const std::vector<BaselinePiece>& pieces,
+                                                 cv::Point2d d, double x_height, double tolerance,
+                                                 double max_gap, const GapTest& blank = nullptr);
+
+// A GapTest over `ink`: the band from 2.2 text heights (`x_height`) under
+// the baseline to 0.6 over it (`up`: from the baseline into the letters)
+// crosses no component reaching across the text (direction `d`) farther
+// than 2.5 `char_height` (a column rule) and none long (8 text heights) and
+// thin (0.3) along it (a row rule under the row).
+GapTest BlankGapTest(const InkComponents& ink, cv::Point2d d, cv::Point2d up, double x_height,
+                     double char_height);
 
 // Centre lines of thin dark lines (and, if asked, single step edges) found by
 // LSD in `grey`, inside `region`, that are not character strokes.

@@ -526,16 +526,18 @@ int BaselineSide(const InkComponents& ink, const TextLines& lines, TextResult* r
 }
 
 // Step 6, for one chain: the outline on the baseline side (`sign`),
-// descenders and raised parts dropped, cut where it bends, fitted piece by
-// piece; appends the pieces long enough to `segments`.
-void AddBaselineSegments(const TextLines& lines, const std::vector<int>& chain, double sign,
-                         const FeaturesOptions& options, std::vector<Segment>* segments) {
+// descenders and raised parts dropped, cut where it bends; appends the
+// straight pieces to `pieces` (short ones too: a piece may continue
+// another across a gap).
+void AddBaselinePieces(const TextLines& lines, const std::vector<int>& chain, double sign,
+                       double tolerance, const FeaturesOptions& options,
+                       std::vector<BaselinePiece>* pieces) {
   const cv::Point2d d = lines.d, n = lines.n;
   const double x_height = lines.x_height;
-  const double tolerance = std::max(options.bend_px, options.bend_rel * x_height);
-  const double min_length = std::max(options.min_length_px, options.min_text_length * x_height);
   const std::vector<Sample> samples = Outline(lines, chain, sign);
-  if (samples.size() < 5) return;
+  // Fewer than 5 make no segment alone, but a price of a few digits may
+  // continue its item's baseline.
+  if (samples.size() < (options.row_gap > 0 ? 3u : 5u)) return;
   const std::vector<double> off = Offsets(samples, 3 * x_height);
   const double band = 0.2 * x_height + 0.5;
   std::vector<Sample> kept_samples;
@@ -561,19 +563,43 @@ void AddBaselineSegments(const TextLines& lines, const std::vector<int>& chain, 
     // Each piece's line is fitted to its samples within half the tolerance
     // of the running median: the few farther off (serifs, a descender's
     // stub) would tilt it.
-    std::vector<cv::Point2d> piece;
+    BaselinePiece piece;
     for (int k = first; k <= last; ++k)
-      if (std::abs(noise[size_t(k)]) <= 0.5 * tolerance) piece.push_back(kept[size_t(k)]);
+      if (std::abs(noise[size_t(k)]) <= 0.5 * tolerance) piece.samples.push_back(kept[size_t(k)]);
+    for (int k = first; k <= last; ++k) {
+      piece.characters += k == first || kept_mark[size_t(k)] != kept_mark[size_t(k - 1)];
+      piece.height = std::max(piece.height, lines.marks[size_t(kept_mark[size_t(k)])].height());
+    }
+    if (piece.samples.size() < 3 || piece.characters < 2) continue;
+    if (FitLine(piece.samples).rms > 0.5 * tolerance) continue;
+    piece.chain = chain.front();
+    piece.first = kept[size_t(first)];
+    piece.last = kept[size_t(last)];
+    pieces->push_back(std::move(piece));
+  }
+}
+
+// Step 7: one segment per group of pieces (JoinBaselinePieces), fitted to
+// all of their samples, if long enough and chained from enough characters.
+void AddBaselineSegments(const std::vector<BaselinePiece>& pieces,
+                         const std::vector<std::vector<int>>& groups, double tolerance,
+                         double min_length, std::vector<Segment>* segments) {
+  for (const std::vector<int>& group : groups) {
+    std::vector<cv::Point2d> samples;
     int characters = 0;
-    for (int k = first; k <= last; ++k)
-      characters += k == first || kept_mark[size_t(k)] != kept_mark[size_t(k - 1)];
-    if (piece.size() < 5 || characters < 3) continue;
-    const LineFit fit = FitLine(piece);
+    for (int k : group) {
+      samples.insert(samples.end(), pieces[size_t(k)].samples.begin(),
+                     pieces[size_t(k)].samples.end());
+      characters += pieces[size_t(k)].characters;
+    }
+    if (samples.size() < 5 || characters < 3) continue;
+    const LineFit fit = FitLine(samples);
     if (fit.rms > 0.5 * tolerance) continue;
     auto project = [&](const cv::Point2d& p) {
       return fit.point + fit.direction * (p - fit.point).dot(fit.direction);
     };
-    const cv::Point2d p0 = project(kept[size_t(first)]), p1 = project(kept[size_t(last)]);
+    const cv::Point2d p0 = project(pieces[size_t(group.front())].first);
+    const cv::Point2d p1 = project(pieces[size_t(group.back())].last);
     if (cv::norm(p1 - p0) < min_length) continue;
     segments->push_back({"text", {p0, p1}, characters});
   }
@@ -616,12 +642,28 @@ TextResult DetectTextSegments(const InkComponents& ink, const FeaturesOptions& o
   // Upside down: the baselines lie on the image-up side of their letters.
   result.upside_down = side != 0 && sign * lines.n.y < 0;
 
-  // 6. Baselines, cut where they bend and fitted piece by piece.
+  // 6. Baselines, cut where they bend into straight pieces.
+  const double tolerance = std::max(options.bend_px, options.bend_rel * lines.x_height);
+  std::vector<BaselinePiece> pieces;
   for (const auto& chain : lines.chains) {
     for (int k : chain) result.is_character[size_t(marks[k].label)] = 1;
     if (!result.orientation_known) continue;
-    AddBaselineSegments(lines, chain, sign, options, &result.segments);
+    AddBaselinePieces(lines, chain, sign, tolerance, options, &pieces);
   }
+
+  // 7. Pieces of one row joined across wide gaps, then fitted and kept
+  // if long enough.
+  std::vector<std::vector<int>> groups;
+  if (options.row_gap > 0) {
+    groups = JoinBaselinePieces(pieces, lines.d, lines.x_height, tolerance,
+                                options.row_gap * lines.x_height,
+                                BlankGapTest(ink, lines.d, -sign * lines.n, lines.x_height, h_med));
+  } else {
+    for (int k = 0; k < int(pieces.size()); ++k) groups.push_back({k});
+  }
+  const double min_length =
+      std::max(options.min_length_px, options.min_text_length * lines.x_height);
+  AddBaselineSegments(pieces, groups, tolerance, min_length, &result.segments);
   return result;
 }
 

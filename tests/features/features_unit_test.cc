@@ -3,6 +3,7 @@
 // kept out; bad masks; and the geometric helpers.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -194,6 +195,7 @@ TEST(DetectFeatures, PixelNoiseDoesNotCutSmallSlantedText) {
   auto measure = [&](double window) {
     FeaturesOptions options;
     options.bend_window = window;
+    options.row_gap = 0;  // joining the words of a line would mend the cuts measured here
     double length = 0;
     for (const Segment& s : DetectFeatures(photo, mask, options).segments) {
       if (s.kind != "text") continue;
@@ -247,6 +249,133 @@ TEST(FeatureHelpers, FitLineRecoversALine) {
   const detail::LineFit fit = detail::FitLine(pts);
   EXPECT_NEAR(std::abs(fit.direction.y / fit.direction.x), 0.5, 1e-3);
   EXPECT_NEAR(fit.rms, 0.2 / std::sqrt(1.25), 0.02);
+}
+
+// A receipt: items on the left, prices on the right, a wide blank gap
+// between them on each row's baseline.
+Page DrawReceipt() {
+  static const char* kItems[] = {"Butter", "Cheese",  "Bread", "Apples",  "Tomatoes", "Coffee",
+                                 "Pasta",  "Yoghurt", "Soap",  "Milk 1L", "Rice 2kg", "Tea"};
+  static const char* kPrices[] = {"5.54",  "12.37", "3.10", "7.69",  "14.03", "9.75",
+                                  "10.81", "2.95",  "6.08", "11.52", "4.47",  "8.16"};
+  Page p;
+  p.image = cv::Mat3b(600, 1000, cv::Vec3b(90, 90, 90));
+  p.mask = cv::Mat1b::zeros(p.image.size());
+  const cv::Rect page(100, 40, 800, 520);
+  p.mask(page).setTo(255);
+  p.image(page).setTo(cv::Scalar(240, 240, 240));
+  for (int k = 0; k < 12; ++k) {
+    const int y = 90 + 36 * k;
+    cv::putText(p.image, kItems[k], {160, y}, cv::FONT_HERSHEY_COMPLEX, 0.7, cv::Scalar(20, 20, 20),
+                1, cv::LINE_AA);
+    int base = 0;
+    const cv::Size size = cv::getTextSize(kPrices[k], cv::FONT_HERSHEY_COMPLEX, 0.7, 1, &base);
+    cv::putText(p.image, kPrices[k], {840 - size.width, y}, cv::FONT_HERSHEY_COMPLEX, 0.7,
+                cv::Scalar(20, 20, 20), 1, cv::LINE_AA);
+    p.baselines.push_back(y);
+  }
+  return p;
+}
+
+// Text segments reaching from the items (left of x = 300) to the prices
+// (right of x = 760); every text segment must lie on a baseline.
+int WholeRows(const FeaturesResult& r, const std::vector<double>& baselines) {
+  int whole = 0;
+  for (const Segment& s : r.segments) {
+    if (s.kind != "text") continue;
+    const double x0 = std::min(s.points.front().x, s.points.back().x);
+    const double x1 = std::max(s.points.front().x, s.points.back().x);
+    // Antialiased strokes reach about a pixel past putText's baseline, this
+    // font's digits half a pixel farther than its letters; 2 px is what
+    // evaluate counts as on a line.
+    EXPECT_LE(WorstOffset(s, baselines), 2.0);
+    whole += x0 < 300 && x1 > 760;
+  }
+  return whole;
+}
+
+// Most of the 12 rows come out whole; a short item whose few letters do not
+// tell its direction ("Tea") may stay apart from its price.
+TEST(DetectFeatures, ReceiptRowsAreJoinedAcrossTheirGap) {
+  const Page p = DrawReceipt();
+  EXPECT_GE(WholeRows(DetectFeatures(p.image, p.mask, {}), p.baselines), 9);
+  FeaturesOptions unjoined;
+  unjoined.row_gap = 0;
+  EXPECT_EQ(WholeRows(DetectFeatures(p.image, p.mask, unjoined), p.baselines), 0);
+}
+
+TEST(DetectFeatures, ReceiptRowsTurnedAQuarterAreJoinedToo) {
+  // Receipts are often photographed across: turned clockwise, a row runs
+  // down the image. The segments are turned back to compare.
+  const Page p = DrawReceipt();
+  cv::Mat3b image;
+  cv::Mat1b mask;
+  cv::rotate(p.image, image, cv::ROTATE_90_CLOCKWISE);
+  cv::rotate(p.mask, mask, cv::ROTATE_90_CLOCKWISE);
+  FeaturesResult r = DetectFeatures(image, mask, {});
+  for (Segment& s : r.segments)
+    for (cv::Point2d& q : s.points) q = {q.y, p.image.rows - 1 - q.x};
+  EXPECT_GE(WholeRows(r, p.baselines), 9);
+}
+
+TEST(DetectFeatures, ARuleAcrossTheGapKeepsATableRowsCellsApart) {
+  Page p = DrawReceipt();
+  cv::line(p.image, {500, 60}, {500, 520}, cv::Scalar(30, 30, 30), 2);  // a column rule
+  EXPECT_EQ(WholeRows(DetectFeatures(p.image, p.mask, {}), p.baselines), 0);
+}
+
+// A piece of a baseline as JoinBaselinePieces takes it: samples every 4 px
+// from x0 to x1 on y = y0 + slope * (x - x0), a quarter pixel up and down
+// in turn (the pixel grid).
+detail::BaselinePiece Piece(double x0, double x1, double y0, double slope, int chain) {
+  detail::BaselinePiece piece;
+  for (double x = x0; x <= x1; x += 4)
+    piece.samples.emplace_back(x, y0 + slope * (x - x0) + (int(x) % 8 ? 0.25 : -0.25));
+  piece.first = piece.samples.front();
+  piece.last = piece.samples.back();
+  piece.characters = int((x1 - x0) / 10);
+  piece.height = 16;
+  piece.chain = chain;
+  return piece;
+}
+
+// Text 12 px high (x-height), tolerance 1.5 px, gaps up to 60 text heights.
+std::vector<std::vector<int>> Join(const std::vector<detail::BaselinePiece>& pieces) {
+  return detail::JoinBaselinePieces(pieces, {1, 0}, 12, 1.5, 60 * 12);
+}
+
+TEST(FeatureHelpers, RowJoinBridgesAWideGapOnOneBaseline) {
+  // "Butter" and "5.54": 60 and 40 px long, 340 px apart, on a line sloping
+  // by 1 degree.
+  const double slope = std::tan(CV_PI / 180);
+  const auto groups =
+      Join({Piece(100, 160, 200, slope, 0), Piece(500, 540, 200 + 400 * slope, slope, 1)});
+  ASSERT_EQ(groups.size(), 1u);
+  EXPECT_EQ(groups[0], (std::vector<int>{0, 1}));
+}
+
+TEST(FeatureHelpers, RowJoinKeepsRowsApart) {
+  // The next row's price, 2.2 text heights lower, continues no item alone;
+  // with both rows there, each item takes its own price.
+  EXPECT_EQ(Join({Piece(100, 160, 200, 0, 0), Piece(500, 540, 226.4, 0, 1)}).size(), 2u);
+  auto groups = Join({Piece(100, 160, 200, 0, 0), Piece(100, 148, 226.4, 0, 1),
+                      Piece(500, 540, 200, 0, 2), Piece(492, 540, 226.4, 0, 3)});
+  std::sort(groups.begin(), groups.end());
+  ASSERT_EQ(groups.size(), 2u);
+  EXPECT_EQ(groups[0], (std::vector<int>{0, 2}));
+  EXPECT_EQ(groups[1], (std::vector<int>{1, 3}));
+}
+
+TEST(FeatureHelpers, RowJoinDoesNotBridgeACrease) {
+  // A crease in the gap at x = 330: beyond it the row turns by 3 degrees,
+  // its two parts meeting there. One line through both pieces fits each
+  // closely, but turns against the item by half the kink.
+  const double turn = std::tan(3 * CV_PI / 180);
+  const auto groups =
+      Join({Piece(100, 160, 200, 0, 0), Piece(500, 540, 200 + 170 * turn, turn, 1)});
+  EXPECT_EQ(groups.size(), 2u);
+  // Pieces of one chain were cut apart by the bend test: never joined back.
+  EXPECT_EQ(Join({Piece(100, 160, 200, 0, 0), Piece(164, 240, 200, 0, 0)}).size(), 2u);
 }
 
 }  // namespace
