@@ -1,13 +1,21 @@
 #include "stages/synth/folds.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <numeric>
+#include <stdexcept>
+#include <string>
+#include <unordered_map>
 
 namespace docunfold::synth {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
+// Sampling of the self-intersection test (metres): fine enough for the arc of
+// a 3 mm crease turned by 180 degrees (radius 1 mm) to keep its layers apart.
+constexpr double kContactSpacing = 0.0015;
 
 Eigen::Vector2d Perp(const Eigen::Vector2d& d) { return {-d.y(), d.x()}; }
 
@@ -71,8 +79,12 @@ FoldedSheet::FoldedSheet(double width_m, double height_m, std::vector<Fold> fold
           far_area[i] += 1;
   order_.resize(folds_.size());
   std::iota(order_.begin(), order_.end(), 0);
-  std::stable_sort(order_.begin(), order_.end(),
-                   [&](int a, int b) { return far_area[a] > far_area[b]; });
+  // Narrow folds beside an end (an end curl's strips) can tie on the sampled
+  // area; the one farther from the root is then the farther out.
+  std::stable_sort(order_.begin(), order_.end(), [&](int a, int b) {
+    if (far_area[a] != far_area[b]) return far_area[a] > far_area[b];
+    return -Side(a, root) < -Side(b, root);
+  });
 
   for (size_t i = 0; i < folds_.size(); ++i) {
     const Fold& f = folds_[i];
@@ -126,20 +138,34 @@ Eigen::Vector3d FoldedSheet::Map(const Eigen::Vector2d& uv) const {
   return x;
 }
 
-std::vector<Fold> RandomFolds(double W, double H, const FoldOptions& options, std::mt19937* rng) {
+std::vector<Fold> RandomFolds(double W, double H, const FoldOptions& options, std::mt19937* rng,
+                              const std::vector<Fold>& fixed) {
   std::uniform_real_distribution<double> uni(0, 1);
   auto range = [&](double lo, double hi) { return lo + (hi - lo) * uni(*rng); };
   const Eigen::Vector2d centre(W / 2, H / 2);
   const int wanted = options.creases + (options.curl ? 1 : 0);
-  if (wanted == 0) return {};
+  // Up to max_total_angle no path turns far enough for the sheet to meet
+  // itself; beyond it (a flap, a steep panel) only a test of the folded
+  // sheet can tell.
+  const bool check_contact = !fixed.empty() || options.crease_angle_max > options.max_total_angle;
+  const double max_total = std::max(options.max_total_angle, options.crease_angle_max);
+  if (wanted == 0) {
+    if (fixed.empty()) return {};
+    return SelfIntersects(FoldedSheet(W, H, fixed), kContactSpacing) ? std::vector<Fold>{} : fixed;
+  }
+  std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> fixed_segments;
+  for (const Fold& f : fixed) {
+    const auto [lo, hi] = ClipToSheet(f.point, f.direction, W, H);
+    fixed_segments.emplace_back(f.point + lo * f.direction, f.point + hi * f.direction);
+  }
 
   for (int attempt = 0; attempt < 2000; ++attempt) {
     // A dominant direction: usually along a page side (a letter folded in
     // thirds), sometimes anything.
     double base = uni(*rng) < 0.6 ? (uni(*rng) < 0.5 ? 0.0 : kPi / 2) : range(0, kPi);
     base += range(-0.15, 0.15);
-    std::vector<Fold> folds;
-    std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> segments;
+    std::vector<Fold> folds = fixed;
+    std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> segments = fixed_segments;
     bool ok = true;
     for (int k = 0; k < wanted && ok; ++k) {
       const bool is_curl = options.curl && k == wanted - 1;
@@ -190,17 +216,170 @@ std::vector<Fold> RandomFolds(double W, double H, const FoldOptions& options, st
       for (int b = 0; b < 24 && !too_much; ++b) {
         const Eigen::Vector2d p((a + 0.5) / 24 * W, (b + 0.5) / 24 * H);
         double total = 0;
-        for (const Fold& f : folds) {
+        for (size_t k = fixed.size(); k < folds.size(); ++k) {
+          const Fold& f = folds[k];
           Eigen::Vector2d n = Perp(f.direction);
           if (n.dot(centre - f.point) > 0) n = -n;
           if (n.dot(p - f.point) > 0) total += f.angle;
         }
-        too_much = std::abs(total) * 180 / kPi > options.max_total_angle;
+        too_much = std::abs(total) * 180 / kPi > max_total;
       }
     if (too_much) continue;
+    if (check_contact && SelfIntersects(sheet, kContactSpacing)) continue;
     return folds;
   }
   return {};  // the caller reports that no valid folds were found
+}
+
+namespace {
+
+// Whether segment a-b crosses triangle p0 p1 p2 (Moller-Trumbore); a segment
+// in the triangle's plane does not count (flat panels are coplanar with
+// themselves).
+bool SegmentCrosses(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& p0,
+                    const Eigen::Vector3d& p1, const Eigen::Vector3d& p2) {
+  const Eigen::Vector3d d = b - a, e1 = p1 - p0, e2 = p2 - p0;
+  const Eigen::Vector3d h = d.cross(e2);
+  const double det = e1.dot(h);
+  if (std::abs(det) <= 1e-9 * d.norm() * e1.norm() * e2.norm()) return false;
+  const Eigen::Vector3d s = a - p0;
+  const double u = s.dot(h) / det;
+  if (u < 0 || u > 1) return false;
+  const Eigen::Vector3d q = s.cross(e1);
+  const double v = d.dot(q) / det;
+  if (v < 0 || u + v > 1) return false;
+  const double t = e2.dot(q) / det;
+  return t > 0 && t < 1;
+}
+
+}  // namespace
+
+bool SelfIntersects(const FoldedSheet& sheet, double spacing) {
+  const int nx = std::max(2, int(std::ceil(sheet.width() / spacing)) + 1);
+  const int ny = std::max(2, int(std::ceil(sheet.height() / spacing)) + 1);
+  std::vector<Eigen::Vector3d> p;
+  for (int r = 0; r < ny; ++r)
+    for (int c = 0; c < nx; ++c)
+      p.push_back(sheet.Map({sheet.width() * c / (nx - 1), sheet.height() * r / (ny - 1)}));
+  std::vector<std::array<int, 3>> triangles;
+  for (int r = 0; r + 1 < ny; ++r)
+    for (int c = 0; c + 1 < nx; ++c) {
+      const int a = r * nx + c, b = a + 1, d = a + nx, e = d + 1;
+      triangles.push_back({a, b, e});
+      triangles.push_back({a, e, d});
+    }
+  // Triangles binned by their bounding boxes in a uniform grid of cells.
+  Eigen::Vector3d lo = p[0];
+  for (const Eigen::Vector3d& x : p) lo = lo.cwiseMin(x);
+  const double cell = 2 * spacing;
+  auto index = [&](const Eigen::Vector3d& x) {
+    return Eigen::Vector3i(int((x.x() - lo.x()) / cell), int((x.y() - lo.y()) / cell),
+                           int((x.z() - lo.z()) / cell));
+  };
+  auto key = [](int i, int j, int k) {
+    return (int64_t(i) << 42) | (int64_t(j) << 21) | int64_t(k);
+  };
+  auto for_cells = [&](const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
+                       auto&& visit) {
+    const Eigen::Vector3i i0 = index(a.cwiseMin(b).cwiseMin(c)),
+                          i1 = index(a.cwiseMax(b).cwiseMax(c));
+    for (int i = i0.x(); i <= i1.x(); ++i)
+      for (int j = i0.y(); j <= i1.y(); ++j)
+        for (int k = i0.z(); k <= i1.z(); ++k) visit(key(i, j, k));
+  };
+  std::unordered_map<int64_t, std::vector<int>> bins;
+  for (size_t t = 0; t < triangles.size(); ++t) {
+    const auto& T = triangles[t];
+    for_cells(p[T[0]], p[T[1]], p[T[2]], [&](int64_t k) { bins[k].push_back(int(t)); });
+  }
+  // Every edge against the triangles near it that share none of its ends.
+  for (const auto& T : triangles)
+    for (int e = 0; e < 3; ++e) {
+      const int i = T[e], j = T[(e + 1) % 3];
+      bool crossing = false;
+      for_cells(p[i], p[j], p[j], [&](int64_t k) {
+        auto it = bins.find(k);
+        if (crossing || it == bins.end()) return;
+        for (int t : it->second) {
+          const auto& U = triangles[t];
+          if (U[0] == i || U[1] == i || U[2] == i || U[0] == j || U[1] == j || U[2] == j) continue;
+          if (SegmentCrosses(p[i], p[j], p[U[0]], p[U[1]], p[U[2]])) {
+            crossing = true;
+            return;
+          }
+        }
+      });
+      if (crossing) return true;
+    }
+  return false;
+}
+
+std::vector<Fold> ShapeFolds(double W, double H, const ShapeOptions& shapes,
+                             const FoldOptions& folds, std::mt19937* rng) {
+  std::vector<Fold> out;
+  if (!shapes.any()) return out;
+  std::uniform_real_distribution<double> uni(0, 1);
+  auto range = [&](double lo, double hi) { return lo + (hi - lo) * uni(*rng); };
+  auto crease_width = [&] {
+    return range(folds.crease_width_min, std::max(folds.crease_width_min, folds.crease_width_max));
+  };
+  const bool curl_top = shapes.end_curl == PageEnd::kTop || shapes.end_curl == PageEnd::kBoth;
+  const bool curl_bottom = shapes.end_curl == PageEnd::kBottom || shapes.end_curl == PageEnd::kBoth;
+  bool free_end[2] = {!curl_top, !curl_bottom};  // top, bottom
+  // Each shape needs an end of its own, or their strips would cross.
+  auto take_end = [&](const char* what) {
+    if (!free_end[0] && !free_end[1])
+      throw std::invalid_argument(std::string(what) + " needs an end of the page that " +
+                                  "no other shape uses");
+    const int e = free_end[0] && free_end[1] ? (uni(*rng) < 0.5 ? 0 : 1) : (free_end[0] ? 0 : 1);
+    free_end[e] = false;
+    return e;
+  };
+  // A fold across the page at `distance` from end e (0 top, 1 bottom),
+  // turned by `tilt` radians; its far side is the end.
+  auto across = [&](int e, double distance, double tilt, double width, double angle_deg) {
+    Fold f;
+    f.point = {W / 2, e == 0 ? distance : H - distance};
+    f.direction = {std::cos(tilt), std::sin(tilt)};
+    f.width = width;
+    f.angle = kTowardsPrint * angle_deg * kPi / 180;
+    return f;
+  };
+  // An end curl: adjacent strips up to the edge, each bent more than the one
+  // before, so that the curvature grows towards the end as a roll's does.
+  const int strips = 6;
+  const double length = std::min(shapes.end_curl_length, 0.4 * H);
+  for (int e = 0; e < 2; ++e) {
+    if (!(e == 0 ? curl_top : curl_bottom)) continue;
+    for (int i = 0; i < strips; ++i)
+      out.push_back(across(e, length * (1 - (i + 0.5) / strips), 0, length / strips,
+                           shapes.end_curl_angle * (i + 1) / (strips * (strips + 1) / 2)));
+  }
+  if (shapes.steep_angle > 0) {
+    const int e = take_end("--steep-fold");
+    out.push_back(
+        across(e, range(0.18, 0.3) * H, range(-0.08, 0.08), crease_width(), shapes.steep_angle));
+  }
+  if (shapes.flap == Flap::kEnd) {
+    const int e = take_end("--flap end");
+    out.push_back(
+        across(e, range(0.1, 0.2) * H, range(-0.1, 0.1), crease_width(), shapes.flap_angle));
+  } else if (shapes.flap == Flap::kCorner) {
+    const int e = take_end("--flap corner");
+    const bool left = uni(*rng) < 0.5;
+    const double a = range(0.3, 0.55) * W;
+    const double b = std::min(a * range(0.8, 1.25), 0.4 * H);
+    const Eigen::Vector2d corner(left ? 0 : W, e == 0 ? 0 : H);
+    const Eigen::Vector2d p1 = corner + Eigen::Vector2d(left ? a : -a, 0);
+    const Eigen::Vector2d p2 = corner + Eigen::Vector2d(0, e == 0 ? b : -b);
+    Fold f;
+    f.point = (p1 + p2) / 2;
+    f.direction = (p2 - p1).normalized();
+    f.width = crease_width();
+    f.angle = kTowardsPrint * shapes.flap_angle * kPi / 180;
+    out.push_back(f);
+  }
+  return out;
 }
 
 }  // namespace docunfold::synth

@@ -54,8 +54,45 @@ struct FoldOptions {
 };
 
 // Random non-crossing folds for a sheet; deterministic for the generator's
-// state. Lines keep their strips apart and stay away from the corners.
+// state. Lines keep their strips apart and stay away from the corners. The
+// result begins with `fixed` (folds the caller placed: a flap, a steep end,
+// an end curl), which the random creases keep clear of. With fixed folds or
+// creases over max_total_angle, a fold set is kept only if the folded sheet
+// does not pass through itself (SelfIntersects); a crease over
+// max_total_angle raises the limit on any path to its angle.
 std::vector<Fold> RandomFolds(double width_m, double height_m, const FoldOptions& options,
-                              std::mt19937* rng);
+                              std::mt19937* rng, const std::vector<Fold>& fixed = {});
+
+// Whether the folded sheet, sampled as a triangle mesh at `spacing` metres,
+// passes through itself: an edge of one triangle crossing another triangle
+// that shares no vertex with it.
+bool SelfIntersects(const FoldedSheet& sheet, double spacing);
+
+// Printed-side conventions of FoldedSheet: the printed side of the flat sheet
+// faces -z (d/dv x d/du), so a fold with a negative angle turns its far side
+// towards the print: up off the table once the sheet is placed print up.
+constexpr double kTowardsPrint = -1;
+
+enum class Flap { kNone, kCorner, kEnd };
+enum class PageEnd { kNone, kTop, kBottom, kBoth };
+
+// Shapes that docunfold finds hard, placed on purpose rather than at random.
+// Ends are the short sides' ends of the page: top (v = 0) and bottom (v = H).
+struct ShapeOptions {
+  Flap flap = Flap::kNone;  // a corner or an end folded back over the page
+  double flap_angle = 176;  // degrees; 180 lies flat on the page
+  double steep_angle = 0;   // degrees; > 0 adds a crease near an end bent up by it
+  PageEnd end_curl = PageEnd::kNone;
+  double end_curl_length = 0.035;  // metres of the page that curl
+  double end_curl_angle = 150;     // degrees the end turns, in all
+  bool any() const { return flap != Flap::kNone || steep_angle > 0 || end_curl != PageEnd::kNone; }
+};
+
+// The folds of `shapes` for a W x H sheet (random sizes and ends from the
+// generator; nothing drawn when shapes.any() is false). Each bends towards
+// the print. Crease widths come from `folds`. Throws std::invalid_argument
+// when the shapes need more ends than the page has.
+std::vector<Fold> ShapeFolds(double width_m, double height_m, const ShapeOptions& shapes,
+                             const FoldOptions& folds, std::mt19937* rng);
 
 }  // namespace docunfold::synth

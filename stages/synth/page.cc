@@ -132,9 +132,7 @@ class Typesetter {
   void Text(const std::string& style, double size_pt, const std::string& text, double u, double v,
             const cv::Scalar& colour, bool same_line = false) {
     if (text.find_first_not_of(' ') == std::string::npos) return;
-    const int h = std::max(1, Px(size_pt * kMetresPerPoint));
-    Font(style)->putText(page_->image, text, cv::Point(Px(u), Px(v)), h, colour, -1, cv::LINE_AA,
-                         true);
+    Ink(style, size_pt, text, u, v, colour);
     const double w = Width(style, size_pt, text);
     // The baseline runs under the inked characters, not the leading spaces.
     const size_t first = text.find_first_not_of(' ');
@@ -144,6 +142,14 @@ class Typesetter {
       page_->text.back() += "  " + text.substr(first);
     else
       page_->text.push_back(text.substr(first));
+  }
+
+  // Draws `text` only (no ground truth).
+  void Ink(const std::string& style, double size_pt, const std::string& text, double u, double v,
+           const cv::Scalar& colour) {
+    const int h = std::max(1, Px(size_pt * kMetresPerPoint));
+    Font(style)->putText(page_->image, text, cv::Point(Px(u), Px(v)), h, colour, -1, cv::LINE_AA,
+                         true);
   }
 
   void Rule(double u0, double v0, double u1, double v1, double thickness_m,
@@ -349,6 +355,143 @@ void DrawReceipt(Typesetter& ts, Page& page, std::mt19937* rng) {
           ink);
 }
 
+// Prints monospaced rows down a till roll: every row `columns` characters
+// from `left`, so that spaces right-align prices as a till does.
+struct RollPrinter {
+  Typesetter& ts;
+  cv::Scalar ink;
+  double left, size, line_h;
+  int columns;
+  double v;
+
+  // A row in characters `columns / cols` times as large as the body's
+  // (cols: the row's width in those characters); bold is struck twice a
+  // dot apart, as a thermal till's emphasis is, in the same face.
+  void Row(const std::string& text, bool bold = false, int cols = 0) {
+    const double scale = cols > 0 ? double(columns) / cols : 1;
+    v += line_h * (scale - 1);
+    if (bold) ts.Ink("mono", size * scale, text, left + 0.000125, v, ink);
+    ts.Text("mono", size * scale, text, left, v, ink);
+    v += line_h;
+  }
+  void Centre(const std::string& text, bool bold = false, int cols = 0) {
+    const int width = cols > 0 ? cols : columns;
+    Row(std::string(std::max(0, (width - int(text.size())) / 2), ' ') + text, bold, cols);
+  }
+  // `name` at the left, `amount` ending in the last column.
+  void Item(const std::string& name, const std::string& amount, bool bold = false, int cols = 0) {
+    const int width = cols > 0 ? cols : columns;
+    const std::string shown = name.substr(0, std::max(1, width - int(amount.size()) - 1));
+    Row(shown + std::string(std::max(1, width - int(shown.size()) - int(amount.size())), ' ') +
+            amount,
+        bold, cols);
+  }
+  void Rule(char c) { Row(std::string(columns, c)); }
+};
+
+struct RollItem {
+  std::string name;
+  double unit;  // price of one, or of a kilogram
+  bool by_weight;
+};
+
+// A receipt as a till prints it on a 58 or 80 mm roll: a centred header
+// (shop, address, telephone, VAT number), the store, till and date, a dashed,
+// dotted or double separator, the items (name left, a gap, the price in the
+// last column; a quantity or weight row under some), subtotal, a larger
+// TOTAL, the payment, a VAT summary and a centred footer.
+void DrawRollReceipt(Typesetter& ts, Page& page, int roll_mm, std::mt19937* rng) {
+  const int columns = RollColumns(roll_mm);
+  const double printable = std::min(RollPrintableWidth(roll_mm), page.width_m - 0.004);
+  // The font size that puts `columns` advances across the printable width.
+  const double advance_per_pt = ts.Width("mono", 10, std::string(20, '0')) / 20 / 10;
+  const double size = printable / columns / advance_per_pt;
+  const double line_h = size * kMetresPerPoint * Uniform(rng, 1.45, 1.7);
+  RollPrinter p{ts,     Ink(rng), (page.width_m - printable) / 2, size,
+                line_h, columns,  Uniform(rng, 0.006, 0.012)};
+  const char rule = std::string("-.=")[(*rng)() % 3];
+  const std::vector<std::string> shops = {"CORNER MARKET", "GREEN GROCER", "CITY PHARMACY",
+                                          "BOOK NOOK",     "HARDWARE HUT", "FRESH FOODS"};
+  const std::vector<std::string> streets = {"Mill Lane",   "Harbour Road",  "Station Street",
+                                            "Church Walk", "Market Square", "Elm Grove"};
+  // Header: the shop's name larger, then its address and numbers.
+  const std::string shop = Pick(shops, rng);
+  // Larger rows: three quarters as many characters, each a third larger.
+  const int big = columns * 3 / 4;
+  p.Centre(shop, true, big);
+  p.Centre(std::to_string(1 + (*rng)() % 180) + " " + Pick(streets, rng));
+  p.Centre("Tel 01632 " + std::to_string(100000 + (*rng)() % 900000));
+  p.Centre("VAT No GB " + std::to_string(100 + (*rng)() % 900) + " " +
+           std::to_string(1000 + (*rng)() % 9000) + " " + std::to_string(10 + (*rng)() % 90));
+  p.v += line_h * 0.5;
+  char when[64];
+  std::snprintf(when, sizeof when, "%02d/%02d/2026 %02d:%02d", 1 + int((*rng)() % 28),
+                1 + int((*rng)() % 12), 8 + int((*rng)() % 12), int((*rng)() % 60));
+  p.Item(
+      "Store " + std::to_string(1 + (*rng)() % 99) + "  Till " + std::to_string(1 + (*rng)() % 9),
+      "Op " + std::to_string(100 + (*rng)() % 900));
+  p.Item(when, "No " + std::to_string(1000 + (*rng)() % 9000));
+  p.Rule(rule);
+
+  // Items down to the room the totals and footer need.
+  const std::vector<std::string> items = {
+      "Bread",  "Milk 1L", "Cheddar 400g", "Coffee beans", "Pasta",      "Rice 2kg",
+      "Butter", "Soap",    "Tea bags 80",  "Eggs x6",      "Yoghurt",    "Orange juice",
+      "Cereal", "Tuna",    "Olive oil",    "Biscuits",     "Washing up", "Toothpaste"};
+  const std::vector<std::string> weighed = {"Apples", "Bananas", "Tomatoes",
+                                            "Onions", "Carrots", "Grapes"};
+  const bool vat_codes = (*rng)() % 2 == 0;
+  const double footer_lines = 12.5;
+  const double bottom = page.height_m - Uniform(rng, 0.008, 0.015) - footer_lines * line_h;
+  double total = 0, taxed = 0;
+  int count = 0;
+  while (p.v + line_h < bottom || count < 3) {
+    const int kind = int((*rng)() % 6);  // 0 weighed, 1 several, else one
+    RollItem item{kind == 0 ? Pick(weighed, rng) : Pick(items, rng), Uniform(rng, 0.4, 9.5),
+                  kind == 0};
+    const int quantity = kind == 1 ? 2 + int((*rng)() % 4) : 1;
+    const double weight = Uniform(rng, 0.2, 1.6);
+    const double price =
+        std::round((item.by_weight ? item.unit * weight : item.unit * quantity) * 100) / 100;
+    if ((kind <= 1) && p.v + 2 * line_h >= bottom && count >= 3) break;
+    // Food at 0 % VAT (B), household goods at 20 % (A).
+    const bool vat_a =
+        item.name == "Soap" || item.name == "Toothpaste" || item.name == "Washing up";
+    if (vat_a) taxed += price;
+    p.Item(item.name, Money(price) + (vat_codes ? (vat_a ? " A" : " B") : ""));
+    if (item.by_weight) {
+      char row[64];
+      std::snprintf(row, sizeof row, "  %.3f kg @ %s/kg", weight, Money(item.unit).c_str());
+      p.Row(row);
+    } else if (quantity > 1) {
+      p.Row("  " + std::to_string(quantity) + " @ " + Money(item.unit));
+    }
+    total += price;
+    ++count;
+  }
+
+  // Totals, payment, VAT and the footer.
+  p.Rule(rule);
+  p.Item(std::to_string(count) + " ITEMS  SUBTOTAL", Money(total));
+  p.Item("TOTAL", Money(total), true, big);
+  p.v += line_h * 0.3;
+  if ((*rng)() % 2 == 0) {
+    p.Item("CARD  ************" + std::to_string(1000 + (*rng)() % 9000), Money(total));
+    p.Item("AUTH CODE", std::to_string(100000 + (*rng)() % 900000));
+  } else {
+    const double cash = std::ceil(total / 10 + 0.01) * 10;
+    p.Item("CASH", Money(cash));
+    p.Item("CHANGE", Money(cash - total));
+  }
+  p.Rule(rule);
+  p.Item("VAT  A 20%", Money(taxed * 0.2 / 1.2));
+  p.Item("VAT  B  0%", Money(0));
+  p.v += line_h * 0.5;
+  p.Centre("THANK YOU FOR SHOPPING");
+  p.Centre("PLEASE KEEP YOUR RECEIPT");
+  p.Centre("Returns within 28 days");
+}
+
 void DrawPoster(Typesetter& ts, Page& page, std::mt19937* rng) {
   const double margin = Uniform(rng, 0.015, 0.022);
   const cv::Scalar ink = Ink(rng);
@@ -412,7 +555,11 @@ cv::Size2d DefaultPageSize(PageKind kind) {
   return kind == PageKind::kReceipt ? cv::Size2d(0.08, 0.2) : cv::Size2d(0.21, 0.297);
 }
 
-Page MakePage(PageKind kind, cv::Size2d size_m, double dpi, std::mt19937* rng) {
+int RollColumns(int roll_mm) { return roll_mm >= 80 ? 48 : 32; }
+
+double RollPrintableWidth(int roll_mm) { return roll_mm >= 80 ? 0.072 : 0.048; }
+
+Page MakePage(PageKind kind, cv::Size2d size_m, double dpi, std::mt19937* rng, int roll_mm) {
   Page page;
   page.width_m = size_m.width;
   page.height_m = size_m.height;
@@ -430,7 +577,10 @@ Page MakePage(PageKind kind, cv::Size2d size_m, double dpi, std::mt19937* rng) {
       DrawTablePage(ts, page, rng);
       break;
     case PageKind::kReceipt:
-      DrawReceipt(ts, page, rng);
+      if (roll_mm > 0)
+        DrawRollReceipt(ts, page, roll_mm, rng);
+      else
+        DrawReceipt(ts, page, rng);
       break;
     case PageKind::kPoster:
       DrawPoster(ts, page, rng);

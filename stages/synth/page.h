@@ -32,7 +32,15 @@ struct Page {
 cv::Size2d DefaultPageSize(PageKind kind);
 
 // Draws a page of the given kind at `dpi` (content chosen by the generator).
-// Throws std::runtime_error when no font can be loaded.
-Page MakePage(PageKind kind, cv::Size2d size_m, double dpi, std::mt19937* rng);
+// A receipt with `roll_mm` 58 or 80 is laid out as a till prints on a roll of
+// that width (RollColumns characters a line); 0 keeps the older, plainer
+// receipt. Throws std::runtime_error when no font can be loaded.
+Page MakePage(PageKind kind, cv::Size2d size_m, double dpi, std::mt19937* rng, int roll_mm = 0);
+
+// Characters a line that a till prints on a roll `roll_mm` wide (the common
+// 203-dpi printers' 12-dot font: 32 on 58 mm paper, 48 on 80 mm), and the
+// printable width in metres.
+int RollColumns(int roll_mm);
+double RollPrintableWidth(int roll_mm);
 
 }  // namespace docunfold::synth

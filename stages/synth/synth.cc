@@ -19,8 +19,11 @@ namespace docunfold::synth {
 namespace {
 
 // The folded sheet sampled on a grid, placed on the table: its printed side
-// facing up on average, resting at z = 0, turned to a random azimuth.
-PageSurface PlaceOnTable(const FoldedSheet& sheet, double spacing, std::mt19937* rng) {
+// facing up on average (or, with `root_flat`, the panel holding the page
+// centre lying flat, print up: a flap, a steep end or a curled end would tilt
+// the average), resting at z = 0, turned to a random azimuth.
+PageSurface PlaceOnTable(const FoldedSheet& sheet, double spacing, bool root_flat,
+                         std::mt19937* rng) {
   PageSurface s;
   s.nx = std::max(2, int(std::ceil(sheet.width() / spacing)) + 1);
   s.ny = std::max(2, int(std::ceil(sheet.height() / spacing)) + 1);
@@ -41,9 +44,12 @@ PageSurface PlaceOnTable(const FoldedSheet& sheet, double spacing, std::mt19937*
   Eigen::Vector3d mean_normal = Eigen::Vector3d::Zero();
   for (const auto& q : s.quads)
     mean_normal += (s.vertices[q[3]] - s.vertices[q[0]]).cross(s.vertices[q[1]] - s.vertices[q[0]]);
+  // FoldedSheet leaves the root panel in z = 0 with its print facing -z.
   const Eigen::Matrix3d up =
-      Eigen::Quaterniond::FromTwoVectors(mean_normal.normalized(), Eigen::Vector3d::UnitZ())
-          .toRotationMatrix();
+      root_flat
+          ? Eigen::Matrix3d(Eigen::AngleAxisd(3.14159265358979323846, Eigen::Vector3d::UnitX()))
+          : Eigen::Quaterniond::FromTwoVectors(mean_normal.normalized(), Eigen::Vector3d::UnitZ())
+                .toRotationMatrix();
   const double yaw = std::uniform_real_distribution<double>(0, 2 * 3.14159265358979)(*rng);
   const Eigen::Matrix3d R =
       Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix() * up;
@@ -111,17 +117,29 @@ Scene MakeScene(const SynthOptions& o, std::mt19937* rng) {
   Scene scene;
   cv::Size2d& size = scene.size;
   size = DefaultPageSize(o.kind);
+  // A receipt torn off a roll is as wide as the roll, and as long as the
+  // till made it.
+  if (o.roll_mm > 0)
+    size = {o.roll_mm / 1000.0, std::uniform_real_distribution<double>(0.14, 0.24)(*rng)};
   if (o.page_size_m.width > 0) size.width = o.page_size_m.width;
   if (o.page_size_m.height > 0) size.height = o.page_size_m.height;
 
   Log("printing a " + PageKindName(o.kind) + " page");
-  scene.page = MakePage(o.kind, size, o.texture_dpi, rng);
-  scene.folds = RandomFolds(size.width, size.height, o.folds, rng);
-  if (scene.folds.empty() && (o.folds.creases > 0 || o.folds.curl))
+  scene.page = MakePage(o.kind, size, o.texture_dpi, rng, o.roll_mm);
+  std::vector<Fold> shaped;
+  try {
+    shaped = ShapeFolds(size.width, size.height, o.shapes, o.folds, rng);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
+  scene.folds = RandomFolds(size.width, size.height, o.folds, rng, shaped);
+  if (scene.folds.empty() && (o.folds.creases > 0 || o.folds.curl || o.shapes.any()))
     throw UsageError("cannot place " + std::to_string(o.folds.creases) +
-                     " non-crossing folds on this page; ask for fewer");
+                     " non-crossing folds on this page" +
+                     (o.shapes.any() ? " beside the flap, steep fold or end curl" : "") +
+                     " without the page passing through itself; ask for fewer");
   FoldedSheet sheet(size.width, size.height, scene.folds);
-  scene.surface = PlaceOnTable(sheet, o.mesh_spacing_m, rng);
+  scene.surface = PlaceOnTable(sheet, o.mesh_spacing_m, o.shapes.any(), rng);
   scene.cameras = MakeCameras(scene.surface, o.cameras, rng);
   scene.light = RandomLighting(rng);
   scene.table = MakeTable(o.render.background, rng);
@@ -226,17 +244,44 @@ void DeclareOptions(OptionTable& table, SynthOptions* o) {
   for (PageKind k : {PageKind::kText, PageKind::kTable, PageKind::kReceipt, PageKind::kPoster})
     kinds.emplace_back(PageKindName(k), k);
   table.Choice("kind", &o->kind, kinds, "the page");
-  table.Parsed<cv::Size2d>("page-size", &o->page_size_m, "WxH", ParsePageSize, FormatPageSize,
-                           "page size in mm (default: A4, receipt 80x200)");
+  table.Parsed<cv::Size2d>(
+      "page-size", &o->page_size_m, "WxH", ParsePageSize, FormatPageSize,
+      "page size in mm (default: A4, receipt 80x200, a --roll receipt the roll's width by "
+      "140 to 240)");
+  table.Choice("roll", &o->roll_mm, {{"none", 0}, {"58", 58}, {"80", 80}},
+               "receipt only: the till roll's width in mm; prints the receipt as a till does "
+               "(32 or 48 monospaced columns, prices right-aligned, separator rows, TOTAL, "
+               "footer); none keeps the older, plainer receipt");
   table.Value("creases", &o->folds.creases, "number of narrow folds");
   table.Parsed<double>("crease-width-mm", &o->folds.crease_width_min, "MM", ParseMillimetres,
                        FormatMillimetres, "narrowest crease (mm)");
   table.Parsed<double>("crease-width-max-mm", &o->folds.crease_width_max, "MM", ParseMillimetres,
                        FormatMillimetres,
                        "widest crease (mm); below --crease-width-mm means that width");
-  table.Value("angle-min", &o->folds.crease_angle_min, "smallest crease angle (degrees)");
-  table.Value("angle-max", &o->folds.crease_angle_max, "largest crease angle (degrees)");
+  table.Value("angle-min", &o->folds.crease_angle_min, 0.0, 180.0,
+              "smallest crease angle (degrees)");
+  table.Value("angle-max", &o->folds.crease_angle_max, 0.0, 180.0,
+              "largest crease angle (degrees); over 125 a fold set is kept only if the page "
+              "does not pass through itself");
   table.Switch("curl", &o->folds.curl, "add one wide bend (a curl of several cm)");
+  table.Choice("flap", &o->shapes.flap,
+               {{"none", Flap::kNone}, {"corner", Flap::kCorner}, {"end", Flap::kEnd}},
+               "fold a corner or an end of the page back over it (its blank back up)");
+  table.Value("flap-angle", &o->shapes.flap_angle, 90.0, 180.0,
+              "how far the flap turns (degrees; 180 lies on the page)");
+  table.Value("steep-fold", &o->shapes.steep_angle, 0.0, 170.0,
+              "add a crease near an end bent up by this angle (degrees; over 90 the end panel "
+              "leans back over the page; 0: none)");
+  table.Choice("end-curl", &o->shapes.end_curl,
+               {{"none", PageEnd::kNone},
+                {"top", PageEnd::kTop},
+                {"bottom", PageEnd::kBottom},
+                {"both", PageEnd::kBoth}},
+               "curl an end of the page up off the table, tightest at the edge");
+  table.Parsed<double>("end-curl-length-mm", &o->shapes.end_curl_length, "MM", ParseMillimetres,
+                       FormatMillimetres, "length of the page that curls (mm)");
+  table.Value("end-curl-angle", &o->shapes.end_curl_angle, 1.0, 270.0,
+              "how far a curled end turns in all (degrees)");
   table.Value("views", &o->cameras.views, 1, 30, "number of photos");
   table.Value("width", &o->cameras.width, 64, std::numeric_limits<int>::max(),
               "image width (pixels)");
@@ -266,6 +311,9 @@ SynthResult Run(const SynthOptions& o, const Json& options_record) {
     throw UsageError(o.out.string() + ": exists (pass --force to replace it)");
   if (o.cameras.views < 1 || o.cameras.views > 30)
     throw UsageError("--views must be between 1 and 30");
+  if (o.roll_mm > 0 && o.kind != PageKind::kReceipt)
+    throw UsageError("--roll is for --kind receipt");
+  if (o.shapes.end_curl_length <= 0) throw UsageError("--end-curl-length-mm must be positive");
 
   std::mt19937 rng(o.seed);
   const Scene scene = MakeScene(o, &rng);

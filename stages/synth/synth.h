@@ -25,7 +25,9 @@ struct SynthOptions {
   uint32_t seed = 1;   // everything random derives from it
   PageKind kind = PageKind::kText;
   cv::Size2d page_size_m{0, 0};   // 0: the kind's default (DefaultPageSize)
+  int roll_mm = 0;                // receipt: the till roll's width (58 or 80), 0 the older layout
   FoldOptions folds;              // creases, curl, widths and angles
+  ShapeOptions shapes;            // flap, steep fold, end curl
   CameraOptions cameras;          // views, image size, field of view, elevation, cut-off
   RenderOptions render;           // background, noise, JPEG quality
   double flat_dpi = 150;          // resolution of ground_truth/flat.png
