@@ -35,6 +35,50 @@ void AddRules(const cv::Mat1b& ink, bool transposed, double min_length, double m
   }
 }
 
+// Pieces of text on one baseline (within a pixel), left to right, become one
+// line across any blank gap between them, as synth's truth records a
+// receipt's row ("Butter ....... 5.54" is one line): on the flat page they
+// are one straight line. Not across a vertical rule.
+std::vector<TrueLine> JoinRows(const std::vector<TrueLine>& lines) {
+  std::vector<TrueLine> text, out;
+  for (const TrueLine& l : lines) (l.kind == "text" ? text : out).push_back(l);
+  std::sort(text.begin(), text.end(),
+            [](const TrueLine& a, const TrueLine& b) { return a.points[0].y() < b.points[0].y(); });
+  auto rule_across = [&](double x0, double x1, double y) {
+    for (const TrueLine& r : out) {
+      const Eigen::Vector2d& a = r.points.front();
+      const Eigen::Vector2d& b = r.points.back();
+      if (std::abs(a.x() - b.x()) > 1.0) continue;  // vertical rules only
+      if (a.x() > x0 && a.x() < x1 && std::min(a.y(), b.y()) < y && std::max(a.y(), b.y()) > y - 5)
+        return true;
+    }
+    return false;
+  };
+  // Rows: runs of pieces whose baselines lie within a pixel of the first's.
+  std::vector<TrueLine> rows;
+  for (size_t i = 0; i < text.size();) {
+    size_t j = i;
+    while (j < text.size() && text[j].points[0].y() - text[i].points[0].y() <= 1.0) ++j;
+    std::vector<TrueLine> row(text.begin() + i, text.begin() + j);
+    std::sort(row.begin(), row.end(), [](const TrueLine& a, const TrueLine& b) {
+      return a.points[0].x() < b.points[0].x();
+    });
+    bool started = false;  // rows.back() is a line of this row
+    for (const TrueLine& piece : row) {
+      if (started &&
+          !rule_across(rows.back().points[1].x(), piece.points[0].x(), piece.points[0].y())) {
+        rows.back().points[1].x() = std::max(rows.back().points[1].x(), piece.points[1].x());
+        continue;
+      }
+      rows.push_back(piece);
+      started = true;
+    }
+    i = j;
+  }
+  out.insert(out.end(), rows.begin(), rows.end());
+  return out;
+}
+
 }  // namespace
 
 std::vector<TrueLine> LinesFromFlatScan(const GroundTruth& gt) {
@@ -97,7 +141,11 @@ std::vector<TrueLine> LinesFromFlatScan(const GroundTruth& gt) {
     const double y = Median(bottoms) - 0.5;
     out.push_back({"text", {{x0 - 0.5, y}, {x1 - 0.5, y}}});
   }
-  return out;
+  // A till roll (at least twice as long as wide) prints a row as one line,
+  // as synth's receipts record it; a table's cells are lines of their own,
+  // as synth's tables record them.
+  const bool roll = std::max(grey.cols, grey.rows) >= 2 * std::min(grey.cols, grey.rows);
+  return roll ? JoinRows(out) : out;
 }
 
 }  // namespace docunfold::evaluate

@@ -150,30 +150,12 @@ TEST_P(FeaturesOnDataSet, FlatScanLinesAgreeWithSynth) {
 
 // Receipts, the weakest pages: a row is an item and its price far apart on
 // one baseline, and detect-features joins it across the gap. Their truth
-// spans the gap as synth's does; a flat scan's lines (LinesFromFlatScan)
-// stop at it, so for a set without synth's lines a row is the flat-scan
-// lines on one baseline (within a pixel) joined. The most frontal view only
-// (about a second a set).
+// spans the gap (synth's, and LinesFromFlatScan's rows on one baseline). The
+// most frontal view only (about a second a set).
 LineFigures MeasureReceipt(const fs::path& set) {
   auto gt = LoadGroundTruth(set);
   EXPECT_TRUE(gt);
   if (!gt) return {};
-  if (gt->lines.empty()) {
-    std::vector<TrueLine> lines = LinesFromFlatScan(*gt);
-    std::sort(lines.begin(), lines.end(), [](const TrueLine& a, const TrueLine& b) {
-      return a.points.front().y() < b.points.front().y();
-    });
-    for (const TrueLine& l : lines) {
-      TrueLine* last = gt->lines.empty() ? nullptr : &gt->lines.back();
-      if (l.kind == "text" && last && last->kind == "text" &&
-          std::abs(l.points.front().y() - last->points.front().y()) <= 1.0) {
-        last->points.front().x() = std::min(last->points.front().x(), l.points.front().x());
-        last->points.back().x() = std::max(last->points.back().x(), l.points.back().x());
-      } else {
-        gt->lines.push_back(l);
-      }
-    }
-  }
   const PinholeCamera& cam = gt->cameras.views[size_t(MostFrontalView(*gt))];
   const cv::Mat image = ReadView(*gt, cam);
   EXPECT_FALSE(image.empty()) << cam.image;
