@@ -3,7 +3,7 @@
 # pipeline on every data set with ground truth (samples/*, and the
 # independently rendered ../shared/realistic/* when present), with the rows
 # the checks compare against (homography, oracle and its crop to what the
-# photos see, the oracle textured from every photo, docunfold-init, and both
+# photos see, docunfold-init, and both
 # with the light's shading removed), through
 # scripts/bench.sh; two sets side by side; then a book of three samples'
 # PDFs. OCR is left out (the metrics
@@ -20,7 +20,7 @@ fi
 rm -rf "$out"
 mkdir -p "$out"
 BUILD=$build BENCH_WORK=$out/work BENCH_OUT=$out BENCH_JOBS=${E2E_JOBS:-2} \
-  BENCH_ONLY="homography oracle oracle-seen oracle-multiview docunfold docunfold-init oracle-deshaded docunfold-deshaded" BENCH_EVAL_FLAGS=--no-ocr \
+  BENCH_ONLY="homography oracle oracle-seen docunfold docunfold-init oracle-deshaded docunfold-deshaded" BENCH_EVAL_FLAGS=--no-ocr \
   BENCH_OCR_SIZE=native "$src/scripts/bench.sh" "${sets[@]}" > "$out/bench.log" 2>&1
 rc=$?
 # A book of three samples' PDFs (made above), joined in the order given.
