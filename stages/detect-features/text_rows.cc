@@ -18,7 +18,11 @@ constexpr double kMaxTurn = 3.0 * kDegree;   // the joint line against the rows 
 constexpr double kMaxOffset = 0.15;          // of the x-height: rows lie a line apart
 constexpr double kMaxHeightRatio = 1.25;     // one font size: digits against letters
 constexpr int kNeighbours = 8;               // pieces around one that tell the rows' direction
-constexpr double kMaxDrift = 1.5;            // text heights a line may drift over a gap (3 sigma)
+// A page's rows are joined only when this fraction of them bridge a gap
+// wider than kWideGap text heights (feature_parts.h, JoinBaselinePieces).
+constexpr double kWideGap = 3.0;
+constexpr double kMinGappedRows = 0.3;
+constexpr double kMaxDrift = 1.5;  // text heights a line may drift over a gap (3 sigma)
 
 double Cross(cv::Point2d u, cv::Point2d v) { return u.x * v.y - u.y * v.x; }
 
@@ -224,8 +228,21 @@ std::vector<std::vector<int>> JoinBaselinePieces(const std::vector<BaselinePiece
     b.samples.clear();
   }
   std::vector<std::vector<int>> out;
-  for (Group& g : groups)
-    if (!g.pieces.empty()) out.push_back(std::move(g.pieces));
+  int gapped = 0;
+  for (Group& g : groups) {
+    if (g.pieces.empty()) continue;
+    for (size_t k = 1; k < g.pieces.size(); ++k)
+      if (pieces[size_t(g.pieces[k])].first.dot(d) - pieces[size_t(g.pieces[k - 1])].last.dot(d) >
+          kWideGap * x_height) {
+        ++gapped;
+        break;
+      }
+    out.push_back(std::move(g.pieces));
+  }
+  if (gapped < kMinGappedRows * double(out.size())) {
+    out.clear();
+    for (int i = 0; i < count; ++i) out.push_back({i});
+  }
   return out;
 }
 

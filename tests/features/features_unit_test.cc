@@ -366,6 +366,31 @@ TEST(FeatureHelpers, RowJoinKeepsRowsApart) {
   EXPECT_EQ(groups[1], (std::vector<int>{1, 3}));
 }
 
+TEST(FeatureHelpers, RowJoinOnlyOnAPageOfGappedRows) {
+  // Running text: ten whole lines, two of them cut by a washed-out band (a
+  // fold's highlight) 5 text heights wide. Two gapped rows of ten: nothing
+  // is joined.
+  std::vector<detail::BaselinePiece> text;
+  for (int row = 0; row < 10; ++row) {
+    const double y = 200 + 30 * row;
+    if (row == 3 || row == 6) {
+      text.push_back(Piece(100, 300, y, 0, int(text.size())));
+      text.push_back(Piece(360, 600, y, 0, int(text.size())));
+    } else {
+      text.push_back(Piece(100, 600, y, 0, int(text.size())));
+    }
+  }
+  EXPECT_EQ(Join(text).size(), text.size());
+  // A receipt: every row an item and a price far apart. Each row is joined.
+  std::vector<detail::BaselinePiece> receipt;
+  for (int row = 0; row < 10; ++row) {
+    const double y = 200 + 30 * row;
+    receipt.push_back(Piece(100, 160, y, 0, int(receipt.size())));
+    receipt.push_back(Piece(500, 540, y, 0, int(receipt.size())));
+  }
+  EXPECT_EQ(Join(receipt).size(), 10u);
+}
+
 TEST(FeatureHelpers, RowJoinDoesNotBridgeACrease) {
   // A crease in the gap at x = 330: beyond it the row turns by 3 degrees,
   // its two parts meeting there. One line through both pieces fits each
