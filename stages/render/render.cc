@@ -115,6 +115,7 @@ OrientationOptions OrientationHint(const std::vector<DirectionVote>& text_lines,
 // (r->crop_*, r->pixels_per_unit, r->size_rule) and M' rasterized in it.
 struct OutputFrame {
   SizeChoice size;
+  std::vector<Eigen::Vector2d> pixel;  // M''s vertices in output pixels
   RasterResult raster;
 };
 
@@ -139,9 +140,11 @@ OutputFrame FrameOutput(const RenderOptions& options, const CropRect& crop,
   // Flat rasterization of M': output pixel centre (x, y) is the point
   // (crop_x0 + (x + 0.5) / s, crop_y0 + (y + 0.5) / s) of M'.
   std::vector<Eigen::Vector3d> screen(flat.size());
-  for (size_t i = 0; i < flat.size(); ++i)
-    screen[i] = {(flat[i].x() - r->crop_x0) * size.scale - 0.5,
-                 (flat[i].y() - r->crop_y0) * size.scale - 0.5, 1.0};
+  for (size_t i = 0; i < flat.size(); ++i) {
+    frame.pixel.emplace_back((flat[i].x() - r->crop_x0) * size.scale - 0.5,
+                             (flat[i].y() - r->crop_y0) * size.scale - 0.5);
+    screen[i] = {frame.pixel[i].x(), frame.pixel[i].y(), 1.0};
+  }
   frame.raster = Rasterize(screen, pm.triangles, size.width, size.height);
   frame.size = size;
   return frame;
@@ -305,7 +308,7 @@ RenderResult Run(const RenderOptions& options, const RenderInputs& in) {
   cv::Mat3b image;
   cv::Mat1b state;
   const SampleStats stats =
-      fusion ? FusePixels(options, in, pm, crop.flat, frame.raster, lookup.raster(),
+      fusion ? FusePixels(options, in, pm, crop.flat, frame.pixel, frame.raster, lookup.raster(),
                           frame.size.scale, photos, &image, &state, &r)
              : SamplePixels(options, in, pm, crop.flat, frame.raster, lookup.raster(),
                             frame.size.scale, &image, &state);

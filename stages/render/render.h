@@ -228,8 +228,8 @@ struct RenderResult {
   // and pixels_per_unit above refer to the unturned image).
   int quarter_turns = 0;
   // kFusion: which photo coloured each pixel of M' (texture_fusion.h's
-  // labels, indices into RenderInputs' views with the reference first),
-  // turned as `rectified`; and what each photo contributed.
+  // labels, indices into texture_views: the reference, then the views with a
+  // photo), turned as `rectified`; and what each photo contributed.
   cv::Mat1b texture_labels;
   std::vector<FusionViewReport> texture_views;
   double texture_unseen = 0;  // fraction of M' in the crop no photo sees

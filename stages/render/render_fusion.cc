@@ -19,19 +19,17 @@ std::vector<cv::Mat> ReadViewPhotos(const RenderInputs& in, bool needed) {
 
 SampleStats FusePixels(const RenderOptions& options, const RenderInputs& in,
                        const ProjectedMesh& pm, const std::vector<Eigen::Vector2d>& flat,
+                       const std::vector<Eigen::Vector2d>& out_pixel,
                        const RasterResult& out_raster, const RasterResult& ref_raster, double scale,
                        const std::vector<cv::Mat>& photos, cv::Mat3b* image, cv::Mat1b* state,
                        RenderResult* r) {
   const int W = out_raster.face.cols, H = out_raster.face.rows;
   FusionSurface surface;
   surface.world = in.meshes.mesh3d;
+  surface.pixel = out_pixel;
   surface.triangles = pm.triangles;
   surface.width = W;
   surface.height = H;
-  // The same output pixels as the flat rasterization (FrameOutput).
-  for (const Eigen::Vector2d& q : flat)
-    surface.pixel.emplace_back((q.x() - r->crop_x0) * scale - 0.5,
-                               (q.y() - r->crop_y0) * scale - 0.5);
   // The reference first: reference.png, undistorted; its outline is where
   // M comes from, so it needs no mask.
   std::vector<FusionView> views = {{in.camera, {}, in.reference, {}, in.camera.image}};

@@ -80,13 +80,15 @@ SampleStats SamplePixels(const RenderOptions& options, const RenderInputs& in,
 std::vector<cv::Mat> ReadViewPhotos(const RenderInputs& in, bool needed);
 
 // The texture from every photo (options.texture == kFusion,
-// common/texture_fusion.h) over the same output pixels as SamplePixels,
+// common/texture_fusion.h) over the same output pixels as SamplePixels
+// (`out_pixel`: M's vertices there, as `out_raster` was rasterized),
 // with the same states: kPage where some photo sees M, kHidden where none
 // does (with --sample-hidden, the reference photo's colour there,
 // kHiddenSampled). r->texture_labels and r->texture_views; r->timings gets
 // the fusion's steps.
 SampleStats FusePixels(const RenderOptions& options, const RenderInputs& in,
                        const ProjectedMesh& pm, const std::vector<Eigen::Vector2d>& flat,
+                       const std::vector<Eigen::Vector2d>& out_pixel,
                        const RasterResult& out_raster, const RasterResult& ref_raster, double scale,
                        const std::vector<cv::Mat>& photos, cv::Mat3b* image, cv::Mat1b* state,
                        RenderResult* r);
