@@ -197,17 +197,22 @@ make_row_docunfold() {
 }
 # The same meshes rendered with the light's shading divided out, and the
 # oracle with it divided out the same way (the fair ceiling for that row).
-make_row_docunfold-deshaded() {
+# The final meshes (init-mesh's without optimize) rendered again with other
+# render flags: render_variant <row> <suffix> <render flag...>.
+render_variant() {
+  local row=$1 suffix=$2
+  shift 2
   have render || { reason="no render binary"; return 1; }
   local meshes=$work/50_optimize
   [[ -f $meshes/mesh3d.ply ]] || meshes=$work/40_init
   [[ -f $meshes/mesh3d.ply ]] || { reason="no meshes"; return 1; }
   mesh_dir=$meshes
-  timed docunfold-deshaded "$bin/render" --sfm "$work/10_sfm" --boundary "$work/20_boundary" \
-    --meshes "$meshes" --out "$work/60_render_deshaded" --images "$data/images" \
-    --features "$work/30_features/features.json" --shading remove || return
-  image=$work/60_render_deshaded/rectified.png
+  timed "$row" "$bin/render" --sfm "$work/10_sfm" --boundary "$work/20_boundary" \
+    --meshes "$meshes" --out "$work/60_render_$suffix" --images "$data/images" \
+    --features "$work/30_features/features.json" "$@" || return
+  image=$work/60_render_$suffix/rectified.png
 }
+make_row_docunfold-deshaded() { render_variant docunfold-deshaded deshaded --shading remove; }
 make_row_oracle-deshaded() {
   [[ -f $work/10_sfm/cameras.json ]] || { reason="no 10_sfm/cameras.json"; return 1; }
   [[ -f $data/ground_truth/mesh.ply ]] || { reason="no ground_truth/mesh.ply"; return 1; }
@@ -217,17 +222,7 @@ make_row_oracle-deshaded() {
 }
 # The final meshes textured from the reference photo alone (render
 # --texture reference), as the paper does: what texture fusion adds.
-make_row_docunfold-reference() {
-  have render || { reason="no render binary"; return 1; }
-  local meshes=$work/50_optimize
-  [[ -f $meshes/mesh3d.ply ]] || meshes=$work/40_init
-  [[ -f $meshes/mesh3d.ply ]] || { reason="no meshes"; return 1; }
-  mesh_dir=$meshes
-  timed docunfold-reference "$bin/render" --sfm "$work/10_sfm" --boundary "$work/20_boundary" \
-    --meshes "$meshes" --out "$work/60_render_reference" --images "$data/images" \
-    --features "$work/30_features/features.json" --texture reference || return
-  image=$work/60_render_reference/rectified.png
-}
+make_row_docunfold-reference() { render_variant docunfold-reference reference --texture reference; }
 make_row_docunfold-init() {
   have render || { reason="no render binary"; return 1; }
   [[ -f $work/40_init/mesh3d.ply ]] || { reason="no 40_init/mesh3d.ply"; return 1; }
