@@ -26,15 +26,19 @@ struct Page {
   std::vector<double> rules;      // y of each rule's centre
 };
 
+// A grey table of `size` with a white page over `page`, its mask set there.
+void BlankPage(cv::Size size, const cv::Rect& page, Page* p) {
+  p->image = cv::Mat3b(size, cv::Vec3b(90, 90, 90));
+  p->mask = cv::Mat1b::zeros(size);
+  p->mask(page).setTo(255);
+  p->image(page).setTo(cv::Scalar(240, 240, 240));
+}
+
 // A grey table with a white page: text lines (Hershey font; putText's origin
 // is the baseline) and, below them, three horizontal rules 2 px thick.
 Page DrawPage() {
   Page p;
-  p.image = cv::Mat3b(900, 1200, cv::Vec3b(90, 90, 90));
-  p.mask = cv::Mat1b::zeros(p.image.size());
-  const cv::Rect page(150, 80, 900, 760);
-  p.mask(page).setTo(255);
-  p.image(page).setTo(cv::Scalar(240, 240, 240));
+  BlankPage({1200, 900}, {150, 80, 900, 760}, &p);
   for (int y = 160; y < 560; y += 30) {
     cv::putText(p.image, kLine, {200, y}, cv::FONT_HERSHEY_COMPLEX, 0.7, cv::Scalar(20, 20, 20), 1,
                 cv::LINE_AA);
@@ -259,11 +263,7 @@ Page DrawReceipt() {
   static const char* kPrices[] = {"5.54",  "12.37", "3.10", "7.69",  "14.03", "9.75",
                                   "10.81", "2.95",  "6.08", "11.52", "4.47",  "8.16"};
   Page p;
-  p.image = cv::Mat3b(600, 1000, cv::Vec3b(90, 90, 90));
-  p.mask = cv::Mat1b::zeros(p.image.size());
-  const cv::Rect page(100, 40, 800, 520);
-  p.mask(page).setTo(255);
-  p.image(page).setTo(cv::Scalar(240, 240, 240));
+  BlankPage({1000, 600}, {100, 40, 800, 520}, &p);
   for (int k = 0; k < 12; ++k) {
     const int y = 90 + 36 * k;
     cv::putText(p.image, kItems[k], {160, y}, cv::FONT_HERSHEY_COMPLEX, 0.7, cv::Scalar(20, 20, 20),

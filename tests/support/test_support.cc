@@ -51,19 +51,21 @@ CommandResult RunCommand(const std::string& command_line) {
 fs::path StageBinary(const std::string& name) { return fs::path(DOCUNFOLD_BIN_DIR) / name; }
 fs::path SourceDir() { return fs::path(DOCUNFOLD_SOURCE_DIR); }
 fs::path SampleDir(const std::string& name) { return SourceDir() / "samples" / name; }
-fs::path RealisticDir() {
-  if (const char* env = std::getenv("DOCUNFOLD_REALISTIC_DIR")) return env;
-  fs::path p = SourceDir().parent_path() / "shared" / "realistic";
+namespace {
+
+// $env when set, else ../shared/<name> beside the source tree when it is
+// there, else "".
+fs::path SharedSets(const char* env, const char* name) {
+  if (const char* value = std::getenv(env)) return value;
+  fs::path p = SourceDir().parent_path() / "shared" / name;
   std::error_code ec;
   return fs::is_directory(p, ec) ? p : fs::path();
 }
 
-fs::path RealisticHardDir() {
-  if (const char* env = std::getenv("DOCUNFOLD_REALISTIC_HARD_DIR")) return env;
-  fs::path p = SourceDir().parent_path() / "shared" / "realistic-hard";
-  std::error_code ec;
-  return fs::is_directory(p, ec) ? p : fs::path();
-}
+}  // namespace
+
+fs::path RealisticDir() { return SharedSets("DOCUNFOLD_REALISTIC_DIR", "realistic"); }
+fs::path RealisticHardDir() { return SharedSets("DOCUNFOLD_REALISTIC_HARD_DIR", "realistic-hard"); }
 
 fs::path E2eDir() { return fs::path(DOCUNFOLD_BIN_DIR).parent_path() / "e2e"; }
 
