@@ -109,6 +109,12 @@ bool SeenAt(const RasterResult& depth, const PinholeCamera& camera,
 
 }  // namespace
 
+bool TruePointSeen(const GroundTruth& gt, const PinholeCamera& camera,
+                   const Eigen::Vector2d& flat_px) {
+  Eigen::Vector2d px;
+  return SeenAt(gt.ViewRaster(camera), camera, gt.SurfacePoint(flat_px), &px);
+}
+
 cv::Mat1b TruePageMask(const GroundTruth& gt, const PinholeCamera& camera) {
   return gt.ViewRaster(camera).face >= 0;
 }

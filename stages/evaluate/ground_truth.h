@@ -61,6 +61,12 @@ bool HasTrueSurface(const fs::path& dataset);
 // something is missing or malformed.
 GroundTruth LoadGroundTruth(const fs::path& dataset);
 
+// Whether the true surface at flat.png pixel `flat_px` is seen by `camera`:
+// on the page, in front of the camera, inside its image and not hidden by the
+// page itself.
+bool TruePointSeen(const GroundTruth& gt, const PinholeCamera& camera,
+                   const Eigen::Vector2d& flat_px);
+
 // True page region in the image of `camera` (255 inside).
 cv::Mat1b TruePageMask(const GroundTruth& gt, const PinholeCamera& camera);
 

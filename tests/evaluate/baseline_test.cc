@@ -90,7 +90,9 @@ TEST_P(Baselines, OracleClearlyBeatsHomographyOnFoldedPages) {
   // A flap folded over the page (realistic-hard) hides part of it from every photo.
   const bool hard = !RealisticHardDir().empty() && data.parent_path() == RealisticHardDir();
   if (whole_page) {
-    if (!hard) EXPECT_GT(o, 0.8) << "the oracle textures through the true surface";
+    if (!hard) {
+      EXPECT_GT(o, 0.8) << "the oracle textures through the true surface";
+    }
     // Seen whole by the reference, the crop to what the photos see is no crop.
     options.crop_to_seen = true;
     const cv::Mat seen = baseline::Run({data, work}, options).image;
@@ -110,7 +112,9 @@ TEST_P(Baselines, OracleClearlyBeatsHomographyOnFoldedPages) {
   const double m = MsSsimOf(data, baseline::Run({data, work}, options).image);
   std::cout << data.filename().string() << ": MS-SSIM oracle-multiview " << m << "\n";
   EXPECT_GT(m, o - 0.01) << "fusion lost against the reference photo alone";
-  if (hard) EXPECT_GT(m, h + 0.2);
+  if (hard) {
+    EXPECT_GT(m, h + 0.2);
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(DataSets, Baselines, ::testing::ValuesIn(DataSetsWithGroundTruth()),

@@ -21,6 +21,7 @@
 #include "common/json_io.h"
 #include "common/page_files.h"
 #include "common/ply.h"
+#include "common/raster.h"
 #include "tests/boundary/eval_support.h"
 #include "tests/support/ground_truth.h"
 #include "tests/support/test_support.h"
@@ -350,6 +351,119 @@ TEST_P(EndToEnd, OtherViewsShowThePagePastTheReferenceImage) {
     EXPECT_GE(extended, 1) << set_;
   } else {
     EXPECT_EQ(textured, 0.0) << set_;
+  }
+}
+
+// The first and the last line of text some photo shows (a receipt's header and
+// total) map into the result: a crop that stops at a fold or a curl, or a mesh
+// that ends short of the page's end, loses them. Each line is sampled every 4
+// flat.png pixels and carried to sfm's world through the true surface; a
+// point the reference photo sees maps through the mesh M under its pixel there
+// (what render samples), another through the nearest vertex of M, which must
+// lie within 1 % of the page diagonal; then through M' into the crop. Pages
+// cut off in the reference photo are left out: there the crop ends where
+// the photos' view of the page ends.
+TEST_P(EndToEnd, FirstAndLastLinesOfTextAreInTheResult) {
+  struct Sampled {
+    double mean_y = 0;
+    std::vector<Eigen::Vector2d> flat;
+    std::vector<bool> seen, seen_by_reference;
+  };
+  const Boundary boundary = ReadBoundary(work_ / "20_boundary/boundary.json");
+  for (const auto& side : boundary.sides)
+    if (!side.real)  // OtherViewsShowThePagePastTheReferenceImage covers a page cut off there
+      GTEST_SKIP() << set_ << ": the page is cut off in the reference photo";
+  const PinholeCamera* reference = sfm_.Find(sfm_.reference);
+  ASSERT_NE(reference, nullptr) << set_;
+  const PinholeCamera* true_reference = gt_.cameras.Find(sfm_.reference);
+  ASSERT_NE(true_reference, nullptr) << set_;
+  std::vector<Sampled> lines;
+  for (const TrueLine& l : TruthLines(gt_)) {
+    if (l.kind != "text") continue;
+    Sampled s;
+    for (size_t k = 0; k + 1 < l.points.size(); ++k) {
+      const Eigen::Vector2d a = l.points[k], b = l.points[k + 1];
+      const int n = std::max(1, int(std::ceil((b - a).norm() / 4.0)));
+      for (int j = (k == 0 ? 0 : 1); j <= n; ++j) s.flat.push_back(a + (b - a) * (double(j) / n));
+    }
+    for (const Eigen::Vector2d& p : s.flat) s.mean_y += p.y() / s.flat.size();
+    s.seen.assign(s.flat.size(), false);
+    s.seen_by_reference.assign(s.flat.size(), false);
+    if (!s.flat.empty()) lines.push_back(std::move(s));
+  }
+  if (lines.empty()) GTEST_SKIP() << set_ << ": no text lines in the truth";
+  for (const PinholeCamera& camera : gt_.cameras.views)  // one rasterization per camera
+    for (Sampled& s : lines)
+      for (size_t i = 0; i < s.flat.size(); ++i) {
+        if (s.seen[i] && camera.image != true_reference->image) continue;
+        const bool seen = TruePointSeen(gt_, camera, s.flat[i]);
+        s.seen[i] = s.seen[i] || seen;
+        if (camera.image == true_reference->image) s.seen_by_reference[i] = seen;
+      }
+  std::vector<const Sampled*> shown;
+  for (const Sampled& s : lines)
+    if (std::count(s.seen.begin(), s.seen.end(), true) >= 0.9 * s.seen.size()) shown.push_back(&s);
+  if (shown.empty()) GTEST_SKIP() << set_ << ": no line of text seen whole in any photo";
+  auto by_y = [](const Sampled* a, const Sampled* b) { return a->mean_y < b->mean_y; };
+  const Sampled* first = *std::min_element(shown.begin(), shown.end(), by_y);
+  const Sampled* last = *std::max_element(shown.begin(), shown.end(), by_y);
+
+  const PlyData m3 = ReadPly(work_ / "50_optimize/mesh3d.ply");
+  const PlyData m2 = ReadPly(work_ / "50_optimize/mesh2d.ply");
+  ASSERT_EQ(m3.vertices.size(), m2.vertices.size()) << set_;
+  const std::vector<Triangle> triangles = Triangulate(m3.faces);
+  const RasterResult in_reference = RasterizeMesh(*reference, m3.vertices, triangles);
+  const Json render = ReadJsonFile(work_ / "60_render/render.json");
+  const Json& crop = render.at("crop");
+  const Eigen::Rotation2Dd rotation(render.at("rotation_deg").get<double>() * M_PI / 180);
+  const double reach = 0.01 * gt_.Diagonal() * sim_.s;
+  // M' position of sfm-world point x, if M reaches it.
+  auto on_flat_mesh = [&](const Eigen::Vector3d& x,
+                          bool by_reference) -> std::optional<Eigen::Vector2d> {
+    if (by_reference) {
+      const Eigen::Vector3d xc = reference->CamFromWorld(x);
+      const Eigen::Vector2d px = reference->ProjectCam(xc);
+      const int u = int(std::lround(px.x())), v = int(std::lround(px.y()));
+      if (!(xc.z() > 0) || u < 0 || v < 0 || u >= in_reference.face.cols ||
+          v >= in_reference.face.rows || in_reference.face(v, u) < 0)
+        return std::nullopt;
+      const Triangle& t = triangles[in_reference.face(v, u)];
+      const cv::Vec2f b = in_reference.bary(v, u);
+      return ((1 - b[0] - b[1]) * m2.vertices[t[0]] + b[0] * m2.vertices[t[1]] +
+              b[1] * m2.vertices[t[2]])
+          .head<2>();
+    }
+    size_t best = 0;
+    double best_d2 = std::numeric_limits<double>::infinity();
+    for (size_t v = 0; v < m3.vertices.size(); ++v) {
+      const double d2 = (m3.vertices[v] - x).squaredNorm();
+      if (d2 < best_d2) best_d2 = d2, best = v;
+    }
+    if (std::sqrt(best_d2) > reach) return std::nullopt;
+    return m2.vertices[best].head<2>();
+  };
+  for (const Sampled* line : {first, last}) {
+    int checked = 0, off_mesh = 0, outside = 0;
+    for (size_t i = 0; i < line->flat.size(); ++i) {
+      const auto x_true = gt_.SurfacePoint(line->flat[i]);
+      if (!line->seen[i] || !x_true) continue;
+      ++checked;
+      const auto flat =
+          on_flat_mesh(sim_.s * (sim_.R * *x_true) + sim_.t, line->seen_by_reference[i]);
+      if (!flat) {
+        ++off_mesh;
+        continue;
+      }
+      const Eigen::Vector2d q = rotation * *flat;
+      if (q.x() < crop.at("x0").get<double>() || q.x() > crop.at("x1").get<double>() ||
+          q.y() < crop.at("y0").get<double>() || q.y() > crop.at("y1").get<double>())
+        ++outside;
+    }
+    const char* which = line == first ? "first" : "last";
+    std::printf("%s: %s line of text at flat y %.0f: %d points, %d off M, %d outside the crop\n",
+                set_.c_str(), which, line->mean_y, checked, off_mesh, outside);
+    ASSERT_GT(checked, 0) << set_;
+    EXPECT_LE(off_mesh + outside, 0.05 * checked) << set_ << ": the " << which << " line";
   }
 }
 

@@ -22,6 +22,7 @@ using evaluate::TrueLine;
 using evaluate::TrueLinesInView;
 using evaluate::TrueOutlineInView;
 using evaluate::TruePageMask;
+using evaluate::TruePointSeen;
 using evaluate::TruthLines;
 
 // Loads ground_truth/ of a data set; fails the current test (and returns
