@@ -36,7 +36,8 @@ struct TextResult {
   cv::Point2d down;                // unit, towards the baselines (the reader's down)
   std::vector<char> is_character;  // per component label: chained as text
 };
-TextResult DetectTextSegments(const InkComponents& ink, const FeaturesOptions& options);
+TextResult DetectTextSegments(const InkComponents& ink, const cv::Mat1b& grey,
+                              const FeaturesOptions& options);
 
 // A straight piece of one chain's baseline, before the shortest are left
 // out: pieces of one row may still be joined across a wide gap.
@@ -75,6 +76,16 @@ std::vector<std::vector<int>> JoinBaselinePieces(const std::vector<BaselinePiece
 // thin (0.3) along it (a row rule under the row).
 GapTest BlankGapTest(const InkComponents& ink, cv::Point2d d, cv::Point2d up, double x_height,
                      double char_height);
+
+// A GapTest over `grey`: the paper between the pieces is one layer. Where
+// a corner curled over the page hides a row, its blank back is a run of
+// paper of another grey, entered and left at an edge; shading drifts. So
+// no step of the paper's grey (ink and its rim left out) over 8 % between
+// the medians over one text height (`x_height`) either side of a point,
+// in the band 0.3 to 0.7 text heights into the letters (`up`). `grey` and
+// `labels` (the ink components) must outlive the test.
+GapTest OnePaperLayerTest(const cv::Mat1b& grey, const cv::Mat1i& labels, cv::Point2d up,
+                          double x_height);
 
 // Centre lines of thin dark lines (and, if asked, single step edges) found by
 // LSD in `grey`, inside `region`, that are not character strokes.

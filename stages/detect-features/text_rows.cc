@@ -23,6 +23,11 @@ constexpr int kNeighbours = 8;               // pieces around one that tell the 
 constexpr double kWideGap = 3.0;
 constexpr double kMinGappedRows = 0.3;
 constexpr double kMaxDrift = 1.5;  // text heights a line may drift over a gap (3 sigma)
+// The largest step of the paper's grey within a gap, of the brighter side:
+// a fold's shadow along a receipt's rows reaches 6 %, the blank back of a
+// corner curled over the page 11 % (docs/decisions/detect-features.md,
+// "A join stays on one layer of paper").
+constexpr double kMaxPaperStep = 0.08;
 
 double Cross(cv::Point2d u, cv::Point2d v) { return u.x * v.y - u.y * v.x; }
 
@@ -149,6 +154,46 @@ GapTest BlankGapTest(const InkComponents& ink, cv::Point2d d, cv::Point2d up, do
         if (x < 0 || y < 0 || x >= labels.cols || y >= labels.rows) continue;
         if ((*blocks)[size_t(labels(y, x))]) return false;
       }
+    return true;
+  };
+}
+
+GapTest OnePaperLayerTest(const cv::Mat1b& grey, const cv::Mat1i& labels, cv::Point2d up,
+                          double x_height) {
+  return [&grey, &labels, up, x_height](const cv::Point2d& from, const cv::Point2d& to) {
+    // The paper's grey along the gap, inside the letters' band (lifted 0.3
+    // to 0.7 of the text height off the baseline), ink and its 1 px rim
+    // left out, and a text height clear of either piece's last letter.
+    auto near_ink = [&](int x, int y) {
+      for (int v = std::max(0, y - 1); v <= std::min(labels.rows - 1, y + 1); ++v)
+        for (int u = std::max(0, x - 1); u <= std::min(labels.cols - 1, x + 1); ++u)
+          if (labels(v, u) != 0) return true;
+      return false;
+    };
+    const double length = cv::norm(to - from);
+    const cv::Point2d along = (to - from) * (1.0 / std::max(1e-9, length));
+    std::vector<double> paper;  // per pixel along the gap; -1 where all is ink
+    for (double t = x_height; t <= length - x_height; t += 1.0) {
+      std::vector<double> column;
+      for (double lift : {0.3, 0.5, 0.7}) {
+        const cv::Point2d p = from + along * t + up * (lift * x_height);
+        const int x = int(std::lround(p.x)), y = int(std::lround(p.y));
+        if (x < 0 || y < 0 || x >= grey.cols || y >= grey.rows || near_ink(x, y)) continue;
+        column.push_back(grey(y, x));
+      }
+      paper.push_back(column.empty() ? -1 : Median(column));
+    }
+    // The medians over one text height either side of each point: shading
+    // drifts slowly, the edge of a layer over the page steps at once.
+    const int w = std::max(2, int(std::lround(x_height)));
+    for (int t = w; t + w <= int(paper.size()); ++t) {
+      std::vector<double> before, after;
+      for (int k = t - w; k < t + w; ++k)
+        if (paper[size_t(k)] >= 0) (k < t ? before : after).push_back(paper[size_t(k)]);
+      if (2 * before.size() < size_t(w) || 2 * after.size() < size_t(w)) continue;
+      const double m0 = Median(before), m1 = Median(after);
+      if (std::abs(m0 - m1) > kMaxPaperStep * std::max(m0, m1)) return false;
+    }
     return true;
   };
 }

@@ -402,13 +402,16 @@ std::vector<Sample> Outline(const TextLines& lines, const std::vector<int>& chai
 }
 
 // Each sample's offset from the median of its neighbours within
-// `half_window` pixels either way, the chain's overall tilt removed.
-// Descenders, or ascenders, stick out.
-std::vector<double> Offsets(const std::vector<Sample>& samples, double half_window) {
+// `half_window` pixels either way, the chain's overall tilt (fitted to the
+// samples `tilt_from` marks, all when empty) removed. Descenders, or
+// ascenders, stick out.
+std::vector<double> Offsets(const std::vector<Sample>& samples, double half_window,
+                            const std::vector<char>& tilt_from = {}) {
   std::vector<double> out(samples.size(), 0.0);
   if (samples.size() < 3) return out;
   std::vector<cv::Point2d> raw;
-  for (const Sample& s : samples) raw.emplace_back(s.a, s.c);
+  for (size_t k = 0; k < samples.size(); ++k)
+    if (tilt_from.empty() || tilt_from[k]) raw.emplace_back(samples[k].a, samples[k].c);
   const LineFit tilt = FitLine(raw);
   const double slope =
       tilt.direction.y / (std::abs(tilt.direction.x) > 1e-9 ? tilt.direction.x : 1e-9);
@@ -528,9 +531,11 @@ int BaselineSide(const InkComponents& ink, const TextLines& lines, TextResult* r
 // Step 6, for one chain: the outline on the baseline side (`sign`),
 // descenders and raised parts dropped, cut where it bends; appends the
 // straight pieces to `pieces` (short ones too: a piece may continue
-// another across a gap).
+// another across a gap). `refit_tilt`: the chain's tilt fitted again
+// without its descenders (docs/decisions/detect-features.md, "Short words'
+// tilt refitted on receipts").
 void AddBaselinePieces(const TextLines& lines, const std::vector<int>& chain, double sign,
-                       double tolerance, const FeaturesOptions& options,
+                       double tolerance, const FeaturesOptions& options, bool refit_tilt,
                        std::vector<BaselinePiece>* pieces) {
   const cv::Point2d d = lines.d, n = lines.n;
   const double x_height = lines.x_height;
@@ -538,7 +543,16 @@ void AddBaselinePieces(const TextLines& lines, const std::vector<int>& chain, do
   // Fewer than 5 make no segment alone, but a price of a few digits may
   // continue its item's baseline.
   if (samples.size() < (options.row_gap > 0 ? 3u : 5u)) return;
-  const std::vector<double> off = Offsets(samples, 3 * x_height);
+  std::vector<double> off = Offsets(samples, 3 * x_height);
+  if (refit_tilt) {
+    // A short word's tilt is pulled by its descenders ("Apples": two p's of
+    // six letters) until they pass the band below; fitted again without
+    // the samples beyond the baseline side, they stick out.
+    std::vector<char> on_baseline(samples.size());
+    size_t count = 0;
+    for (size_t k = 0; k < samples.size(); ++k) count += on_baseline[k] = off[k] <= 0.5 * tolerance;
+    if (count >= 3) off = Offsets(samples, 3 * x_height, on_baseline);
+  }
   const double band = 0.2 * x_height + 0.5;
   std::vector<Sample> kept_samples;
   for (size_t k = 0; k < samples.size(); ++k)
@@ -607,7 +621,8 @@ void AddBaselineSegments(const std::vector<BaselinePiece>& pieces,
 
 }  // namespace
 
-TextResult DetectTextSegments(const InkComponents& ink, const FeaturesOptions& options) {
+TextResult DetectTextSegments(const InkComponents& ink, const cv::Mat1b& grey,
+                              const FeaturesOptions& options) {
   TextResult result;
   result.is_character.assign(size_t(ink.count), 0);
   // 1. Marks of character size.
@@ -644,20 +659,35 @@ TextResult DetectTextSegments(const InkComponents& ink, const FeaturesOptions& o
 
   // 6. Baselines, cut where they bend into straight pieces.
   const double tolerance = std::max(options.bend_px, options.bend_rel * lines.x_height);
-  std::vector<BaselinePiece> pieces;
-  for (const auto& chain : lines.chains) {
+  for (const auto& chain : lines.chains)
     for (int k : chain) result.is_character[size_t(marks[k].label)] = 1;
-    if (!result.orientation_known) continue;
-    AddBaselinePieces(lines, chain, sign, tolerance, options, &pieces);
-  }
+  auto baseline_pieces = [&](bool refit_tilt) {
+    std::vector<BaselinePiece> pieces;
+    if (result.orientation_known)
+      for (const auto& chain : lines.chains)
+        AddBaselinePieces(lines, chain, sign, tolerance, options, refit_tilt, &pieces);
+    return pieces;
+  };
+  std::vector<BaselinePiece> pieces = baseline_pieces(false);
 
-  // 7. Pieces of one row joined across wide gaps, then fitted and kept
-  // if long enough.
+  // 7. Pieces of one row joined across wide gaps, then fitted and kept if
+  // long enough. On a page whose rows join (a receipt) the pieces are made
+  // again with short words' tilt refitted; text pages keep theirs.
   std::vector<std::vector<int>> groups;
   if (options.row_gap > 0) {
-    groups = JoinBaselinePieces(pieces, lines.d, lines.x_height, tolerance,
-                                options.row_gap * lines.x_height,
-                                BlankGapTest(ink, lines.d, -sign * lines.n, lines.x_height, h_med));
+    const cv::Point2d up = -sign * lines.n;
+    const GapTest rules = BlankGapTest(ink, lines.d, up, lines.x_height, h_med);
+    const GapTest layer = OnePaperLayerTest(grey, ink.labels, up, lines.x_height);
+    auto join = [&] {
+      return JoinBaselinePieces(
+          pieces, lines.d, lines.x_height, tolerance, options.row_gap * lines.x_height,
+          [&](const cv::Point2d& a, const cv::Point2d& b) { return rules(a, b) && layer(a, b); });
+    };
+    groups = join();
+    if (groups.size() < pieces.size()) {
+      pieces = baseline_pieces(true);
+      groups = join();
+    }
   } else {
     for (int k = 0; k < int(pieces.size()); ++k) groups.push_back({k});
   }

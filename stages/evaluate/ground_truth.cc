@@ -107,6 +107,23 @@ bool SeenAt(const RasterResult& depth, const PinholeCamera& camera,
          xc.z() <= depth.depth(y, x) * (1 + 2e-3);
 }
 
+// Whether `camera` sees the printed side of the page at flat pixel q: the
+// map from flat.png into the image keeps its orientation there. Where it
+// turns it over (a corner curled over the page), the camera sees the
+// blank back, and the print on the other side is no line it could find.
+bool PrintedSideSeen(const GroundTruth& gt, const PinholeCamera& camera, const Eigen::Vector2d& q) {
+  const double e = 1.0;  // flat pixels
+  const double sx = q.x() + e < gt.flat_width - 1 ? e : -e;
+  const double sy = q.y() + e < gt.flat_height - 1 ? e : -e;
+  const auto p0 = gt.SurfacePoint(q), p1 = gt.SurfacePoint(q + Eigen::Vector2d(sx, 0)),
+             p2 = gt.SurfacePoint(q + Eigen::Vector2d(0, sy));
+  if (!p0 || !p1 || !p2) return true;
+  const Eigen::Vector2d i0 = camera.ProjectCam(camera.CamFromWorld(*p0));
+  const Eigen::Vector2d u = camera.ProjectCam(camera.CamFromWorld(*p1)) - i0;
+  const Eigen::Vector2d v = camera.ProjectCam(camera.CamFromWorld(*p2)) - i0;
+  return (u.x() * v.y() - u.y() * v.x()) * sx * sy > 0;
+}
+
 }  // namespace
 
 bool TruePointSeen(const GroundTruth& gt, const PinholeCamera& camera,
@@ -156,8 +173,9 @@ std::vector<TrueLine> TrueLinesInView(const GroundTruth& gt, const PinholeCamera
       const int n = std::max(1, int(std::ceil((b - a).norm() / step_px)));
       for (int j = 0; j <= n; ++j) {
         if (k > 0 && j == 0) continue;
+        const Eigen::Vector2d q = a + (b - a) * (double(j) / n);
         Eigen::Vector2d px;
-        if (SeenAt(depth, camera, gt.SurfacePoint(a + (b - a) * (double(j) / n)), &px))
+        if (SeenAt(depth, camera, gt.SurfacePoint(q), &px) && PrintedSideSeen(gt, camera, q))
           piece.points.push_back(px);
         else
           flush();

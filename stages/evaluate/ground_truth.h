@@ -92,8 +92,9 @@ std::vector<std::vector<Eigen::Vector2d>> TrueOutlineInView(const GroundTruth& g
                                                             double step_px = 2.0);
 
 // True straight lines of the page (gt.lines) projected into `camera`, sampled
-// about every `step_px` flat pixels; points hidden by the page itself or
-// outside the image are dropped (a line may so split into several pieces).
+// about every `step_px` flat pixels; points hidden by the page itself,
+// outside the image, or where the camera sees the page's blank back (a
+// corner curled over) are dropped (a line may so split into pieces).
 std::vector<TrueLine> TrueLinesInView(const GroundTruth& gt, const PinholeCamera& camera,
                                       double step_px = 2.0);
 

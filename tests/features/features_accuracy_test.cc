@@ -161,9 +161,10 @@ LineFigures MeasureReceipt(const fs::path& set) {
   EXPECT_FALSE(image.empty()) << cam.image;
   if (image.empty()) return {};
   const evaluate::TruthInView truth = evaluate::SeeTruth(*gt, cam);
-  const LineFigures f =
-      evaluate::MeasureLines(truth, Segments(features::DetectFeatures(image, truth.page, {})));
+  const FeaturesResult r = features::DetectFeatures(image, truth.page, {});
+  const LineFigures f = evaluate::MeasureLines(truth, Segments(r));
   Print(DataSetName(set) + "/" + cam.image + " (rows)", f);
+  MaybeWriteDebug(*gt, cam, image, truth.page, r, DataSetName(set) + "/" + cam.image + " rows");
   return f;
 }
 
@@ -181,6 +182,24 @@ TEST(FeaturesOnReceipts, RealisticRowsAreFoundWhole) {
   const LineFigures f = MeasureReceipt(RealisticDir() / "r03");
   EXPECT_GE(f.precision, 0.97);
   EXPECT_GE(f.recall_text, 0.6);
+}
+
+// The hard receipts: r07 has a corner curled over the page, r09 a panel
+// standing steep. In the raw photo with the true page region r09's rows
+// read 0.580 (its steep panel's 13 rows, a third of its text, are not
+// found; in sfm's reference view, as the pipeline runs, 0.605): r09 is held
+// to 0.55 (docs/decisions/detect-features.md, "A join stays on one layer
+// of paper").
+TEST(FeaturesOnReceipts, HardRowsAreFoundWhole) {
+  const fs::path hard = RealisticHardDir();
+  for (const auto& [name, min_recall] : {std::pair{"r07", 0.6}, std::pair{"r09", 0.55}}) {
+    if (hard.empty() || !fs::exists(hard / name / "ground_truth")) {
+      GTEST_SKIP() << "no ../shared/realistic-hard/" << name;
+    }
+    const LineFigures f = MeasureReceipt(hard / name);
+    EXPECT_GE(f.precision, 0.97) << name;
+    EXPECT_GE(f.recall_text, min_recall) << name;
+  }
 }
 
 std::string SetName(const ::testing::TestParamInfo<fs::path>& info) {

@@ -324,6 +324,57 @@ TEST(DetectFeatures, ARuleAcrossTheGapKeepsATableRowsCellsApart) {
   EXPECT_EQ(WholeRows(DetectFeatures(p.image, p.mask, {}), p.baselines), 0);
 }
 
+// A corner curled over the page shows its blank back, of another grey,
+// over the middle of rows 6 to 8: their items and prices lie in line
+// across it but are on the page beneath. They stay apart; the other rows
+// join as before.
+TEST(DetectFeatures, NoRowIsJoinedAcrossACornerCurledOverIt) {
+  Page p = DrawReceipt();
+  const int whole_before = WholeRows(DetectFeatures(p.image, p.mask, {}), p.baselines);
+  const std::vector<cv::Point> curl = {{380, 220}, {640, 228}, {625, 318}, {395, 312}};
+  cv::fillConvexPoly(p.image, curl, cv::Scalar(205, 205, 205), cv::LINE_AA);
+  const FeaturesResult r = DetectFeatures(p.image, p.mask, {});
+  for (const Segment& s : r.segments) {
+    if (s.kind != "text") continue;
+    const double y = 0.5 * (s.points.front().y + s.points.back().y);
+    const double x0 = std::min(s.points.front().x, s.points.back().x);
+    const double x1 = std::max(s.points.front().x, s.points.back().x);
+    if (y > 220 && y < 318)
+      EXPECT_FALSE(x0 < 400 && x1 > 620) << "a row across the curl at y " << y;
+  }
+  EXPECT_GE(WholeRows(r, p.baselines), whole_before - 3);
+}
+
+// OnePaperLayerTest on a page of grey 200 with the gap from (100, 100) to
+// (500, 100), text 12 px high, letters above the baseline (up = -y).
+bool OneLayer(const cv::Mat1b& grey, const cv::Mat1i& labels) {
+  return detail::OnePaperLayerTest(grey, labels, {0, -1}, 12)({100, 100}, {500, 100});
+}
+
+TEST(FeatureHelpers, OnePaperLayerAcrossShadingAndInk) {
+  cv::Mat1b grey(200, 600, uchar(200));
+  cv::Mat1i labels = cv::Mat1i::zeros(grey.size());
+  EXPECT_TRUE(OneLayer(grey, labels));
+  // Shading drifting from 220 to 160 along the gap (27 %, 2 levels a text
+  // height) is one layer.
+  cv::Mat1b shaded = grey.clone();
+  for (int x = 0; x < shaded.cols; ++x) shaded.col(x).setTo(220 - 60 * x / 600);
+  EXPECT_TRUE(OneLayer(shaded, labels));
+  // So is a dark mark in the gap (a dot, a stray letter): ink is left out.
+  cv::Mat1b marked = grey.clone();
+  cv::rectangle(marked, cv::Rect(290, 86, 10, 12), cv::Scalar(30), cv::FILLED);
+  cv::Mat1i marked_labels = labels.clone();
+  marked_labels(cv::Rect(290, 86, 10, 12)).setTo(1);
+  EXPECT_TRUE(OneLayer(marked, marked_labels));
+  // A blank flap of grey 180 (10 % darker) over the middle of the gap is
+  // another layer; one of 190 (5 %) is taken for shading.
+  for (const auto& [flap, one_layer] : {std::pair{180, false}, std::pair{190, true}}) {
+    cv::Mat1b curled = grey.clone();
+    curled(cv::Rect(250, 0, 120, 200)).setTo(flap);
+    EXPECT_EQ(OneLayer(curled, labels), one_layer) << flap;
+  }
+}
+
 // A piece of a baseline as JoinBaselinePieces takes it: samples every 4 px
 // from x0 to x1 on y = y0 + slope * (x - x0), a quarter pixel up and down
 // in turn (the pixel grid).

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -68,6 +69,41 @@ TEST(GroundTruthHelpers, TrueLinesFallInsideThePage) {
       for (const Eigen::Vector2d& p : l.points)
         ASSERT_GT(mask(int(std::lround(p.y())), int(std::lround(p.x()))), 0) << set;
   }
+}
+
+// A camera behind the page sees its blank back: none of the print's lines.
+// The camera of set01's first photo mirrored through the page's mean plane
+// (x flipped to keep it a camera) sees the same surface as near as before,
+// so only the side it faces tells the lines away.
+TEST(GroundTruthHelpers, TrueLinesAreNotSeenFromBehindThePage) {
+  auto gt = LoadGroundTruth(SampleDir("set01"));
+  ASSERT_TRUE(gt);
+  ASSERT_FALSE(gt->lines.empty());
+  const PinholeCamera& front = gt->cameras.views[0];
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& v : gt->mesh.vertices) c += v / double(gt->mesh.vertices.size());
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  for (const Eigen::Vector3d& v : gt->mesh.vertices) scatter += (v - c) * (v - c).transpose();
+  const Eigen::Vector3d n =
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter).eigenvectors().col(0);
+  const Eigen::Matrix3d mirror = Eigen::Matrix3d::Identity() - 2 * n * n.transpose();
+  const Eigen::Matrix3d flip_x = Eigen::Vector3d(-1, 1, 1).asDiagonal();
+  PinholeCamera behind = front;
+  behind.R = flip_x * front.R * mirror;
+  behind.t = flip_x * (front.R * (2 * c.dot(n) * n) + front.t);
+  auto length = [](const std::vector<TrueLine>& lines) {
+    double sum = 0;
+    for (const TrueLine& l : lines)
+      for (size_t k = 0; k + 1 < l.points.size(); ++k)
+        sum += (l.points[k + 1] - l.points[k]).norm();
+    return sum;
+  };
+  const double seen_from_front = length(TrueLinesInView(*gt, front));
+  ASSERT_GT(seen_from_front, 1000);
+  // The page itself is there: its mask covers as much of the image.
+  EXPECT_GT(cv::countNonZero(TruePageMask(*gt, behind)),
+            0.5 * cv::countNonZero(TruePageMask(*gt, front)));
+  EXPECT_LT(length(TrueLinesInView(*gt, behind)), 0.02 * seen_from_front);
 }
 
 // The page as the true surface and camera predict it in a photo: every pixel
