@@ -129,7 +129,8 @@ bool PrintedSideSeen(const GroundTruth& gt, const PinholeCamera& camera, const E
 bool TruePointSeen(const GroundTruth& gt, const PinholeCamera& camera,
                    const Eigen::Vector2d& flat_px) {
   Eigen::Vector2d px;
-  return SeenAt(gt.ViewRaster(camera), camera, gt.SurfacePoint(flat_px), &px);
+  return SeenAt(gt.ViewRaster(camera), camera, gt.SurfacePoint(flat_px), &px) &&
+         PrintedSideSeen(gt, camera, flat_px);
 }
 
 cv::Mat1b TruePageMask(const GroundTruth& gt, const PinholeCamera& camera) {

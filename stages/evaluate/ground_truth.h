@@ -61,9 +61,9 @@ bool HasTrueSurface(const fs::path& dataset);
 // something is missing or malformed.
 GroundTruth LoadGroundTruth(const fs::path& dataset);
 
-// Whether the true surface at flat.png pixel `flat_px` is seen by `camera`:
-// on the page, in front of the camera, inside its image and not hidden by the
-// page itself.
+// Whether the print at flat.png pixel `flat_px` is seen by `camera`: on the
+// page, in front of the camera, inside its image, not hidden by the page
+// itself, and the printed side (not the blank back) facing the camera.
 bool TruePointSeen(const GroundTruth& gt, const PinholeCamera& camera,
                    const Eigen::Vector2d& flat_px);
 
