@@ -12,6 +12,7 @@
 #include "common/atomic_file.h"
 #include "common/cli.h"
 #include "common/errors.h"
+#include "common/markup.h"
 #include "common/shading.h"
 #include "stages/pdf/markup_scale.h"
 #include "stages/pdf/pdf_file.h"
@@ -45,33 +46,6 @@ std::string ReadText(const fs::path& path) {
   std::stringstream s;
   s << in.rdbuf();
   return s.str();
-}
-
-// Tesseract's escaping of the image name it writes into ALTO and hOCR.
-std::string MarkupEscape(const std::string& text) {
-  std::string out;
-  for (char c : text) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      case '\'':
-        out += "&#39;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
 }
 
 // `text` with every `from` replaced by `to`.
@@ -272,7 +246,7 @@ PdfResult Run(const PdfOptions& o, const PdfInputs& in, const fs::path& out,
   timer.Mark("write_pdf");
 
   // The ALTO and hOCR files name the page image beside them, not the
-  // staging folder it was read from.
+  // staging folder it was read from (Tesseract writes the name escaped).
   // Both are in the pixels of the enlarged copy read: mapped onto the page's.
   const std::string staged = MarkupEscape(image_path.string());
   const std::string alto = ScaleAltoPixels(

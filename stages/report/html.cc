@@ -8,29 +8,6 @@
 
 namespace docunfold::report {
 
-std::string Escape(const std::string& text) {
-  std::string out;
-  for (char c : text) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
-
 std::string Base64(const std::vector<unsigned char>& bytes) {
   static const char* kAlphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
   std::string out;
@@ -57,7 +34,7 @@ std::string InlineImage(const cv::Mat& image, int max_width, const std::string& 
                png ? std::vector<int>{} : std::vector<int>{cv::IMWRITE_JPEG_QUALITY, 88});
   return "<img src=\"data:image/" + std::string(png ? "png" : "jpeg") + ";base64," + Base64(bytes) +
          "\" width=\"" + std::to_string(scaled.cols) + "\" height=\"" +
-         std::to_string(scaled.rows) + "\" alt=\"" + Escape(alt) + "\">";
+         std::to_string(scaled.rows) + "\" alt=\"" + MarkupEscape(alt) + "\">";
 }
 
 namespace {
@@ -146,16 +123,16 @@ std::string SvgScatter(const std::vector<PlotPoint>& points, const PlotOptions& 
     std::snprintf(buf, sizeof buf,
                   "<line x1=\"%d\" y1=\"%.1f\" x2=\"%d\" y2=\"%.1f\" stroke=\"#ddd\"/>"
                   "<text x=\"%d\" y=\"%.1f\" text-anchor=\"end\">%s</text>",
-                  left, Y(t), left + w, Y(t), left - 4, Y(t) + 4, Escape(label).c_str());
+                  left, Y(t), left + w, Y(t), left - 4, Y(t) + 4, MarkupEscape(label).c_str());
     s += buf;
   }
   std::snprintf(buf, sizeof buf, "<text x=\"%d\" y=\"%d\" text-anchor=\"middle\">%s</text>",
-                left + w / 2, o.height - 8, Escape(o.x_label).c_str());
+                left + w / 2, o.height - 8, MarkupEscape(o.x_label).c_str());
   s += buf;
   std::snprintf(buf, sizeof buf,
                 "<text x=\"12\" y=\"%d\" text-anchor=\"middle\" transform=\"rotate(-90 12 %d)\">"
                 "%s</text>",
-                top + h / 2, top + h / 2, Escape(o.y_label).c_str());
+                top + h / 2, top + h / 2, MarkupEscape(o.y_label).c_str());
   s += buf;
   for (const PlotPoint& p : points) {
     const double y = o.log_y ? std::log10(std::max(p.y, 1e-300)) : p.y;
@@ -169,7 +146,7 @@ std::string SvgScatter(const std::vector<PlotPoint>& points, const PlotOptions& 
                   "<circle cx=\"%d\" cy=\"%d\" r=\"4\" fill=\"%s\"/>"
                   "<text x=\"%d\" y=\"%d\">%s</text>",
                   left + w - 90, top + 12 + int(i) * 15, kColours[i % 8], left + w - 82,
-                  top + 16 + int(i) * 15, Escape(o.series_names[i]).c_str());
+                  top + 16 + int(i) * 15, MarkupEscape(o.series_names[i]).c_str());
     s += buf;
   }
   return s + "</svg>";

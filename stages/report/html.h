@@ -1,14 +1,15 @@
-// Small pieces of a self-contained HTML page: escaped text, images inlined as
-// data: URIs, and an inline SVG scatter plot.
+// Small pieces of a self-contained HTML page: images inlined as data: URIs
+// and an inline SVG scatter plot (text is escaped by common/markup.h).
 #pragma once
 
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
 
+#include "common/markup.h"
+
 namespace docunfold::report {
 
-std::string Escape(const std::string& text);
 std::string Base64(const std::vector<unsigned char>& bytes);
 
 // <img> with the image encoded inline (JPEG unless `png`), scaled to at most

@@ -61,21 +61,21 @@ cv::Mat TryImage(const fs::path& p) {
 }
 
 std::string Missing(const std::string& what) {
-  return "<p class=\"missing\">" + Escape(what) + "</p>";
+  return "<p class=\"missing\">" + MarkupEscape(what) + "</p>";
 }
 
 class Page {
  public:
   void Section(const std::string& id, const std::string& title) {
-    body_ += "<section id=\"" + id + "\"><h2>" + Escape(title) + "</h2>\n";
-    toc_ += "<a href=\"#" + id + "\">" + Escape(title) + "</a> ";
+    body_ += "<section id=\"" + id + "\"><h2>" + MarkupEscape(title) + "</h2>\n";
+    toc_ += "<a href=\"#" + id + "\">" + MarkupEscape(title) + "</a> ";
   }
   void End() { body_ += "</section>\n"; }
   void Add(const std::string& html) { body_ += html; }
   std::string Html(const std::string& title, const std::string& summary) const {
     return "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
            "<title>" +
-           Escape(title) +
+           MarkupEscape(title) +
            "</title><style>"
            "body{font-family:sans-serif;margin:1.5em auto;max-width:1200px;color:#222}"
            "h1{margin-bottom:0.2em}h2{border-bottom:1px solid #ccc;padding-bottom:0.2em;"
@@ -86,7 +86,7 @@ class Page {
            ".ref{outline:4px solid #d62728}.missing{color:#a00;font-style:italic}"
            "code{background:#f4f4f4;padding:1px 3px}img{max-width:100%;height:auto}"
            "</style></head><body>\n<h1>" +
-           Escape(title) + "</h1><p>" + summary + "</p><nav>" + toc_ + "</nav>\n" + body_ +
+           MarkupEscape(title) + "</h1><p>" + summary + "</p><nav>" + toc_ + "</nav>\n" + body_ +
            "</body></html>\n";
   }
 
@@ -133,7 +133,7 @@ void PhotosSection(const ReportOptions& o, const DataSet& data, const Json& came
     if (cameras.is_object())
       for (const Json& v : cameras.at("views"))
         registered = registered || v.value("image", "") == name;
-    html += Figure(img, Escape(name) + (is_ref ? " — <b>reference</b>" : "") +
+    html += Figure(img, MarkupEscape(name) + (is_ref ? " — <b>reference</b>" : "") +
                             (cameras.is_object() && !registered ? " — not registered" : ""));
   }
   page->Add(html);
@@ -154,10 +154,10 @@ void PhotosSection(const ReportOptions& o, const DataSet& data, const Json& came
         std::vector<std::string> keys;
         for (const auto& [k, v] : c["views"][0].items())
           if (k != "image" && v.is_number()) keys.push_back(k);
-        for (const auto& k : keys) why += "<th>" + Escape(k) + "</th>";
+        for (const auto& k : keys) why += "<th>" + MarkupEscape(k) + "</th>";
         why += "</tr>";
         for (const Json& cand : c["views"]) {
-          why += "<tr><td class=l>" + Escape(cand.value("image", "?")) + "</td>";
+          why += "<tr><td class=l>" + MarkupEscape(cand.value("image", "?")) + "</td>";
           for (const auto& k : keys)
             why += "<td>" +
                    (cand.contains(k) && cand[k].is_number() ? Fmt(cand[k].get<double>(), "%.3g")
@@ -173,8 +173,8 @@ void PhotosSection(const ReportOptions& o, const DataSet& data, const Json& came
                                     : Json::array();
     std::string left_out;
     for (const Json& l : left_out_files)
-      left_out +=
-          "<li>" + Escape(l.value("image", "?")) + " (" + Escape(l.value("reason", "")) + ")</li>";
+      left_out += "<li>" + MarkupEscape(l.value("image", "?")) + " (" +
+                  MarkupEscape(l.value("reason", "")) + ")</li>";
     const size_t photos = data.images.size() - left_out_files.size();
     page->Add("<p>" + std::to_string(cameras.at("views").size()) + " of " + std::to_string(photos) +
               " photos registered. " + why + "</p>" +
@@ -266,7 +266,7 @@ void MeshSection(const ReportOptions& o, const Json& cameras, Page* page, fs::pa
       caption += PointsCounts(counts);
       page->Add(Figure(InlineImage(points_overlay, o.figure_width / 2 + 100, "points"), caption));
     }
-    page->Add("<p>M and M' from <code>" + Escape(mesh_dir->filename().string()) +
+    page->Add("<p>M and M' from <code>" + MarkupEscape(mesh_dir->filename().string()) +
               "/</code>: " + std::to_string(mesh.grid.nx) + " × " + std::to_string(mesh.grid.ny) +
               " vertices; " + std::to_string(points.size()) +
               " points. Open <code>mesh3d.ply</code> in MeshLab to see M textured, or "
@@ -309,7 +309,7 @@ void ConvergenceSection(const ReportOptions& o, Page* page) {
     table += "<tr><td class=l>" + std::to_string(r) + "</td><td>" + grid + "</td><td>" +
              std::to_string(round.value("iterations", Json::array()).size()) + "</td><td>" +
              Fmt(last_f, "%.3e") + "</td><td>" + Fixed(last_t, 2) + "</td><td class=l>" +
-             Escape(round.value("stop_reason", "")) + "</td></tr>";
+             MarkupEscape(round.value("stop_reason", "")) + "</td></tr>";
   }
   table += "</table>";
   page->Add(SvgScatter(points, plot));
@@ -329,7 +329,7 @@ std::string MetricsRow(const Json& m) {
                                                   : std::string("–")) +
            "</td>";
   };
-  return "<tr><td class=l>" + Escape(m.value("method", "?")) + "</td>" + cell("ms_ssim", 4) +
+  return "<tr><td class=l>" + MarkupEscape(m.value("method", "?")) + "</td>" + cell("ms_ssim", 4) +
          cell("ld", 2) + cell("li_d", 2) + cell("cer", 3) + cell("wer", 3) +
          cell("surface_mean_pct", 2) + cell("isometry_mean", 4) + "</tr>";
 }
@@ -364,7 +364,7 @@ std::string FrontEndParagraph(const Json& f) {
     return o.contains("holds") && !o["holds"].value(key, true) ? std::string(" ✗") : "";
   };
   std::string p =
-      "<p>Front end against the ground truth in " + Escape(f.value("reference", "?")) + ": ";
+      "<p>Front end against the ground truth in " + MarkupEscape(f.value("reference", "?")) + ": ";
   const Json& b = f.value("boundary", Json::object());
   if (b.contains("iou"))
     p += "boundary IoU " + number(b, "iou", 4) + miss(b, "iou") + ", worst visible corner " +
@@ -394,9 +394,9 @@ void ResultSection(const ReportOptions& o, const DataSet& data, const fs::path& 
                             "60_render/rectified.png (" + std::to_string(rectified.cols) + " × " +
                                 std::to_string(rectified.rows) + ")");
   if (!grid.empty())
-    html +=
-        Figure(InlineImage(grid, o.figure_width / 2, "rectified with M'"),
-               "The same with the edges of M' (from " + Escape(mesh_dir.filename().string()) + ")");
+    html += Figure(
+        InlineImage(grid, o.figure_width / 2, "rectified with M'"),
+        "The same with the edges of M' (from " + MarkupEscape(mesh_dir.filename().string()) + ")");
   const cv::Mat labels = TryImage(o.work / "60_render/texture_labels.png");
   const Json render_json = TryJson(o.work / "60_render/render.json");
   if (!labels.empty() && render_json.is_object() && render_json.contains("texture")) {
@@ -407,7 +407,7 @@ void ResultSection(const ReportOptions& o, const DataSet& data, const fs::path& 
       char hex[8];
       std::snprintf(hex, sizeof hex, "#%02x%02x%02x", c[2], c[1], c[0]);
       legend += std::string(v == 0 ? "" : ", ") + "<span style=\"color:" + hex + "\">■</span> " +
-                Escape(views[v].value("view", "?")) + (v == 0 ? " (reference) " : " ") +
+                MarkupEscape(views[v].value("view", "?")) + (v == 0 ? " (reference) " : " ") +
                 Fixed(100 * views[v].value("share", 0.0), 1) + " %";
     }
     html += Figure(
@@ -486,7 +486,8 @@ void PdfSection(const ReportOptions& o, Page* page) {
     page->End();
     return;
   }
-  page->Add("<p><a href=\"" + Escape(file) + "\">" + Escape(file) + "</a>: " + summary + "</p>");
+  page->Add("<p><a href=\"" + MarkupEscape(file) + "\">" + MarkupEscape(file) + "</a>: " + summary +
+            "</p>");
   if (!svg.empty())
     page->Add(Figure(svg,
                      "The words of the text layer in their boxes (blue; red below 0.6 "
@@ -518,7 +519,7 @@ void StagesSection(const ReportOptions& o, Page* page) {
       total += it->second.value("seconds", 0.0);
     }
     t += "<tr><td class=l>" + stage + "</td><td>" + secs + "</td><td>" + mem +
-         "</td><td class=l><code>" + Escape(flags.empty() ? "(defaults)" : flags) +
+         "</td><td class=l><code>" + MarkupEscape(flags.empty() ? "(defaults)" : flags) +
          "</code></td></tr>";
   }
   t += "<tr><th class=l>total</th><th>" + Fixed(total, 1) + "</th><th></th><th></th></tr>";
@@ -557,7 +558,7 @@ ReportResult Run(const ReportOptions& o) {
   const std::string name = fs::absolute(o.data).lexically_normal().filename().string();
   ReportResult r;
   r.html = page.Html("docunfold report: " + name,
-                     "Data set <code>" + Escape(fs::absolute(o.data).string()) + "</code>, " +
+                     "Data set <code>" + MarkupEscape(fs::absolute(o.data).string()) + "</code>, " +
                          std::to_string(data.images.size()) + " files in images/; made " + date +
                          " by docunfold " + ProgramVersion() + ".");
   return r;

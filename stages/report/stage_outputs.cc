@@ -124,7 +124,7 @@ std::string PdfWordsSvg(const cv::Mat& page_image, const Json& pdf, int width) {
            "<text x=\"" + Fixed(x, 0) + "\" y=\"" + Fixed(y + 0.85 * bh, 1) + "\" font-size=\"" +
            Fixed(bh, 1) + "\" textLength=\"" + Fixed(bw, 0) +
            "\" lengthAdjust=\"spacingAndGlyphs\" fill=\"" + colour + "\">" +
-           Escape(word[5].get<std::string>()) + "</text>";
+           MarkupEscape(word[5].get<std::string>()) + "</text>";
   }
   return svg + "</svg>";
 }
@@ -140,10 +140,10 @@ std::string PdfSummary(const Json& pdf) {
   const Json dpi = page.value("dpi", Json::array());
   return (format == "None" ? std::string("No standard paper format") : "Paper " + format) + ", " +
          Fixed(page.value("width_mm", 0.0), 1) + " × " + Fixed(page.value("height_mm", 0.0), 1) +
-         " mm (" + Escape(page.value("rule", "")) + "), " +
+         " mm (" + MarkupEscape(page.value("rule", "")) + "), " +
          (dpi.size() == 2 ? Fixed(dpi[0].get<double>(), 0) : std::string("?")) + " dpi; " +
          std::to_string(text.value("words", 0)) + " words read (" +
-         Escape(text.value("language", "")) + "), mean confidence " +
+         MarkupEscape(text.value("language", "")) + "), mean confidence " +
          Fixed(text.value("mean_confidence", 0.0), 2) + "; " +
          std::to_string(pdf.value("/files/pdf_bytes"_json_pointer, 0) / 1024) + " KB.";
 }
