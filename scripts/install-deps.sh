@@ -7,8 +7,8 @@
 set -euo pipefail
 
 packages=(
-  # toolchain
-  build-essential cmake pkg-config
+  # toolchain (lld: a faster linker than GNU ld)
+  build-essential cmake pkg-config lld
   # images, features, freetype text rendering (synth), LSD, DeepFlow
   libopencv-dev libopencv-contrib-dev
   # the photo reader: libjpeg to tell a damaged JPEG from a whole one, EXIF
