@@ -103,7 +103,7 @@ FeaturesResult DetectFeatures(const cv::Mat& image, const cv::Mat& mask_in,
   ink &= region;
   const detail::InkComponents components = detail::FindComponents(ink);
   step("ink: " + std::to_string(components.count - 1) + " marks");
-  detail::TextResult text = detail::DetectTextSegments(components, grey, options);
+  detail::TextResult text = detail::DetectTextSegments(components, grey, image, options);
   step("text: " + std::to_string(text.segments.size()) + " segments, height " +
        Fixed(text.height, 2) + " px");
   std::vector<Segment> edges =

@@ -37,7 +37,7 @@ struct TextResult {
   std::vector<char> is_character;  // per component label: chained as text
 };
 TextResult DetectTextSegments(const InkComponents& ink, const cv::Mat1b& grey,
-                              const FeaturesOptions& options);
+                              const cv::Mat3b& colour, const FeaturesOptions& options);
 
 // A straight piece of one chain's baseline, before the shortest are left
 // out: pieces of one row may still be joined across a wide gap.
@@ -59,9 +59,11 @@ struct BaselinePiece {
 // `blank`, if given, tells whether the gap between two baseline points is
 // free of ink other than characters (a table's column rule crosses it: the
 // cells of a row are separate lines).
-// Only a page whose rows are gapped joins anything: unless at least 30 % of
-// the joined groups bridge a gap wider than 3 text heights (a receipt's item
-// and price), every piece comes back alone. On a
+// Only a page whose rows are gapped joins anything: unless the joined groups
+// that bridge a gap wider than 3 text heights (a receipt's item and price)
+// make at least 40 % of the groups' length along the text, every piece comes
+// back alone (counted by length, not by group: a till roll's lone VAT codes,
+// separators and header words are many but short). On a
 // page of running text such a gap is where glare or a fold's highlight
 // washed the print out, and a line joined across it joins two panels.
 using GapTest = std::function<bool(const cv::Point2d& from, const cv::Point2d& to)>;
@@ -86,6 +88,18 @@ GapTest BlankGapTest(const InkComponents& ink, cv::Point2d d, cv::Point2d up, do
 // `labels` (the ink components) must outlive the test.
 GapTest OnePaperLayerTest(const cv::Mat1b& grey, const cv::Mat1i& labels, cv::Point2d up,
                           double x_height);
+
+// A GapTest over `colour`: the paper between the pieces has one hue. Shading
+// darkens paper without changing its hue, the blank back of a corner curled
+// over the page (another paper, or lit otherwise) need not. So no step of
+// the paper's chromaticity (blue and red shares, ink and its rim left out)
+// over 0.01 between the medians over one text height either side of a
+// point, in the band of OnePaperLayerTest, from a text height into one
+// piece to a text height into the other: the paper between their letters
+// counts too (a layer may cover the whole gap). `colour` and `labels` must
+// outlive the test.
+GapTest OnePaperHueTest(const cv::Mat3b& colour, const cv::Mat1i& labels, cv::Point2d up,
+                        double x_height);
 
 // Centre lines of thin dark lines (and, if asked, single step edges) found by
 // LSD in `grey`, inside `region`, that are not character strokes.

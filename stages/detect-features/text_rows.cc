@@ -2,6 +2,7 @@
 // and its price lie far apart on one baseline, each too short to keep alone
 // (docs/decisions/detect-features.md, "Receipt rows joined across their gap").
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <memory>
 #include <opencv2/imgproc.hpp>
@@ -18,16 +19,31 @@ constexpr double kMaxTurn = 3.0 * kDegree;   // the joint line against the rows 
 constexpr double kMaxOffset = 0.15;          // of the x-height: rows lie a line apart
 constexpr double kMaxHeightRatio = 1.25;     // one font size: digits against letters
 constexpr int kNeighbours = 8;               // pieces around one that tell the rows' direction
-// A page's rows are joined only when this fraction of them bridge a gap
-// wider than kWideGap text heights (feature_parts.h, JoinBaselinePieces).
+// A page's rows are joined only when those that bridge a gap wider than
+// kWideGap text heights make this share of the rows' length
+// (feature_parts.h, JoinBaselinePieces): on the text pages, tables and the
+// poster at most 0.21, on the receipts at least 0.61.
 constexpr double kWideGap = 3.0;
-constexpr double kMinGappedRows = 0.3;
+constexpr double kMinGappedLength = 0.4;
 constexpr double kMaxDrift = 1.5;  // text heights a line may drift over a gap (3 sigma)
 // The largest step of the paper's grey within a gap, of the brighter side:
 // a fold's shadow along a receipt's rows reaches 6 %, the blank back of a
 // corner curled over the page 11 % (docs/decisions/detect-features.md,
 // "A join stays on one layer of paper").
 constexpr double kMaxPaperStep = 0.08;
+// The largest step of the paper's chromaticity along a gap and a text height
+// into either piece: at most 0.0045 on the receipts' rows, 0.016 to 0.018
+// where r07's rows run under the tip of its curled corner
+// (docs/decisions/detect-features.md, "A till roll's rows").
+constexpr double kMaxHueStep = 0.01;
+
+// Whether a pixel is ink or its 1 px rim (antialiasing).
+bool NearInk(const cv::Mat1i& labels, int x, int y) {
+  for (int v = std::max(0, y - 1); v <= std::min(labels.rows - 1, y + 1); ++v)
+    for (int u = std::max(0, x - 1); u <= std::min(labels.cols - 1, x + 1); ++u)
+      if (labels(v, u) != 0) return true;
+  return false;
+}
 
 double Cross(cv::Point2d u, cv::Point2d v) { return u.x * v.y - u.y * v.x; }
 
@@ -158,18 +174,49 @@ GapTest BlankGapTest(const InkComponents& ink, cv::Point2d d, cv::Point2d up, do
   };
 }
 
+GapTest OnePaperHueTest(const cv::Mat3b& colour, const cv::Mat1i& labels, cv::Point2d up,
+                        double x_height) {
+  return [&colour, &labels, up, x_height](const cv::Point2d& from, const cv::Point2d& to) {
+    const double length = cv::norm(to - from);
+    const cv::Point2d along = (to - from) * (1.0 / std::max(1e-9, length));
+    // Per pixel along the gap: the median blue and red shares of the
+    // paper's colour across the letters' band; none where all is ink.
+    std::vector<std::array<double, 2>> hue;
+    std::vector<char> paper;
+    for (double t = -x_height; t <= length + x_height; t += 1.0) {
+      std::vector<double> blue, red;
+      for (double lift : {0.3, 0.5, 0.7}) {
+        const cv::Point2d p = from + along * t + up * (lift * x_height);
+        const int x = int(std::lround(p.x)), y = int(std::lround(p.y));
+        if (x < 0 || y < 0 || x >= colour.cols || y >= colour.rows || NearInk(labels, x, y))
+          continue;
+        const cv::Vec3b c = colour(y, x);
+        const double sum = std::max(1.0, double(c[0]) + c[1] + c[2]);
+        blue.push_back(c[0] / sum);
+        red.push_back(c[2] / sum);
+      }
+      paper.push_back(!blue.empty());
+      hue.push_back({blue.empty() ? 0 : Median(blue), red.empty() ? 0 : Median(red)});
+    }
+    const int w = std::max(2, int(std::lround(x_height)));
+    for (int t = w; t + w <= int(hue.size()); ++t)
+      for (size_t ch = 0; ch < 2; ++ch) {
+        std::vector<double> before, after;
+        for (int k = t - w; k < t + w; ++k)
+          if (paper[size_t(k)]) (k < t ? before : after).push_back(hue[size_t(k)][ch]);
+        if (2 * before.size() < size_t(w) || 2 * after.size() < size_t(w)) continue;
+        if (std::abs(Median(before) - Median(after)) > kMaxHueStep) return false;
+      }
+    return true;
+  };
+}
+
 GapTest OnePaperLayerTest(const cv::Mat1b& grey, const cv::Mat1i& labels, cv::Point2d up,
                           double x_height) {
   return [&grey, &labels, up, x_height](const cv::Point2d& from, const cv::Point2d& to) {
     // The paper's grey along the gap, inside the letters' band (lifted 0.3
     // to 0.7 of the text height off the baseline), ink and its 1 px rim
     // left out, and a text height clear of either piece's last letter.
-    auto near_ink = [&](int x, int y) {
-      for (int v = std::max(0, y - 1); v <= std::min(labels.rows - 1, y + 1); ++v)
-        for (int u = std::max(0, x - 1); u <= std::min(labels.cols - 1, x + 1); ++u)
-          if (labels(v, u) != 0) return true;
-      return false;
-    };
     const double length = cv::norm(to - from);
     const cv::Point2d along = (to - from) * (1.0 / std::max(1e-9, length));
     std::vector<double> paper;  // per pixel along the gap; -1 where all is ink
@@ -178,7 +225,7 @@ GapTest OnePaperLayerTest(const cv::Mat1b& grey, const cv::Mat1i& labels, cv::Po
       for (double lift : {0.3, 0.5, 0.7}) {
         const cv::Point2d p = from + along * t + up * (lift * x_height);
         const int x = int(std::lround(p.x)), y = int(std::lround(p.y));
-        if (x < 0 || y < 0 || x >= grey.cols || y >= grey.rows || near_ink(x, y)) continue;
+        if (x < 0 || y < 0 || x >= grey.cols || y >= grey.rows || NearInk(labels, x, y)) continue;
         column.push_back(grey(y, x));
       }
       paper.push_back(column.empty() ? -1 : Median(column));
@@ -273,18 +320,19 @@ std::vector<std::vector<int>> JoinBaselinePieces(const std::vector<BaselinePiece
     b.samples.clear();
   }
   std::vector<std::vector<int>> out;
-  int gapped = 0;
+  double length = 0, gapped = 0;
   for (Group& g : groups) {
     if (g.pieces.empty()) continue;
+    length += g.a1 - g.a0;
     for (size_t k = 1; k < g.pieces.size(); ++k)
       if (pieces[size_t(g.pieces[k])].first.dot(d) - pieces[size_t(g.pieces[k - 1])].last.dot(d) >
           kWideGap * x_height) {
-        ++gapped;
+        gapped += g.a1 - g.a0;
         break;
       }
     out.push_back(std::move(g.pieces));
   }
-  if (gapped < kMinGappedRows * double(out.size())) {
+  if (gapped < kMinGappedLength * length) {
     out.clear();
     for (int i = 0; i < count; ++i) out.push_back({i});
   }

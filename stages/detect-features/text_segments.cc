@@ -12,6 +12,11 @@
 namespace docunfold::features::detail {
 namespace {
 
+// On a page whose rows join, a chain's own letters' band under this many
+// text heights is a separator's, not text (receipts' lowercase: 0.7 and
+// more, their "=" and "-" rows 0.4 to 0.5).
+constexpr double kMinOwnBand = 0.6;
+
 // A character candidate: a connected component with its pixels and, once
 // the text direction d and its normal n are known, its extent along both.
 struct Mark {
@@ -117,70 +122,6 @@ double TextDirection(const std::vector<Mark>& marks, double char_size) {
   if (median_spacing(across) < median_spacing(best)) best = std::fmod(across + CV_PI, CV_PI);
   return best;
 }
-
-}  // namespace
-
-LineFit FitLine(const std::vector<cv::Point2d>& points) {
-  LineFit fit;
-  if (points.empty()) return fit;
-  cv::Point2d mean(0, 0);
-  for (const auto& p : points) mean += p;
-  mean *= 1.0 / double(points.size());
-  double sxx = 0, sxy = 0, syy = 0;
-  for (const auto& p : points) {
-    const cv::Point2d d = p - mean;
-    sxx += d.x * d.x;
-    sxy += d.x * d.y;
-    syy += d.y * d.y;
-  }
-  const double angle = 0.5 * std::atan2(2 * sxy, sxx - syy);
-  fit.direction = {std::cos(angle), std::sin(angle)};
-  fit.point = mean;
-  double r2 = 0;
-  for (const auto& p : points) {
-    const cv::Point2d d = p - mean;
-    const double r = d.x * -fit.direction.y + d.y * fit.direction.x;
-    r2 += r * r;
-  }
-  fit.rms = std::sqrt(r2 / double(points.size()));
-  return fit;
-}
-
-std::vector<std::pair<int, int>> SplitWhereBent(const std::vector<cv::Point2d>& points,
-                                                double tolerance) {
-  std::vector<std::pair<int, int>> out;
-  if (points.size() < 2) {
-    if (!points.empty()) out.emplace_back(0, 0);
-    return out;
-  }
-  std::vector<std::pair<int, int>> stack = {{0, int(points.size()) - 1}};
-  while (!stack.empty()) {
-    auto [a, b] = stack.back();
-    stack.pop_back();
-    const cv::Point2d chord = points[b] - points[a];
-    const double len = cv::norm(chord);
-    int worst = -1;
-    double worst_d = tolerance;
-    for (int k = a + 1; k < b; ++k) {
-      const cv::Point2d v = points[k] - points[a];
-      const double d = len > 1e-9 ? std::abs(chord.x * v.y - chord.y * v.x) / len : cv::norm(v);
-      if (d > worst_d) {
-        worst_d = d;
-        worst = k;
-      }
-    }
-    if (worst < 0) {
-      out.emplace_back(a, b);
-    } else {
-      stack.emplace_back(worst, b);
-      stack.emplace_back(a, worst);
-    }
-  }
-  std::sort(out.begin(), out.end());
-  return out;
-}
-
-namespace {
 
 // Step 1: the marks of character size (merged letters of a word included),
 // with their pixels and centres; none when there are fewer than three.
@@ -368,11 +309,14 @@ struct Sample {
 };
 
 // The outline of a chain on one side: in narrow bins along the line, the
-// ink's extreme towards sign * n (sign +1: the +n side).
-std::vector<Sample> Outline(const TextLines& lines, const std::vector<int>& chain, double sign) {
+// ink's extreme towards sign * n (sign +1: the +n side). `band`: the height
+// of the letters' band the ink must nearly cross (below, the page's text
+// height).
+std::vector<Sample> Outline(const TextLines& lines, const std::vector<int>& chain, double sign,
+                            double band) {
   const std::vector<Mark>& marks = lines.marks;
   const cv::Point2d d = lines.d, n = lines.n;
-  const double bin = lines.bin, x_height = lines.x_height;
+  const double bin = lines.bin;
   std::vector<Sample> samples;
   for (int k : chain) {
     const Mark& m = marks[k];
@@ -393,7 +337,7 @@ std::vector<Sample> Outline(const TextLines& lines, const std::vector<int>& chai
     // extreme is somewhere in the middle of the band. The ink's edge lies
     // half a pixel beyond the last ink pixel's centre.
     for (int b = 0; b < bins; ++b)
-      if (best[size_t(b)] > -1e299 && best[size_t(b)] - least[size_t(b)] >= 0.6 * x_height)
+      if (best[size_t(b)] > -1e299 && best[size_t(b)] - least[size_t(b)] >= 0.6 * band)
         samples.push_back({best_a[size_t(b)], best[size_t(b)] + 0.5, k});
   }
   std::sort(samples.begin(), samples.end(),
@@ -436,7 +380,7 @@ void StrayVotes(const TextLines& lines, double* stray_plus, double* stray_minus)
   for (const auto& chain : lines.chains) {
     if (chain.size() < 3) continue;
     for (double side : {1.0, -1.0})
-      for (double o : Offsets(Outline(lines, chain, side), 3 * x_height))
+      for (double o : Offsets(Outline(lines, chain, side, x_height), 3 * x_height))
         (side > 0 ? *stray_plus : *stray_minus) += std::min(std::abs(o), 0.6 * x_height);
   }
 }
@@ -531,20 +475,31 @@ int BaselineSide(const InkComponents& ink, const TextLines& lines, TextResult* r
 // Step 6, for one chain: the outline on the baseline side (`sign`),
 // descenders and raised parts dropped, cut where it bends; appends the
 // straight pieces to `pieces` (short ones too: a piece may continue
-// another across a gap). `refit_tilt`: the chain's tilt fitted again
-// without its descenders (docs/decisions/detect-features.md, "Short words'
-// tilt refitted on receipts").
+// another across a gap). `receipt`: on a page whose rows join, the chain's
+// tilt is fitted again without its descenders (docs/decisions/
+// detect-features.md, "Short words' tilt refitted on receipts") and its
+// outline sampled against its own letters' band ("A till roll's rows").
 void AddBaselinePieces(const TextLines& lines, const std::vector<int>& chain, double sign,
-                       double tolerance, const FeaturesOptions& options, bool refit_tilt,
+                       double tolerance, const FeaturesOptions& options, bool receipt,
                        std::vector<BaselinePiece>* pieces) {
   const cv::Point2d d = lines.d, n = lines.n;
   const double x_height = lines.x_height;
-  const std::vector<Sample> samples = Outline(lines, chain, sign);
+  double letters = x_height;
+  if (receipt) {
+    // A till roll's text height is that of its digits and capitals; the
+    // lowercase of its items would never cross 0.6 of it. A chain whose
+    // own band is under 0.6 text heights is not text but a separator's
+    // dashes or double bars, with no ink on the baseline.
+    const ChainBand own = FitChainBand(lines.marks, chain);
+    letters = std::min(x_height, Median(own.bottoms) - Median(own.tops) + 1);
+    if (letters < kMinOwnBand * x_height) return;
+  }
+  const std::vector<Sample> samples = Outline(lines, chain, sign, letters);
   // Fewer than 5 make no segment alone, but a price of a few digits may
   // continue its item's baseline.
   if (samples.size() < (options.row_gap > 0 ? 3u : 5u)) return;
   std::vector<double> off = Offsets(samples, 3 * x_height);
-  if (refit_tilt) {
+  if (receipt) {
     // A short word's tilt is pulled by its descenders ("Apples": two p's of
     // six letters) until they pass the band below; fitted again without
     // the samples beyond the baseline side, they stick out.
@@ -622,7 +577,7 @@ void AddBaselineSegments(const std::vector<BaselinePiece>& pieces,
 }  // namespace
 
 TextResult DetectTextSegments(const InkComponents& ink, const cv::Mat1b& grey,
-                              const FeaturesOptions& options) {
+                              const cv::Mat3b& colour, const FeaturesOptions& options) {
   TextResult result;
   result.is_character.assign(size_t(ink.count), 0);
   // 1. Marks of character size.
@@ -661,27 +616,31 @@ TextResult DetectTextSegments(const InkComponents& ink, const cv::Mat1b& grey,
   const double tolerance = std::max(options.bend_px, options.bend_rel * lines.x_height);
   for (const auto& chain : lines.chains)
     for (int k : chain) result.is_character[size_t(marks[k].label)] = 1;
-  auto baseline_pieces = [&](bool refit_tilt) {
+  auto baseline_pieces = [&](bool receipt) {
     std::vector<BaselinePiece> pieces;
     if (result.orientation_known)
       for (const auto& chain : lines.chains)
-        AddBaselinePieces(lines, chain, sign, tolerance, options, refit_tilt, &pieces);
+        AddBaselinePieces(lines, chain, sign, tolerance, options, receipt, &pieces);
     return pieces;
   };
   std::vector<BaselinePiece> pieces = baseline_pieces(false);
 
   // 7. Pieces of one row joined across wide gaps, then fitted and kept if
   // long enough. On a page whose rows join (a receipt) the pieces are made
-  // again with short words' tilt refitted; text pages keep theirs.
+  // again, short words' tilt refitted and each chain sampled against its
+  // own letters' band; text pages keep theirs.
   std::vector<std::vector<int>> groups;
   if (options.row_gap > 0) {
     const cv::Point2d up = -sign * lines.n;
     const GapTest rules = BlankGapTest(ink, lines.d, up, lines.x_height, h_med);
     const GapTest layer = OnePaperLayerTest(grey, ink.labels, up, lines.x_height);
+    const GapTest hue = OnePaperHueTest(colour, ink.labels, up, lines.x_height);
     auto join = [&] {
-      return JoinBaselinePieces(
-          pieces, lines.d, lines.x_height, tolerance, options.row_gap * lines.x_height,
-          [&](const cv::Point2d& a, const cv::Point2d& b) { return rules(a, b) && layer(a, b); });
+      return JoinBaselinePieces(pieces, lines.d, lines.x_height, tolerance,
+                                options.row_gap * lines.x_height,
+                                [&](const cv::Point2d& a, const cv::Point2d& b) {
+                                  return rules(a, b) && layer(a, b) && hue(a, b);
+                                });
     };
     groups = join();
     if (groups.size() < pieces.size()) {

@@ -144,6 +144,49 @@ class Typesetter {
       page_->text.push_back(text.substr(first));
   }
 
+  // Draws a row of rule characters (a till's "-----", "=====" or "....."):
+  // the row is a line of text.txt, but nothing of it sits on its baseline,
+  // so each bar of its ink is recorded as a true rule line instead, along
+  // the middle of the bar.
+  void RuleRow(const std::string& style, double size_pt, const std::string& text, double u,
+               double v, const cv::Scalar& colour) {
+    Ink(style, size_pt, text, u, v, colour);
+    page_->text.push_back(text);
+    // The row drawn again alone, black on white, baseline at (h, h).
+    const int h = std::max(1, Px(size_pt * kMetresPerPoint));
+    const int w = Px(u + Width(style, size_pt, text)) - Px(u);
+    cv::Mat scratch(2 * h, w + 2 * h, CV_8UC3, cv::Scalar(255, 255, 255));
+    Font(style)->putText(scratch, text, cv::Point(h, h), h, cv::Scalar(0, 0, 0), -1, cv::LINE_AA,
+                         true);
+    cv::Mat1b dark;
+    cv::cvtColor(scratch, dark, cv::COLOR_BGR2GRAY);
+    dark = dark < 128;
+    // Rows of ink across a tenth of the row or more (dots too) make a bar.
+    std::vector<int> count(size_t(dark.rows));
+    for (int y = 0; y < dark.rows; ++y) count[size_t(y)] = cv::countNonZero(dark.row(y));
+    for (int y = 0; y < dark.rows;) {
+      if (count[size_t(y)] < 0.1 * w) {
+        ++y;
+        continue;
+      }
+      double sum = 0, weight = 0;
+      int x0 = dark.cols, x1 = -1;
+      for (; y < dark.rows && count[size_t(y)] >= 0.1 * w; ++y) {
+        sum += double(y) * count[size_t(y)];
+        weight += count[size_t(y)];
+        for (int x = 0; x < dark.cols; ++x)
+          if (dark(y, x)) {
+            x0 = std::min(x0, x);
+            x1 = std::max(x1, x);
+          }
+      }
+      const double bar_v = v + (sum / weight + 0.5 - h) / page_->pixels_per_m;  // row centres
+      page_->lines.push_back({"rule",
+                              {{u + (x0 - h) / page_->pixels_per_m, bar_v},
+                               {u + (x1 + 1 - h) / page_->pixels_per_m, bar_v}}});
+    }
+  }
+
   // Draws `text` only (no ground truth).
   void Ink(const std::string& style, double size_pt, const std::string& text, double u, double v,
            const cv::Scalar& colour) {
@@ -386,7 +429,10 @@ struct RollPrinter {
             amount,
         bold, cols);
   }
-  void Rule(char c) { Row(std::string(columns, c)); }
+  void Rule(char c) {
+    ts.RuleRow("mono", size, std::string(columns, c), left, v, ink);
+    v += line_h;
+  }
 };
 
 struct RollItem {

@@ -375,6 +375,26 @@ TEST(FeatureHelpers, OnePaperLayerAcrossShadingAndInk) {
   }
 }
 
+TEST(FeatureHelpers, OnePaperHueAcrossShadingNotAcrossAnotherPaper) {
+  // Cream paper (B 190, G 205, R 215), the gap from (100, 100) to (500,
+  // 100), text 12 px high, letters above the baseline.
+  const cv::Mat3b paper(200, 600, cv::Vec3b(190, 205, 215));
+  const cv::Mat1i labels = cv::Mat1i::zeros(paper.size());
+  auto one_hue = [&](const cv::Mat3b& colour) {
+    return detail::OnePaperHueTest(colour, labels, {0, -1}, 12)({100, 100}, {500, 100});
+  };
+  EXPECT_TRUE(one_hue(paper));
+  // A shadow over the middle of the gap, 30 % darker: the same hue.
+  cv::Mat3b shaded = paper.clone();
+  shaded(cv::Rect(250, 0, 120, 200)).setTo(cv::Vec3b(133, 143, 150));
+  EXPECT_TRUE(one_hue(shaded));
+  // A neutral grey flap over the whole gap and no farther (its edges
+  // within a text height of the pieces), as bright as the paper.
+  cv::Mat3b flap = paper.clone();
+  flap(cv::Rect(103, 0, 394, 200)).setTo(cv::Vec3b(203, 203, 203));
+  EXPECT_FALSE(one_hue(flap));
+}
+
 // A piece of a baseline as JoinBaselinePieces takes it: samples every 4 px
 // from x0 to x1 on y = y0 + slope * (x - x0), a quarter pixel up and down
 // in turn (the pixel grid).
@@ -440,6 +460,12 @@ TEST(FeatureHelpers, RowJoinOnlyOnAPageOfGappedRows) {
     receipt.push_back(Piece(500, 540, y, 0, int(receipt.size())));
   }
   EXPECT_EQ(Join(receipt).size(), 10u);
+  // A till roll: besides its ten priced rows, thirty short pieces that join
+  // nothing (VAT codes, header words, pieces of separators). A quarter of
+  // the groups bridge a gap, but nearly all of the rows' length: joined.
+  std::vector<detail::BaselinePiece> roll = receipt;
+  for (int k = 0; k < 30; ++k) roll.push_back(Piece(100, 120, 520 + 30 * k, 0, int(roll.size())));
+  EXPECT_EQ(Join(roll).size(), 40u);
 }
 
 TEST(FeatureHelpers, RowJoinDoesNotBridgeACrease) {

@@ -147,16 +147,26 @@ TEST(SynthShapes, RollReceiptPrintsTillRowsAndRecordsTheirBaselines) {
     EXPECT_GE(priced, 6) << roll;
     EXPECT_EQ(separators, 3) << roll;
     EXPECT_EQ(total, 1) << roll;
-    // One baseline in features.json for every printed row; the priced rows
-    // end together at the printable width's right edge.
+    // One baseline in features.json for every printed row but the
+    // separators, which have no ink on theirs: one rule line for each bar
+    // of their dashes, dots or double lines, across the printable width.
+    // The priced rows end together at the printable width's right edge.
     std::vector<double> ends;
-    int baselines = 0;
-    for (const TrueLine& l : gt->lines)
+    int baselines = 0, bars = 0;
+    for (const TrueLine& l : gt->lines) {
+      const double u0 = l.points.front().x() / gt->flat_width * gt->width_m;
+      const double u1 = l.points.back().x() / gt->flat_width * gt->width_m;
       if (l.kind == "text") {
         ++baselines;
-        ends.push_back(l.points.back().x() / gt->flat_width * gt->width_m);
+        ends.push_back(u1);
+      } else if (l.kind == "rule") {
+        ++bars;
+        EXPECT_GT(u1 - u0, 0.95 * (std::string(roll) == "58" ? 0.048 : 0.072)) << roll;
       }
-    EXPECT_EQ(baselines, rows) << roll;
+    }
+    EXPECT_EQ(baselines, rows - separators) << roll;
+    EXPECT_GE(bars, separators) << roll;
+    EXPECT_LE(bars, 2 * separators) << roll;
     const double printable = std::string(roll) == "58" ? 0.048 : 0.072;
     const double right = (gt->width_m + printable) / 2;
     int at_right = 0;
