@@ -174,74 +174,85 @@ GapTest BlankGapTest(const InkComponents& ink, cv::Point2d d, cv::Point2d up, do
   };
 }
 
+namespace {
+
+// Per pixel along the gap, t from t0 to t1 pixels past `from` towards
+// `along`: the medians of the N channels `value(x, y)` gives of the paper in
+// the letters' band (lifted 0.3, 0.5 and 0.7 text heights along `up`), ink
+// and its 1 px rim left out; NaN where all of it is ink or off the image.
+template <int N, class Value>
+std::vector<cv::Vec<double, N>> PaperAlong(const cv::Mat1i& labels, cv::Point2d from,
+                                           cv::Point2d along, cv::Point2d up, double x_height,
+                                           double t0, double t1, const Value& value) {
+  std::vector<cv::Vec<double, N>> paper;
+  for (double t = t0; t <= t1; t += 1.0) {
+    std::array<std::vector<double>, N> column;
+    for (double lift : {0.3, 0.5, 0.7}) {
+      const cv::Point2d p = from + along * t + up * (lift * x_height);
+      const int x = int(std::lround(p.x)), y = int(std::lround(p.y));
+      if (x < 0 || y < 0 || x >= labels.cols || y >= labels.rows || NearInk(labels, x, y)) continue;
+      const cv::Vec<double, N> v = value(x, y);
+      for (int c = 0; c < N; ++c) column[size_t(c)].push_back(v[c]);
+    }
+    cv::Vec<double, N> median;
+    for (int c = 0; c < N; ++c)
+      median[c] = column[size_t(c)].empty() ? std::nan("") : Median(column[size_t(c)]);
+    paper.push_back(median);
+  }
+  return paper;
+}
+
+// Whether channel `c` of `paper` (PaperAlong) steps somewhere: the medians
+// over `w` pixels either side of a point, each side at least half paper,
+// such that `steps(before, after)`. Shading drifts slowly, the edge of a
+// layer over the page steps at once.
+template <int N, class Steps>
+bool PaperSteps(const std::vector<cv::Vec<double, N>>& paper, int c, int w, const Steps& steps) {
+  for (int t = w; t + w <= int(paper.size()); ++t) {
+    std::vector<double> before, after;
+    for (int k = t - w; k < t + w; ++k)
+      if (!std::isnan(paper[size_t(k)][c])) (k < t ? before : after).push_back(paper[size_t(k)][c]);
+    if (2 * before.size() < size_t(w) || 2 * after.size() < size_t(w)) continue;
+    if (steps(Median(before), Median(after))) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
 GapTest OnePaperHueTest(const cv::Mat3b& colour, const cv::Mat1i& labels, cv::Point2d up,
                         double x_height) {
   return [&colour, &labels, up, x_height](const cv::Point2d& from, const cv::Point2d& to) {
     const double length = cv::norm(to - from);
     const cv::Point2d along = (to - from) * (1.0 / std::max(1e-9, length));
-    // Per pixel along the gap: the median blue and red shares of the
-    // paper's colour across the letters' band; none where all is ink.
-    std::vector<std::array<double, 2>> hue;
-    std::vector<char> paper;
-    for (double t = -x_height; t <= length + x_height; t += 1.0) {
-      std::vector<double> blue, red;
-      for (double lift : {0.3, 0.5, 0.7}) {
-        const cv::Point2d p = from + along * t + up * (lift * x_height);
-        const int x = int(std::lround(p.x)), y = int(std::lround(p.y));
-        if (x < 0 || y < 0 || x >= colour.cols || y >= colour.rows || NearInk(labels, x, y))
-          continue;
-        const cv::Vec3b c = colour(y, x);
-        const double sum = std::max(1.0, double(c[0]) + c[1] + c[2]);
-        blue.push_back(c[0] / sum);
-        red.push_back(c[2] / sum);
-      }
-      paper.push_back(!blue.empty());
-      hue.push_back({blue.empty() ? 0 : Median(blue), red.empty() ? 0 : Median(red)});
-    }
+    // The blue and red shares of the paper's colour, from a text height
+    // into one piece to a text height into the other.
+    const auto paper = PaperAlong<2>(labels, from, along, up, x_height, -x_height,
+                                     length + x_height, [&colour](int x, int y) {
+                                       const cv::Vec3b c = colour(y, x);
+                                       const double sum = std::max(1.0, double(c[0]) + c[1] + c[2]);
+                                       return cv::Vec2d(c[0] / sum, c[2] / sum);
+                                     });
     const int w = std::max(2, int(std::lround(x_height)));
-    for (int t = w; t + w <= int(hue.size()); ++t)
-      for (size_t ch = 0; ch < 2; ++ch) {
-        std::vector<double> before, after;
-        for (int k = t - w; k < t + w; ++k)
-          if (paper[size_t(k)]) (k < t ? before : after).push_back(hue[size_t(k)][ch]);
-        if (2 * before.size() < size_t(w) || 2 * after.size() < size_t(w)) continue;
-        if (std::abs(Median(before) - Median(after)) > kMaxHueStep) return false;
-      }
-    return true;
+    auto steps = [](double m0, double m1) { return std::abs(m0 - m1) > kMaxHueStep; };
+    return !PaperSteps(paper, 0, w, steps) && !PaperSteps(paper, 1, w, steps);
   };
 }
 
 GapTest OnePaperLayerTest(const cv::Mat1b& grey, const cv::Mat1i& labels, cv::Point2d up,
                           double x_height) {
   return [&grey, &labels, up, x_height](const cv::Point2d& from, const cv::Point2d& to) {
-    // The paper's grey along the gap, inside the letters' band (lifted 0.3
-    // to 0.7 of the text height off the baseline), ink and its 1 px rim
-    // left out, and a text height clear of either piece's last letter.
+    // The paper's grey along the gap, a text height clear of either
+    // piece's last letter.
     const double length = cv::norm(to - from);
     const cv::Point2d along = (to - from) * (1.0 / std::max(1e-9, length));
-    std::vector<double> paper;  // per pixel along the gap; -1 where all is ink
-    for (double t = x_height; t <= length - x_height; t += 1.0) {
-      std::vector<double> column;
-      for (double lift : {0.3, 0.5, 0.7}) {
-        const cv::Point2d p = from + along * t + up * (lift * x_height);
-        const int x = int(std::lround(p.x)), y = int(std::lround(p.y));
-        if (x < 0 || y < 0 || x >= grey.cols || y >= grey.rows || NearInk(labels, x, y)) continue;
-        column.push_back(grey(y, x));
-      }
-      paper.push_back(column.empty() ? -1 : Median(column));
-    }
-    // The medians over one text height either side of each point: shading
-    // drifts slowly, the edge of a layer over the page steps at once.
+    const auto paper =
+        PaperAlong<1>(labels, from, along, up, x_height, x_height, length - x_height,
+                      [&grey](int x, int y) { return cv::Vec<double, 1>(grey(y, x)); });
     const int w = std::max(2, int(std::lround(x_height)));
-    for (int t = w; t + w <= int(paper.size()); ++t) {
-      std::vector<double> before, after;
-      for (int k = t - w; k < t + w; ++k)
-        if (paper[size_t(k)] >= 0) (k < t ? before : after).push_back(paper[size_t(k)]);
-      if (2 * before.size() < size_t(w) || 2 * after.size() < size_t(w)) continue;
-      const double m0 = Median(before), m1 = Median(after);
-      if (std::abs(m0 - m1) > kMaxPaperStep * std::max(m0, m1)) return false;
-    }
-    return true;
+    return !PaperSteps(paper, 0, w, [](double m0, double m1) {
+      return std::abs(m0 - m1) > kMaxPaperStep * std::max(m0, m1);
+    });
   };
 }
 
