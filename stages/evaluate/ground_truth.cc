@@ -124,13 +124,19 @@ bool PrintedSideSeen(const GroundTruth& gt, const PinholeCamera& camera, const E
   return (u.x() * v.y() - u.y() * v.x()) * sx * sy > 0;
 }
 
+// Whether the print at flat pixel q is seen by `camera` (SeenAt on the
+// printed side; `depth` is the page rasterized in it), and where.
+bool PrintSeenAt(const GroundTruth& gt, const RasterResult& depth, const PinholeCamera& camera,
+                 const Eigen::Vector2d& q, Eigen::Vector2d* px) {
+  return SeenAt(depth, camera, gt.SurfacePoint(q), px) && PrintedSideSeen(gt, camera, q);
+}
+
 }  // namespace
 
 bool TruePointSeen(const GroundTruth& gt, const PinholeCamera& camera,
                    const Eigen::Vector2d& flat_px) {
   Eigen::Vector2d px;
-  return SeenAt(gt.ViewRaster(camera), camera, gt.SurfacePoint(flat_px), &px) &&
-         PrintedSideSeen(gt, camera, flat_px);
+  return PrintSeenAt(gt, gt.ViewRaster(camera), camera, flat_px, &px);
 }
 
 cv::Mat1b TruePageMask(const GroundTruth& gt, const PinholeCamera& camera) {
@@ -176,7 +182,7 @@ std::vector<TrueLine> TrueLinesInView(const GroundTruth& gt, const PinholeCamera
         if (k > 0 && j == 0) continue;
         const Eigen::Vector2d q = a + (b - a) * (double(j) / n);
         Eigen::Vector2d px;
-        if (SeenAt(depth, camera, gt.SurfacePoint(q), &px) && PrintedSideSeen(gt, camera, q))
+        if (PrintSeenAt(gt, depth, camera, q, &px))
           piece.points.push_back(px);
         else
           flush();
