@@ -89,6 +89,24 @@ cv::Mat1b ReadDocumentMask(const fs::path& path, int width, int height) {
   return region;
 }
 
+std::vector<ViewPage> ReadOtherViewPages(const fs::path& cameras_file,
+                                         const fs::path& boundary_dir) {
+  const CameraSet cameras = ReadCameras(cameras_file);
+  const Json doc = ReadJsonFile(cameras_file);
+  const JsonReader reader(doc, cameras_file);
+  std::vector<ViewPage> pages;
+  for (size_t i = 0; i < cameras.views.size(); ++i) {
+    const PinholeCamera& view = cameras.views[i];
+    if (view.image == cameras.reference) continue;
+    const fs::path file = boundary_dir / "views" / fs::path(view.image).stem() / "mask.png";
+    std::error_code ec;
+    if (!fs::is_regular_file(file, ec)) continue;
+    pages.push_back({view, ReadDistortion(reader, "/views/" + std::to_string(i)),
+                     ReadDocumentMask(file, view.width, view.height), file});
+  }
+  return pages;
+}
+
 cv::Mat1b GrowRegion(const cv::Mat1b& region, double margin_px) {
   cv::Mat1b grown = region > 0;
   if (margin_px > 0) {

@@ -68,6 +68,21 @@ FeatureFile ReadFeatures(const fs::path& file);
 // InputError naming the file when it is not width x height or is empty.
 cv::Mat1b ReadDocumentMask(const fs::path& path, int width, int height);
 
+// The page in a photo other than the reference, as segment-boundary found
+// it: <boundary dir>/views/<photo stem>/mask.png, of the original photo (not
+// undistorted; `distortion` is its lens's, OpenCV k1 k2 p1 p2).
+struct ViewPage {
+  PinholeCamera camera;
+  std::array<double, 4> distortion{};
+  cv::Mat1b mask;  // non-zero = page, camera.width x camera.height
+  fs::path file;
+};
+
+// Every view of `cameras_file` but its reference that has such a mask, in
+// the file's order; InputError naming the file for a damaged one.
+std::vector<ViewPage> ReadOtherViewPages(const fs::path& cameras_file,
+                                         const fs::path& boundary_dir);
+
 // The document region in the reference image: `region` (e.g. mask.png, any
 // non-zero pixel inside) grown by `margin_px`, so points on the page's very
 // edge still count.

@@ -10,6 +10,7 @@
 #include "common/cli.h"
 #include "common/depth_field.h"
 #include "common/errors.h"
+#include "common/isometry/mesh_index.h"
 #include "common/isometry/metrics.h"
 #include "common/isometry/unfold.h"
 #include "common/page_files.h"
@@ -137,6 +138,7 @@ void LiftGrid(const Inputs& in, const Options& o, const ImageGrid& g, const Lift
 // The joint optimisation without feature lines (λ5 = λ6 = 0) on the points
 // of the region; records the inliers and their mean distance to M.
 void Refine(const std::vector<Eigen::Vector3d>& points, const Options& o, Result* res) {
+  res->inliers = 0;
   isometry::Problem problem;
   problem.meshes = res->meshes;
   problem.points = points;
@@ -154,6 +156,113 @@ void Refine(const std::vector<Eigen::Vector3d>& points, const Options& o, Result
     }
   res->mean_inlier_distance =
       res->inliers ? distance_sum / res->inliers / std::max(refined.report.model_size, 1e-300) : 0;
+}
+
+// Unfolds M to the plane (from `initial`, a layout without folds) and
+// re-grids the pair on the page.
+void Unfold(const std::vector<Eigen::Vector2d>& initial, const Options& o, Result* res) {
+  MeshPair& m = res->meshes;
+  const auto unfolded = isometry::UnfoldArap(m.grid, m.mesh3d, initial);
+  m.mesh2d = unfolded.mesh2d;
+  res->unfold_iterations = unfolded.iterations;
+  if (o.regrid_on_page) m = RegridOnPage(m);
+}
+
+// The fraction of `points` farther than `distance` (fraction of M's model
+// size) from M.
+double FractionOffMesh(const MeshPair& m, const std::vector<Eigen::Vector3d>& points,
+                       double distance) {
+  const double limit = distance * isometry::ModelSize(m);
+  const isometry::TriangleMeshIndex index(m.mesh3d, m.grid.Triangles());
+  int off = 0;
+  for (const Eigen::Vector3d& p : points)
+    if (!index.Closest(p, limit)) ++off;
+  return points.empty() ? 0.0 : double(off) / double(points.size());
+}
+
+// The fraction of M's vertices farther than `distance` (fraction of M's
+// model size) from every point of `tree`.
+double FractionAwayFromPoints(const MeshPair& m, const PointIndex3d& tree, double distance) {
+  const double limit = distance * isometry::ModelSize(m);
+  int away = 0;
+  for (const Eigen::Vector3d& v : m.mesh3d) {
+    const auto nearest = tree.Nearest(v, 1);
+    if (nearest.empty() || nearest[0].second > limit * limit) ++away;
+  }
+  return m.mesh3d.empty() ? 0.0 : double(away) / double(m.mesh3d.size());
+}
+
+// Mirrors M' when it is a mirror image of the page as the reference photo
+// shows it (a flat layout of points is known only up to a reflection):
+// quads' signed areas in M' against those of their pictures, by area.
+void FaceLikeTheReference(const PinholeCamera& camera, MeshPair* m) {
+  double agree = 0;
+  for (int q = 0; q < m->grid.NumQuads(); ++q) {
+    const std::array<int, 4> c = m->grid.Quad(q);
+    auto signed_area = [&](auto at) {
+      const Eigen::Vector2d a = at(c[0]), b = at(c[1]), d = at(c[3]);
+      const Eigen::Vector2d e1 = b - a, e2 = d - a;
+      return e1.x() * e2.y() - e1.y() * e2.x();
+    };
+    if (camera.CamFromWorld(m->mesh3d[size_t(c[0])]).z() <= 0) continue;
+    const double flat = signed_area([&](int v) { return m->mesh2d[size_t(v)]; });
+    const double seen = signed_area([&](int v) { return camera.Project(m->mesh3d[size_t(v)]); });
+    agree += (flat > 0) == (seen > 0) ? std::abs(seen) : -std::abs(seen);
+  }
+  if (agree < 0)
+    for (Eigen::Vector2d& v : m->mesh2d) v.x() = -v.x();
+}
+
+// Where many of the page's points lie off M, the reference outline does not
+// bound the page (a panel the reference photo sees edge-on or not at all):
+// M is rebuilt from those points and refined on them. It is kept if it
+// leaves at most half as many of them off, without reaching farther from
+// them (a layout gone wrong covers the points and much else).
+void RebuildFromPagePoints(const Inputs& in, const Options& o, Result* res) {
+  const PageFromPointsOptions& po = o.page_from_points;
+  std::vector<ViewPage> photos = in.other_photos;
+  photos.push_back({in.reference, {}, in.mask, {}});
+  const std::vector<bool> on_page = PagePoints(in.points, photos, po);
+  std::vector<Eigen::Vector3d> page;
+  for (size_t i = 0; i < in.points.size(); ++i)
+    if (on_page[i]) page.push_back(in.points[i]);
+  res->page_points = int(page.size());
+  if (page.empty()) return;
+  res->page_points_off_mesh = FractionOffMesh(res->meshes, page, po.off_mesh_distance);
+  if (res->page_points_off_mesh <= po.off_mesh_fraction) return;
+  const std::string off = Fixed(100 * res->page_points_off_mesh, 1) +
+                          " % of the page's points lie off the mesh on the reference outline";
+  MeshPair rebuilt;
+  std::string why;
+  if (!MeshFromPoints(page, o.grid.short_side, o.grid.long_side, po, &rebuilt, &why)) {
+    res->warnings.push_back(off + ", but no mesh could be built from them (" + why + ")");
+    return;
+  }
+  FaceLikeTheReference(in.reference, &rebuilt);
+  Result from_points = *res;
+  from_points.meshes = std::move(rebuilt);
+  Unfold(from_points.meshes.mesh2d, o, &from_points);
+  Refine(page, o, &from_points);
+  const double off_after = FractionOffMesh(from_points.meshes, page, po.off_mesh_distance);
+  const PointIndex3d tree(page);
+  const double away_before = FractionAwayFromPoints(res->meshes, tree, po.away_distance);
+  const double away_after = FractionAwayFromPoints(from_points.meshes, tree, po.away_distance);
+  if (!(off_after <= 0.5 * res->page_points_off_mesh) ||
+      !(away_after <= away_before + po.away_margin)) {
+    res->warnings.push_back(off + "; a mesh built from them leaves " + Fixed(100 * off_after, 1) +
+                            " % off and has " + Fixed(100 * away_after, 1) +
+                            " % of its vertices (" + Fixed(100 * away_before, 1) +
+                            " %) away from them: the first is kept");
+    return;
+  }
+  *res = std::move(from_points);
+  res->warnings.push_back(off +
+                          " (a part of the page the reference photo does not see): mesh "
+                          "built from the points of every photo, " +
+                          Fixed(100 * off_after, 1) + " % off it");
+  res->grid_source = "page_points";
+  res->outline_prior = {};
+  res->outline_prior.note = "mesh built from the page's points";
 }
 
 }  // namespace
@@ -202,20 +311,19 @@ Result Run(const Inputs& in, const Options& o) {
   res.timings.grid = timer.Mark("grid");
 
   // --- Unfold to the plane.
-  MeshPair& m = res.meshes;
-  const auto unfolded = isometry::UnfoldArap(m.grid, m.mesh3d, g.pixels);
-  m.mesh2d = unfolded.mesh2d;
-  res.unfold_iterations = unfolded.iterations;
-  if (o.regrid_on_page) m = RegridOnPage(m);
+  Unfold(g.pixels, o, &res);
   res.timings.unfold = timer.Mark("unfold");
 
   Refine(points.points, o, &res);
   res.timings.refine = timer.Mark("refine");
 
+  if (!in.other_photos.empty()) RebuildFromPagePoints(in, o, &res);
+  res.timings.page = timer.Mark("page");
+
   if (o.upright) TurnUpright(in, &res);
   res.timings.upright = timer.Mark("upright");
 
-  const auto edge = isometry::IsometryEdgeError(m);
+  const auto edge = isometry::IsometryEdgeError(res.meshes);
   res.isometry_error_mean = edge.mean;
   res.isometry_error_max = edge.max;
   res.timings.total = timer.Total();

@@ -11,7 +11,10 @@
 //  3. M unfolded to the plane (as-rigid-as-possible) for M';
 //  4. both refined by the joint optimisation with the feature terms off
 //     (isometry, point fitting, fairness, progressive outlier filtering);
-//  5. M' turned upright by the oriented bounding box of the real boundary
+//  5. where more of the page's points (seen on the page by every photo that
+//     frames them) lie off M than the reference outline can explain, M and
+//     M' rebuilt from those points alone (page_from_points.h) and refined;
+//  6. M' turned upright by the oriented bounding box of the real boundary
 //     sides (of the whole mesh when no side is real): top side at small y.
 #pragma once
 
@@ -30,6 +33,7 @@
 #include "common/page_files.h"
 #include "common/point_source.h"
 #include "stages/init-mesh/outline_prior.h"
+#include "stages/init-mesh/page_from_points.h"
 
 namespace docunfold::init_mesh {
 
@@ -97,6 +101,9 @@ struct Options {
   // The depth of blank paper from the page's outline in 3D (densify's
   // outline points, PointSource::kOutline in points.ply): outline_prior.h.
   OutlinePriorOptions outline_prior;
+  // A page the reference outline does not bound, rebuilt from the points of
+  // every photo: page_from_points.h.
+  PageFromPointsOptions page_from_points;
   bool verbose = false;  // log every outer iteration of the refinement
 };
 
@@ -113,21 +120,26 @@ struct Inputs {
   Boundary boundary;
   cv::Mat1b mask;            // 255 inside the page
   fs::path reference_image;  // 10_sfm/reference.png
+  // The other photos' pages (20_boundary/views/<photo>/mask.png where
+  // segment-boundary found one); empty for a work folder without them.
+  std::vector<ViewPage> other_photos;
 };
 
 // Reads and validates 10_sfm/{cameras.json, points.ply, reference.png} and
-// 20_boundary/{boundary.json, mask.png}; throws InputError naming the file.
+// 20_boundary/{boundary.json, mask.png, views/*/mask.png}; throws InputError naming the file.
 // `points_path` empty: sfm_dir/points.ply.
 Inputs ReadInputs(const fs::path& sfm_dir, const fs::path& boundary_dir,
                   const fs::path& points_path = {});
 
 struct Timings {
-  double grid = 0, depth = 0, unfold = 0, refine = 0, upright = 0, total = 0;
+  double grid = 0, depth = 0, unfold = 0, refine = 0, page = 0, upright = 0, total = 0;
 };
 
 struct Result {
   MeshPair meshes;
-  std::string grid_source;  // "coons" (boundary sides) or "mask_bbox"
+  // "coons" (boundary sides), "mask_bbox" or "page_points" (rebuilt from
+  // the page's points)
+  std::string grid_source;
   std::vector<std::string> warnings;
   int points_total = 0;
   int points_in_region = 0;
@@ -142,6 +154,10 @@ struct Result {
   double isometry_error_max = 0;
   double mean_inlier_distance = 0;  // of the SfM inliers to M, / model size
   OutlinePriorResult outline_prior;
+  // Points on the page in every photo that frames them, and the fraction of
+  // them off M built on the reference outline (-1: no other photos).
+  int page_points = 0;
+  double page_points_off_mesh = -1;
   Timings timings;
 };
 

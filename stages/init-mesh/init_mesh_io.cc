@@ -81,6 +81,10 @@ void DeclareOptions(OptionTable& table, Options* o) {
   table.Value("outline-prior-agreement", &o->outline_prior.agreement, 1e-6, 1.0,
               "the outline's surface counts where the nearby points' depths differ from it by "
               "about this fraction or less (weight exp(-(e/a)^2))");
+  table.Value("page-off-mesh", &o->page_from_points.off_mesh_fraction, 0.0, 1.0,
+              "rebuild M from the page's points (those on the page in every photo that frames "
+              "them) when more than this fraction of them lie off M built on the reference "
+              "outline (1: never)");
   table.Switch("verbose", &o->verbose, "log every outer iteration of the refinement");
 }
 
@@ -112,6 +116,8 @@ Inputs ReadInputs(const fs::path& sfm_dir, const fs::path& boundary_dir,
   in.boundary = ReadBoundary(boundary_dir / "boundary.json");
 
   in.mask = ReadDocumentMask(boundary_dir / "mask.png", in.reference.width, in.reference.height);
+
+  in.other_photos = ReadOtherViewPages(cameras_path, boundary_dir);
   return in;
 }
 
@@ -160,6 +166,9 @@ Json ResultToJson(const Inputs& in, const Result& r, const Options& o, const Jso
                             {"mean_weight", p.mean_weight}};
     if (!p.note.empty()) doc["outline_prior"]["note"] = p.note;
   }
+  doc["page_points"] = {{"photos", in.other_photos.size() + 1}, {"count", r.page_points}};
+  if (r.page_points_off_mesh >= 0)
+    doc["page_points"]["off_reference_mesh"] = r.page_points_off_mesh;
   doc["unfold"] = {{"method", "arap"}, {"iterations", r.unfold_iterations}};
   Json refine = isometry::ToJson(r.refine);
   if (!r.refine.iterations.empty()) {
@@ -174,11 +183,15 @@ Json ResultToJson(const Inputs& in, const Result& r, const Options& o, const Jso
                     {"model_size", r.refine.model_size}};
   doc["upright"] = {{"rotation_deg", r.upright_rotation_deg}, {"from", r.upright_from}};
   doc["warnings"] = r.warnings;
-  doc["timings_s"] = {
-      {"read", read_seconds},       {"depth", r.timings.depth},
-      {"grid", r.timings.grid},     {"unfold", r.timings.unfold},
-      {"refine", r.timings.refine}, {"upright", r.timings.upright},
-      {"write", write_seconds},     {"total", read_seconds + r.timings.total + write_seconds}};
+  doc["timings_s"] = {{"read", read_seconds},
+                      {"depth", r.timings.depth},
+                      {"grid", r.timings.grid},
+                      {"unfold", r.timings.unfold},
+                      {"refine", r.timings.refine},
+                      {"page", r.timings.page},
+                      {"upright", r.timings.upright},
+                      {"write", write_seconds},
+                      {"total", read_seconds + r.timings.total + write_seconds}};
   return doc;
 }
 

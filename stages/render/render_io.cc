@@ -32,23 +32,16 @@ RenderInputs ReadRenderInputs(const fs::path& sfm_dir, const fs::path& boundary_
   in.boundary = ReadBoundary(boundary_dir / "boundary.json");
   // The other views' page masks, where segment-boundary found them, with
   // the distortion of their (original, not undistorted) photos.
-  const Json cameras_doc = ReadJsonFile(in.cameras_file);
-  const JsonReader cameras_reader(cameras_doc, in.cameras_file);
-  for (size_t i = 0; i < cameras.views.size(); ++i) {
-    const PinholeCamera& view = cameras.views[i];
-    if (view.image == cameras.reference) continue;
-    const fs::path mask_file = boundary_dir / "views" / fs::path(view.image).stem() / "mask.png";
-    std::error_code exists_ec;
-    if (!fs::is_regular_file(mask_file, exists_ec)) continue;
+  for (ViewPage& page : ReadOtherViewPages(in.cameras_file, boundary_dir)) {
     fs::path photo;
+    std::error_code exists_ec;
     if (!images_dir.empty()) {
-      photo = images_dir / view.image;
+      photo = images_dir / page.camera.image;
       if (!fs::is_regular_file(photo, exists_ec))
         throw InputError(photo.string() + ": no such file (a view in " + in.cameras_file.string() +
                          ")");
     }
-    in.views.push_back({view, ReadDocumentMask(mask_file, view.width, view.height), mask_file,
-                        photo, ReadDistortion(cameras_reader, "/views/" + std::to_string(i))});
+    in.views.push_back({page.camera, std::move(page.mask), page.file, photo, page.distortion});
   }
   std::error_code ec;
   if (!fs::is_directory(meshes_dir, ec))

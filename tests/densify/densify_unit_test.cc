@@ -10,6 +10,7 @@
 #include <random>
 
 #include "stages/densify/densify.h"
+#include "tests/support/look_at.h"
 
 namespace docunfold::testing {
 namespace {
@@ -20,19 +21,7 @@ using densify::DensifyResult;
 
 PinholeCamera LookAt(const std::string& image, const Eigen::Vector3d& centre,
                      const Eigen::Vector3d& target) {
-  PinholeCamera c;
-  c.image = image;
-  c.width = 800;
-  c.height = 600;
-  c.K << 1000, 0, 399.5, 0, 1000, 299.5, 0, 0, 1;
-  const Eigen::Vector3d z = (target - centre).normalized();
-  const Eigen::Vector3d x = Eigen::Vector3d::UnitY().cross(z).normalized();
-  const Eigen::Vector3d y = z.cross(x);
-  c.R.row(0) = x.transpose();
-  c.R.row(1) = y.transpose();
-  c.R.row(2) = z.transpose();
-  c.t = -c.R * centre;
-  return c;
+  return LookAtCamera(image, centre, target, 800, 600, 1000);
 }
 
 TEST(Densify, ScaledCameraSeesTheResizedPixel) {

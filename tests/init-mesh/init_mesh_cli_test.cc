@@ -91,6 +91,58 @@ TEST(InitMeshCli, TheOutlineShapesBlankPaperBetweenFolds) {
   EXPECT_FALSE(ReadJsonFile(without / "40_init/init.json")["outline_prior"]["used"].get<bool>());
 }
 
+// A page folded along its diagonal, one half standing edge-on to the
+// reference photo: the reference outline is a triangle. The other photos'
+// pages tell which points are the page's; M is built from them and covers
+// the whole page. Without those photos, M on the triangle reaches onto the
+// standing half only as far as the refinement pulls it.
+TEST(InitMeshCli, ATriangularReferenceOutlineStillGivesTheWholePage) {
+  TempDir with, without;
+  const MeshPair truth = WriteDiagonalFoldWork(with.path());
+  WriteDiagonalFoldWork(without.path());
+  fs::remove_all(without / "20_boundary/views");
+  const CommandResult a = RunCommand(InitMeshCommand(with.path()));
+  ASSERT_EQ(a.exit_code, 0) << a.output;
+  EXPECT_NE(a.output.find("mesh built from the points of every photo"), std::string::npos)
+      << a.output;
+  const CommandResult b = RunCommand(InitMeshCommand(without.path()));
+  ASSERT_EQ(b.exit_code, 0) << b.output;
+  const Json report = ReadJsonFile(with / "40_init/init.json");
+  EXPECT_EQ(report["grid"]["source"], "page_points");
+  EXPECT_GT(report["page_points"]["off_reference_mesh"].get<double>(), 0.01);
+  const MeshPair m = ReadMeshPair(with / "40_init");
+  const MeshPair flat_half = ReadMeshPair(without / "40_init");
+  const double size = isometry::ModelSize(truth);
+  const auto page_to_m = SurfaceDistance(truth, m);
+  const auto m_to_page = SurfaceDistance(m, truth);
+  const auto page_to_half = SurfaceDistance(truth, flat_half);
+  auto flat_area = [](const MeshPair& pair) {  // of M', over the page's
+    double sum = 0;
+    for (const Triangle& t : pair.grid.Triangles()) {
+      const Eigen::Vector2d e1 = pair.mesh2d[t[1]] - pair.mesh2d[t[0]];
+      const Eigen::Vector2d e2 = pair.mesh2d[t[2]] - pair.mesh2d[t[0]];
+      sum += 0.5 * std::abs(e1.x() * e2.y() - e1.y() * e2.x());
+    }
+    return sum / (0.21 * 0.297);
+  };
+  const double area = flat_area(m);
+  const double half_area = flat_area(flat_half);
+  std::printf(
+      "[init] diagonal fold, triangular reference outline: page to M %.2f %% (max %.2f %%), M "
+      "to page %.2f %% of the model size, M' area %.3f of the page; from the reference "
+      "outline alone page to M %.2f %% (max %.2f %%), area %.3f\n",
+      100 * page_to_m.mean / size, 100 * page_to_m.max / size, 100 * m_to_page.mean / size, area,
+      100 * page_to_half.mean / size, 100 * page_to_half.max / size, half_area);
+  EXPECT_LT(page_to_m.mean, 0.005 * size);
+  EXPECT_LT(page_to_m.max, 0.03 * size);
+  EXPECT_LT(m_to_page.mean, 0.005 * size);
+  EXPECT_NEAR(area, 1.0, 0.05);
+  // On the triangle alone the standing half's tip is missing.
+  EXPECT_GT(page_to_half.max, 0.05 * size);
+  EXPECT_LT(half_area, 0.93);
+  EXPECT_LT(isometry::IsometryEdgeError(m).mean, 0.01);
+}
+
 TEST(InitMeshCli, MissingOrCorruptFilesAreBadInput) {
   TempDir dir;
   WriteSyntheticWork(dir.path(), 400);

@@ -9,6 +9,7 @@
 #include <array>
 #include <cmath>
 #include <opencv2/core.hpp>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -21,6 +22,7 @@
 #include "common/raster.h"
 #include "tests/isometry/test_meshes.h"
 #include "tests/support/ground_truth.h"
+#include "tests/support/look_at.h"
 #include "tests/support/test_support.h"
 
 namespace docunfold::testing {
@@ -225,6 +227,77 @@ inline MeshPair WriteZigZagWithBlankBandWork(const fs::path& work, double fold_d
   cloud.properties.push_back(source);
   WritePly(work / "10_sfm/points.ply", cloud);
   return placed;
+}
+
+// A page (0.21 x 0.297) folded along its diagonal from the top-right to the
+// bottom-left corner: the top-left triangle lies flat, facing the reference
+// camera 0.45 away; the other stands at 90 degrees toward that camera, which
+// sees it edge-on, so the reference outline is a triangle. Two more photos
+// see both halves; their page masks go to 20_boundary/views/. SfM points
+// cover the whole page. Returns the true pair.
+inline MeshPair WriteDiagonalFoldWork(const fs::path& work) {
+  const double w = 0.21, h = 0.297, d = 0.45;
+  const int nx = 43, ny = 61;
+  const Eigen::Vector2d c1(w / 2, -h / 2), c3(-w / 2, h / 2);  // the fold's ends
+  const Eigen::Vector2d along = (c3 - c1).normalized();
+  const Eigen::Vector2d across(along.y(), -along.x());  // toward the standing half
+  MeshPair truth;
+  truth.grid.nx = nx;
+  truth.grid.ny = ny;
+  for (int r = 0; r < ny; ++r)
+    for (int c = 0; c < nx; ++c) {
+      const Eigen::Vector2d flat(w * c / (nx - 1), h * r / (ny - 1));
+      const Eigen::Vector2d p = flat - Eigen::Vector2d(w / 2, h / 2);
+      const double height = std::max(0.0, across.dot(p - c1));  // past the fold: standing
+      const Eigen::Vector2d on_plane = p - height * across;
+      truth.mesh2d.push_back(flat);
+      truth.mesh3d.push_back({on_plane.x(), on_plane.y(), d - height});
+    }
+  if (across.dot(Eigen::Vector2d(w / 2, h / 2) - c1) < 0)
+    throw std::logic_error("the standing half must hold the bottom-right corner");
+  std::vector<PinholeCamera> cams = {
+      LookAtCamera("ref.jpg", {0, 0, 0}, {0, 0, d}, 640, 480, 600),
+      LookAtCamera("side_a.jpg", {0.3, 0.25, 0.05}, {0, 0, d - 0.05}, 640, 480, 600),
+      LookAtCamera("side_b.jpg", {0.25, 0.3, 0.1}, {0, 0, d - 0.05}, 640, 480, 600)};
+  const PinholeCamera& ref = cams[0];
+  const SampledPoints sample = SampleSurface(truth, 3000, 0.0003, 0.0, 7);
+  PlyData cloud;
+  cloud.vertices = sample.points;
+  cloud.colors.assign(cloud.vertices.size(), {100, 100, 100});
+  EnsureDirectory(work / "10_sfm");
+  WritePly(work / "10_sfm/points.ply", cloud);
+  Json doc = MakeHeader("docunfold.cameras", 1, "synthetic");
+  doc["reference"] = ref.image;
+  doc["views"] = Json::array();
+  for (const auto& cam : cams) doc["views"].push_back(CameraToJson(cam));
+  WriteJsonAtomic(work / "10_sfm/cameras.json", doc);
+  WriteImageAtomic(work / "10_sfm/reference.png",
+                   cv::Mat(ref.height, ref.width, CV_8UC3, cv::Scalar(90, 120, 90)));
+  auto mask_in = [&](const PinholeCamera& cam) {
+    const RasterResult raster = RasterizeMesh(cam, truth.mesh3d, truth.grid.Triangles());
+    return cv::Mat1b(raster.face >= 0);
+  };
+  // The reference outline: the flat triangle, as four sides (its long side
+  // split at the middle, as segment-boundary splits an outline with three
+  // corners).
+  auto segment = [&](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+    std::vector<Eigen::Vector2d> s;
+    for (int k = 0; k <= 20; ++k) {
+      const Eigen::Vector2d p = a + (b - a) * (k / 20.0);
+      s.push_back(ref.Project({p.x(), p.y(), d}));
+    }
+    return s;
+  };
+  const Eigen::Vector2d c0(-w / 2, -h / 2), middle = (c1 + c3) / 2;
+  WriteBoundary(work / "20_boundary", "reference.png", ref.width, ref.height,
+                {segment(c0, c1), segment(c1, middle), segment(c3, middle), segment(c0, c3)},
+                mask_in(ref));
+  for (size_t v = 1; v < cams.size(); ++v) {
+    const fs::path dir = work / "20_boundary/views" / fs::path(cams[v].image).stem();
+    EnsureDirectory(dir);
+    WriteImageAtomic(dir / "mask.png", mask_in(cams[v]));
+  }
+  return truth;
 }
 
 // The command line pipeline.mk uses, on a work folder.

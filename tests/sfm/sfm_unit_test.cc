@@ -22,6 +22,7 @@
 #include "stages/sfm/sfm.h"
 #include "stages/sfm/subprocess.h"
 #include "tests/sfm/sfm_eval.h"
+#include "tests/support/look_at.h"
 #include "tests/support/test_support.h"
 
 namespace docunfold::testing {
@@ -130,15 +131,7 @@ ColmapImage MakeImage(uint32_t id, const std::string& name, const Eigen::Matrix3
 // A camera at `center` looking at `target` (OpenCV axes, y roughly down).
 ColmapImage LookAt(uint32_t id, const std::string& name, const Eigen::Vector3d& center,
                    const Eigen::Vector3d& target) {
-  const Eigen::Vector3d z = (target - center).normalized();
-  Eigen::Vector3d x = Eigen::Vector3d::UnitY().cross(z);
-  if (x.norm() < 1e-6) x = Eigen::Vector3d::UnitX();
-  x.normalize();
-  const Eigen::Vector3d y = z.cross(x);
-  Eigen::Matrix3d R;
-  R.row(0) = x;
-  R.row(1) = y;
-  R.row(2) = z;
+  const Eigen::Matrix3d R = LookAtRotation(center, target);
   return MakeImage(id, name, R, -R * center);
 }
 
