@@ -261,6 +261,7 @@ void RebuildFromPagePoints(const Inputs& in, const Options& o, Result* res) {
                           "built from the points of every photo, " +
                           Fixed(100 * off_after, 1) + " % off it");
   res->grid_source = "page_points";
+  res->points_in_region = int(page.size());  // what the refinement had: inliers + outliers
   res->outline_prior = {};
   res->outline_prior.note = "mesh built from the page's points";
 }
