@@ -235,6 +235,9 @@ TEST_P(EndToEnd, MeshesAreCloseToTheTruthAndReadable) {
   EXPECT_LE(final_surface, 1.5 * init_surface + 0.1) << set_;
   EXPECT_LT(init_iso, 0.01) << set_;
   EXPECT_LT(final_iso, 0.03) << set_;
+  // The mesh is never the grid over the mask's bounding box.
+  const std::string grid_source = ReadJsonFile(work_ / "40_init/init.json")["grid"]["source"];
+  EXPECT_NE(grid_source, "mask_bbox") << set_;
   // Every PLY of the run opens in an independent reader.
   for (const char* f : {"40_init/mesh3d.ply", "40_init/mesh2d.ply", "50_optimize/mesh3d.ply",
                         "50_optimize/mesh2d.ply", "50_optimize/round0/mesh3d.ply"}) {
