@@ -2,7 +2,9 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <functional>
 #include <limits>
 #include <map>
@@ -19,7 +21,8 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // The cell size of the thinning grid: the points' extent between their 1st
-// and 99th percentiles per axis, over o.cells_across.
+// and 99th percentiles per axis, over o.cells_across (0 when they all lie in
+// one place).
 double CellSize(const std::vector<Eigen::Vector3d>& points, const PageFromPointsOptions& o) {
   Eigen::Vector3d extent;
   for (int axis = 0; axis < 3; ++axis) {
@@ -28,7 +31,7 @@ double CellSize(const std::vector<Eigen::Vector3d>& points, const PageFromPoints
     std::sort(v.begin(), v.end());
     extent[axis] = v[v.size() * 99 / 100] - v[v.size() / 100];
   }
-  return std::max(extent.norm(), 1e-300) / o.cells_across;
+  return extent.norm() / o.cells_across;
 }
 
 // One point per occupied cell (the first), as indices into `points`.
@@ -183,6 +186,16 @@ bool LayOutFlat(const std::vector<Eigen::Vector3d>& points, const PageFromPoints
     return false;
   }
   const double cell = CellSize(points, o);
+  const double largest =
+      std::max_element(
+          points.begin(), points.end(),
+          [](auto& a, auto& b) { return a.cwiseAbs().maxCoeff() < b.cwiseAbs().maxCoeff(); })
+          ->cwiseAbs()
+          .maxCoeff();
+  if (!(cell > 1e-9 * largest) || !std::isfinite(largest)) {
+    *why = "the points lie in one place";
+    return false;
+  }
   const std::vector<int> thinned = Thin(points, cell);
   std::vector<Eigen::Vector3d> thin_points, normals;
   {

@@ -105,6 +105,9 @@ TEST(PageFromPoints, TooFewOrCollinearPointsAreRefused) {
   EXPECT_FALSE(
       LayOutFlat(std::vector<Eigen::Vector3d>(5, Eigen::Vector3d::Zero()), {}, &layout, &why));
   EXPECT_NE(why.find("only 5 points"), std::string::npos) << why;
+  EXPECT_FALSE(LayOutFlat(std::vector<Eigen::Vector3d>(100, Eigen::Vector3d(0.1, 0.2, 1)), {},
+                          &layout, &why));
+  EXPECT_NE(why.find("in one place"), std::string::npos) << why;
   std::vector<Eigen::Vector3d> line;
   for (int i = 0; i < 100; ++i) line.push_back({0.01 * i, 0, 1});
   EXPECT_FALSE(LayOutFlat(line, {}, &layout, &why));
