@@ -3,7 +3,10 @@
 // M' turned off upright is turned back by the text rows.
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
 #include "common/grid_mesh.h"
+#include "common/isometry/metrics.h"
 #include "common/page_files.h"
 #include "tests/init-mesh/work_fixture.h"
 #include "tests/support/test_support.h"
@@ -157,6 +160,32 @@ TEST(OptimizeCli, TextRowsTurnAnOffUprightFlatMesh) {
   EXPECT_LT(largest(held), 1e-12);
   EXPECT_GT(largest(sides), 1e-6);
   EXPECT_GT(largest(slants(dir / "none", "text")), 1e-6);
+}
+
+// A page init-mesh rebuilt from the points of every photo (one half of it
+// standing edge-on to the reference photo) stays whole through optimize:
+// the standing half's points fall on the reference outline's edge, inside
+// the document region it fits.
+TEST(OptimizeCli, APageBuiltFromThePointsOfEveryPhotoStaysWhole) {
+  TempDir dir;
+  const MeshPair truth = WriteDiagonalFoldWork(dir.path());
+  ASSERT_EQ(RunCommand(InitMeshCommand(dir.path())).exit_code, 0);
+  ASSERT_EQ(ReadJsonFile(dir / "40_init/init.json")["grid"]["source"], "page_points");
+  WriteJsonAtomic(dir / "features.json",
+                  {{"format", "docunfold.features"}, {"version", 1}, {"segments", Json::array()}});
+  const CommandResult r =
+      RunCommand(OptimizeCommand(dir.path(), dir / "10_sfm/points.ply", dir / "50_optimize"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const double size = isometry::ModelSize(truth);
+  const auto page_to_init = SurfaceDistance(truth, ReadMeshPair(dir / "40_init"));
+  const auto page_to_m = SurfaceDistance(truth, ReadMeshPair(dir / "50_optimize"));
+  std::printf(
+      "[optimize] page rebuilt from its points: page to M %.2f %% (max %.2f %%) of the model "
+      "size, init %.2f %% (max %.2f %%)\n",
+      100 * page_to_m.mean / size, 100 * page_to_m.max / size, 100 * page_to_init.mean / size,
+      100 * page_to_init.max / size);
+  EXPECT_LT(page_to_m.mean, 0.005 * size);
+  EXPECT_LT(page_to_m.max, 0.03 * size);
 }
 
 }  // namespace
