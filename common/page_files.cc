@@ -89,9 +89,8 @@ cv::Mat1b ReadDocumentMask(const fs::path& path, int width, int height) {
   return region;
 }
 
-std::vector<ViewPage> ReadOtherViewPages(const fs::path& cameras_file,
+std::vector<ViewPage> ReadOtherViewPages(const CameraSet& cameras, const fs::path& cameras_file,
                                          const fs::path& boundary_dir) {
-  const CameraSet cameras = ReadCameras(cameras_file);
   const Json doc = ReadJsonFile(cameras_file);
   const JsonReader reader(doc, cameras_file);
   std::vector<ViewPage> pages;

@@ -78,9 +78,10 @@ struct ViewPage {
   fs::path file;
 };
 
-// Every view of `cameras_file` but its reference that has such a mask, in
-// the file's order; InputError naming the file for a damaged one.
-std::vector<ViewPage> ReadOtherViewPages(const fs::path& cameras_file,
+// Every view of `cameras` (read from `cameras_file`, which gives the
+// distortions) but its reference that has such a mask, in the file's order;
+// InputError naming the file for a damaged one.
+std::vector<ViewPage> ReadOtherViewPages(const CameraSet& cameras, const fs::path& cameras_file,
                                          const fs::path& boundary_dir);
 
 // The document region in the reference image: `region` (e.g. mask.png, any

@@ -117,7 +117,7 @@ Inputs ReadInputs(const fs::path& sfm_dir, const fs::path& boundary_dir,
 
   in.mask = ReadDocumentMask(boundary_dir / "mask.png", in.reference.width, in.reference.height);
 
-  in.other_photos = ReadOtherViewPages(cameras_path, boundary_dir);
+  in.other_photos = ReadOtherViewPages(cameras, cameras_path, boundary_dir);
   return in;
 }
 

@@ -155,13 +155,7 @@ Eigen::Vector3d AffineFitAt(const Eigen::Vector2d& u0, const std::vector<int>& n
 std::vector<bool> PagePoints(const std::vector<Eigen::Vector3d>& points,
                              const std::vector<ViewPage>& photos, const PageFromPointsOptions& o) {
   std::vector<cv::Mat1b> grown;
-  const int r = std::max(0, int(std::lround(o.mask_margin_px)));
-  const cv::Mat kernel = cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * r + 1, 2 * r + 1});
-  for (const ViewPage& p : photos) {
-    cv::Mat1b g;
-    cv::dilate(p.mask, g, kernel);
-    grown.push_back(g);
-  }
+  for (const ViewPage& p : photos) grown.push_back(GrowRegion(p.mask, o.mask_margin_px));
   std::vector<bool> page(points.size(), false);
   for (size_t i = 0; i < points.size(); ++i) {
     int framed = 0;

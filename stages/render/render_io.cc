@@ -32,7 +32,7 @@ RenderInputs ReadRenderInputs(const fs::path& sfm_dir, const fs::path& boundary_
   in.boundary = ReadBoundary(boundary_dir / "boundary.json");
   // The other views' page masks, where segment-boundary found them, with
   // the distortion of their (original, not undistorted) photos.
-  for (ViewPage& page : ReadOtherViewPages(in.cameras_file, boundary_dir)) {
+  for (ViewPage& page : ReadOtherViewPages(cameras, in.cameras_file, boundary_dir)) {
     fs::path photo;
     std::error_code exists_ec;
     if (!images_dir.empty()) {
