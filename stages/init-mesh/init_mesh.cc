@@ -321,6 +321,13 @@ Result Run(const Inputs& in, const Options& o) {
   if (!in.other_photos.empty()) RebuildFromPagePoints(in, o, &res);
   res.timings.page = timer.Mark("page");
 
+  if (!in.other_photos.empty()) {
+    std::vector<ViewPage> photos = in.other_photos;
+    photos.push_back({in.reference, {}, in.mask, {}});
+    res.end_folds = FoldEnds(photos, in.reference, points.points, o.end_fold, &res.meshes);
+  }
+  res.timings.ends = timer.Mark("ends");
+
   if (o.upright) TurnUpright(in, &res);
   res.timings.upright = timer.Mark("upright");
 

@@ -32,6 +32,7 @@
 #include "common/option_table.h"
 #include "common/page_files.h"
 #include "common/point_source.h"
+#include "stages/init-mesh/end_fold.h"
 #include "stages/init-mesh/outline_prior.h"
 #include "stages/init-mesh/page_from_points.h"
 
@@ -104,6 +105,8 @@ struct Options {
   // A page the reference outline does not bound, rebuilt from the points of
   // every photo: page_from_points.h.
   PageFromPointsOptions page_from_points;
+  // An end folded up steeply, from the other photos' masks: end_fold.h.
+  EndFoldOptions end_fold;
   bool verbose = false;  // log every outer iteration of the refinement
 };
 
@@ -132,7 +135,7 @@ Inputs ReadInputs(const fs::path& sfm_dir, const fs::path& boundary_dir,
                   const fs::path& points_path = {});
 
 struct Timings {
-  double grid = 0, depth = 0, unfold = 0, refine = 0, page = 0, upright = 0, total = 0;
+  double grid = 0, depth = 0, unfold = 0, refine = 0, page = 0, ends = 0, upright = 0, total = 0;
 };
 
 struct Result {
@@ -158,6 +161,8 @@ struct Result {
   // them off M built on the reference outline (-1: no other photos).
   int page_points = 0;
   double page_points_off_mesh = -1;
+  // Every end's best fold against the photos' masks (empty: no other photos).
+  std::vector<EndFold> end_folds;
   Timings timings;
 };
 

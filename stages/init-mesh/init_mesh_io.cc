@@ -85,6 +85,13 @@ void DeclareOptions(OptionTable& table, Options* o) {
               "rebuild M from the page's points (those on the page in every photo that frames "
               "them) when more than this fraction of them lie off M built on the reference "
               "outline (1: never)");
+  table.Switch("end-fold", &o->end_fold.enabled,
+               "fold an end of M up on a grid line where the other photos' page masks show it "
+               "standing (--no-end-fold: leave the ends as the points and the reference outline "
+               "give them)");
+  table.Value("end-fold-gain", &o->end_fold.min_gain, 0.0, 1.0,
+              "keep a fold when it removes at least this fraction of the mismatch between M's "
+              "silhouettes and the photos' page masks");
   table.Switch("verbose", &o->verbose, "log every outer iteration of the refinement");
 }
 
@@ -169,6 +176,17 @@ Json ResultToJson(const Inputs& in, const Result& r, const Options& o, const Jso
   doc["page_points"] = {{"photos", in.other_photos.size() + 1}, {"count", r.page_points}};
   if (r.page_points_off_mesh >= 0)
     doc["page_points"]["off_reference_mesh"] = r.page_points_off_mesh;
+  static const char* const kEnds[4] = {"first_row", "last_row", "first_column", "last_column"};
+  Json folds = Json::array();
+  for (const EndFold& f : r.end_folds)
+    folds.push_back({{"end", kEnds[f.end]},
+                     {"hinge_line", f.hinge_line},
+                     {"angle_deg", f.angle_deg},
+                     {"length", f.length},
+                     {"mask_mismatch_before", f.mismatch_before},
+                     {"mask_mismatch_after", f.mismatch_after},
+                     {"kept", f.kept}});
+  doc["end_folds"] = folds;
   doc["unfold"] = {{"method", "arap"}, {"iterations", r.unfold_iterations}};
   Json refine = isometry::ToJson(r.refine);
   if (!r.refine.iterations.empty()) {
@@ -183,15 +201,12 @@ Json ResultToJson(const Inputs& in, const Result& r, const Options& o, const Jso
                     {"model_size", r.refine.model_size}};
   doc["upright"] = {{"rotation_deg", r.upright_rotation_deg}, {"from", r.upright_from}};
   doc["warnings"] = r.warnings;
-  doc["timings_s"] = {{"read", read_seconds},
-                      {"depth", r.timings.depth},
-                      {"grid", r.timings.grid},
-                      {"unfold", r.timings.unfold},
-                      {"refine", r.timings.refine},
-                      {"page", r.timings.page},
-                      {"upright", r.timings.upright},
-                      {"write", write_seconds},
-                      {"total", read_seconds + r.timings.total + write_seconds}};
+  doc["timings_s"] = {
+      {"read", read_seconds},       {"depth", r.timings.depth},
+      {"grid", r.timings.grid},     {"unfold", r.timings.unfold},
+      {"refine", r.timings.refine}, {"page", r.timings.page},
+      {"ends", r.timings.ends},     {"upright", r.timings.upright},
+      {"write", write_seconds},     {"total", read_seconds + r.timings.total + write_seconds}};
   return doc;
 }
 

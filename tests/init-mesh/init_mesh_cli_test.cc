@@ -143,6 +143,57 @@ TEST(InitMeshCli, ATriangularReferenceOutlineStillGivesTheWholePage) {
   EXPECT_LT(isometry::IsometryEdgeError(m).mean, 0.01);
 }
 
+TEST(InitMeshCli, AnEndStandingUpIsFoldedFromTheOtherPhotosMasks) {
+  TempDir with, without;
+  const MeshPair truth = WriteStandingEndWork(with.path(), 85);
+  WriteStandingEndWork(without.path(), 85);
+  const CommandResult a = RunCommand(InitMeshCommand(with.path()));
+  ASSERT_EQ(a.exit_code, 0) << a.output;
+  const CommandResult b = RunCommand(InitMeshCommand(without.path(), "--no-end-fold"));
+  ASSERT_EQ(b.exit_code, 0) << b.output;
+  const Json report = ReadJsonFile(with / "40_init/init.json");
+  int kept = 0;
+  for (const Json& fold : report["end_folds"])
+    if (fold["kept"].get<bool>()) {
+      ++kept;
+      EXPECT_EQ(fold["end"], "last_row") << fold.dump();
+    }
+  EXPECT_EQ(kept, 1) << report["end_folds"].dump();
+  const MeshPair m = ReadMeshPair(with / "40_init");
+  const MeshPair smooth = ReadMeshPair(without / "40_init");
+  EXPECT_EQ(m.grid.crease_rows.size() + m.grid.crease_columns.size(), 1u);
+  const double size = isometry::ModelSize(truth);
+  const auto page_to_m = SurfaceDistance(truth, m);
+  const auto page_to_smooth = SurfaceDistance(truth, smooth);
+  auto long_side = [](const MeshPair& pair) {  // M's longer side, as M' has it
+    Eigen::Vector2d lo = pair.mesh2d[0], hi = lo;
+    for (const Eigen::Vector2d& v : pair.mesh2d) {
+      lo = lo.cwiseMin(v);
+      hi = hi.cwiseMax(v);
+    }
+    return (hi - lo).maxCoeff();
+  };
+  // M' of the pair may be scaled against the truth: compare its length with
+  // its width.
+  auto aspect = [&](const MeshPair& pair) {
+    Eigen::Vector2d lo = pair.mesh2d[0], hi = lo;
+    for (const Eigen::Vector2d& v : pair.mesh2d) {
+      lo = lo.cwiseMin(v);
+      hi = hi.cwiseMax(v);
+    }
+    return long_side(pair) / (hi - lo).minCoeff();
+  };
+  std::printf(
+      "[init] receipt end standing at 85 deg: page to M %.2f %% (max %.2f %%) of the model size, "
+      "M' %.3f as long as wide (page 2.5); without the fold %.2f %% (max %.2f %%), %.3f\n",
+      100 * page_to_m.mean / size, 100 * page_to_m.max / size, aspect(m),
+      100 * page_to_smooth.mean / size, 100 * page_to_smooth.max / size, aspect(smooth));
+  EXPECT_LT(page_to_m.mean, 0.5 * page_to_smooth.mean);
+  EXPECT_LT(page_to_m.max, 0.5 * page_to_smooth.max);
+  EXPECT_NEAR(aspect(m), 2.5, 0.1);
+  EXPECT_LT(aspect(smooth), 2.35);  // the standing end comes out short
+}
+
 TEST(InitMeshCli, MissingOrCorruptFilesAreBadInput) {
   TempDir dir;
   WriteSyntheticWork(dir.path(), 400);

@@ -229,6 +229,38 @@ inline MeshPair WriteZigZagWithBlankBandWork(const fs::path& work, double fold_d
   return placed;
 }
 
+// 10_sfm (`points`, the cameras `cams`, the first of them the reference, and
+// a plain reference.png) and 20_boundary (the reference outline `sides`, the
+// page masks of `truth` in every camera) of a scene.
+inline void WriteMultiViewWork(const fs::path& work, const MeshPair& truth,
+                               const std::vector<PinholeCamera>& cams,
+                               const std::vector<Eigen::Vector3d>& points,
+                               const std::array<std::vector<Eigen::Vector2d>, 4>& sides) {
+  const PinholeCamera& ref = cams[0];
+  PlyData cloud;
+  cloud.vertices = points;
+  cloud.colors.assign(cloud.vertices.size(), {100, 100, 100});
+  EnsureDirectory(work / "10_sfm");
+  WritePly(work / "10_sfm/points.ply", cloud);
+  Json doc = MakeHeader("docunfold.cameras", 1, "synthetic");
+  doc["reference"] = ref.image;
+  doc["views"] = Json::array();
+  for (const auto& cam : cams) doc["views"].push_back(CameraToJson(cam));
+  WriteJsonAtomic(work / "10_sfm/cameras.json", doc);
+  WriteImageAtomic(work / "10_sfm/reference.png",
+                   cv::Mat(ref.height, ref.width, CV_8UC3, cv::Scalar(90, 120, 90)));
+  auto mask_in = [&](const PinholeCamera& cam) {
+    const RasterResult raster = RasterizeMesh(cam, truth.mesh3d, truth.grid.Triangles());
+    return cv::Mat1b(raster.face >= 0);
+  };
+  WriteBoundary(work / "20_boundary", "reference.png", ref.width, ref.height, sides, mask_in(ref));
+  for (size_t v = 1; v < cams.size(); ++v) {
+    const fs::path dir = work / "20_boundary/views" / fs::path(cams[v].image).stem();
+    EnsureDirectory(dir);
+    WriteImageAtomic(dir / "mask.png", mask_in(cams[v]));
+  }
+}
+
 // A page (0.21 x 0.297) folded along its diagonal from the top-right to the
 // bottom-left corner: the top-left triangle lies flat, facing the reference
 // camera 0.45 away; the other stands at 90 degrees toward that camera, which
@@ -260,23 +292,6 @@ inline MeshPair WriteDiagonalFoldWork(const fs::path& work) {
       LookAtCamera("side_a.jpg", {0.3, 0.25, 0.05}, {0, 0, d - 0.05}, 640, 480, 600),
       LookAtCamera("side_b.jpg", {0.25, 0.3, 0.1}, {0, 0, d - 0.05}, 640, 480, 600)};
   const PinholeCamera& ref = cams[0];
-  const SampledPoints sample = SampleSurface(truth, 3000, 0.0003, 0.0, 7);
-  PlyData cloud;
-  cloud.vertices = sample.points;
-  cloud.colors.assign(cloud.vertices.size(), {100, 100, 100});
-  EnsureDirectory(work / "10_sfm");
-  WritePly(work / "10_sfm/points.ply", cloud);
-  Json doc = MakeHeader("docunfold.cameras", 1, "synthetic");
-  doc["reference"] = ref.image;
-  doc["views"] = Json::array();
-  for (const auto& cam : cams) doc["views"].push_back(CameraToJson(cam));
-  WriteJsonAtomic(work / "10_sfm/cameras.json", doc);
-  WriteImageAtomic(work / "10_sfm/reference.png",
-                   cv::Mat(ref.height, ref.width, CV_8UC3, cv::Scalar(90, 120, 90)));
-  auto mask_in = [&](const PinholeCamera& cam) {
-    const RasterResult raster = RasterizeMesh(cam, truth.mesh3d, truth.grid.Triangles());
-    return cv::Mat1b(raster.face >= 0);
-  };
   // The reference outline: the flat triangle, as four sides (its long side
   // split at the middle, as segment-boundary splits an outline with three
   // corners).
@@ -289,14 +304,50 @@ inline MeshPair WriteDiagonalFoldWork(const fs::path& work) {
     return s;
   };
   const Eigen::Vector2d c0(-w / 2, -h / 2), middle = (c1 + c3) / 2;
-  WriteBoundary(work / "20_boundary", "reference.png", ref.width, ref.height,
-                {segment(c0, c1), segment(c1, middle), segment(c3, middle), segment(c0, c3)},
-                mask_in(ref));
-  for (size_t v = 1; v < cams.size(); ++v) {
-    const fs::path dir = work / "20_boundary/views" / fs::path(cams[v].image).stem();
-    EnsureDirectory(dir);
-    WriteImageAtomic(dir / "mask.png", mask_in(cams[v]));
+  WriteMultiViewWork(work, truth, cams, SampleSurface(truth, 3000, 0.0003, 0.0, 7).points,
+                     {segment(c0, c1), segment(c1, middle), segment(c3, middle), segment(c0, c3)});
+  return truth;
+}
+
+// A receipt (0.08 x 0.2) lying flat 0.45 from the reference camera, its last
+// `flap` of the length folded up by `fold_deg` towards the camera, which
+// looks at it from beyond the top end, so it sees the printed side of the
+// flap at a grazing angle. SfM points lie on the flat part only (the flap is
+// blank paper, or seen from behind by the other photos); two more photos see
+// the flap from the side and from beyond the bottom end. The reference
+// outline is the true border. Returns the true pair.
+inline MeshPair WriteStandingEndWork(const fs::path& work, double fold_deg, double flap = 0.2) {
+  const double w = 0.08, h = 0.2, d = 0.45, hinge = h * (1 - flap);
+  const double angle = fold_deg * 3.14159265358979323846 / 180;
+  MeshPair truth;
+  truth.grid.nx = 17;
+  truth.grid.ny = 41;
+  for (int r = 0; r < truth.grid.ny; ++r)
+    for (int c = 0; c < truth.grid.nx; ++c) {
+      const Eigen::Vector2d flat(w * c / (truth.grid.nx - 1), h * r / (truth.grid.ny - 1));
+      const double x = flat.x() - w / 2, past = std::max(0.0, flat.y() - hinge);
+      const double y = std::min(flat.y(), hinge) + past * std::cos(angle) - h / 2;
+      truth.mesh2d.push_back(flat);
+      truth.mesh3d.push_back({x, y, d - past * std::sin(angle)});
+    }
+  std::vector<PinholeCamera> cams = {
+      LookAtCamera("ref.jpg", {0, -0.25, 0.05}, {0, 0.02, d}, 640, 480, 700),
+      LookAtCamera("side.jpg", {0.3, 0.05, 0.1}, {0, 0.05, d - 0.03}, 640, 480, 700),
+      LookAtCamera("beyond.jpg", {0.05, 0.35, 0.1}, {0, 0.03, d - 0.03}, 640, 480, 700)};
+  std::vector<Eigen::Vector3d> points;
+  for (const Eigen::Vector3d& p : SampleSurface(truth, 3000, 0.0002, 0.0, 11).points)
+    if (p.y() < hinge - h / 2 - 0.005) points.push_back(p);
+  std::array<std::vector<Eigen::Vector2d>, 4> sides;
+  const QuadGrid& g = truth.grid;
+  for (int c = 0; c < g.nx; ++c) {
+    sides[0].push_back(cams[0].Project(truth.mesh3d[size_t(g.Index(0, c))]));
+    sides[2].push_back(cams[0].Project(truth.mesh3d[size_t(g.Index(g.ny - 1, c))]));
   }
+  for (int r = 0; r < g.ny; ++r) {
+    sides[1].push_back(cams[0].Project(truth.mesh3d[size_t(g.Index(r, g.nx - 1))]));
+    sides[3].push_back(cams[0].Project(truth.mesh3d[size_t(g.Index(r, 0))]));
+  }
+  WriteMultiViewWork(work, truth, cams, points, sides);
   return truth;
 }
 
