@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 
 #include "common/errors.h"
 
@@ -39,33 +38,7 @@ std::vector<Triangle> QuadGrid::Triangles() const {
   return tris;
 }
 
-bool QuadGrid::IsCreaseRow(int row) const {
-  return std::binary_search(crease_rows.begin(), crease_rows.end(), row);
-}
-
-bool QuadGrid::IsCreaseColumn(int col) const {
-  return std::binary_search(crease_columns.begin(), crease_columns.end(), col);
-}
-
 namespace {
-
-// `comment <key> i j ...`: interior line indices below `lines` - 1, ascending.
-std::vector<int> CreaseLines(const PlyData& ply, const std::string& key, int lines,
-                             const fs::path& path) {
-  std::vector<int> out;
-  const auto value = ply.CommentValue(key);
-  if (!value) return out;
-  std::istringstream s(*value);
-  int i = 0;
-  while (s >> i) {
-    if (i < 1 || i > lines - 2 || (!out.empty() && i <= out.back()))
-      throw InputError(path.string() + ": '" + key + "' lists " + std::to_string(i) +
-                       ", not an interior grid line in ascending order");
-    out.push_back(i);
-  }
-  if (!s.eof()) throw InputError(path.string() + ": '" + key + "' must list grid line numbers");
-  return out;
-}
 
 QuadGrid GridOf(const PlyData& ply, const fs::path& path) {
   auto size = ply.GridSize();
@@ -77,8 +50,6 @@ QuadGrid GridOf(const PlyData& ply, const fs::path& path) {
     throw InputError(path.string() + ": expected " + std::to_string(grid.NumQuads()) +
                      " quads for a " + std::to_string(grid.nx) + "x" + std::to_string(grid.ny) +
                      " grid, found " + std::to_string(ply.faces.size()) + " faces");
-  grid.crease_rows = CreaseLines(ply, "crease_rows", grid.ny, path);
-  grid.crease_columns = CreaseLines(ply, "crease_columns", grid.nx, path);
   return grid;
 }
 
@@ -128,14 +99,6 @@ void WriteMeshPair(const fs::path& dir, const MeshPair& m, const MeshPairWriteOp
     p->comments = options.comments;
     p->SetGridSize(m.grid.nx, m.grid.ny);
   }
-  auto list = [](const std::vector<int>& lines) {
-    std::string out;
-    for (int i : lines) out += " " + std::to_string(i);
-    return out;
-  };
-  if (!m.grid.crease_rows.empty()) m3.comments.push_back("crease_rows" + list(m.grid.crease_rows));
-  if (!m.grid.crease_columns.empty())
-    m3.comments.push_back("crease_columns" + list(m.grid.crease_columns));
   m3.comments.insert(m3.comments.begin(), "docunfold mesh3d: M, the page in the world frame");
   m2.comments.insert(m2.comments.begin(),
                      "docunfold mesh2d: M', the flat page (z = 0, x right, y down)");

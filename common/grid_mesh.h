@@ -8,8 +8,6 @@
 //  - quad faces (r,c) (r,c+1) (r+1,c+1) (r+1,c), row-major; quad q is split
 //    into triangles 2q = (0,1,2) and 2q+1 = (0,2,3) of its corners;
 //  - mesh2d: z = 0, x right, y down, same length unit as mesh3d, upright;
-//  - optional `comment crease_rows R...` / `comment crease_columns C...`:
-//    interior grid lines along which M folds sharply (see QuadGrid);
 //  - mesh3d carries texture_u, texture_v (MeshLab convention: v up) into the
 //    reference image and `comment TextureFile <path relative to the PLY>`.
 #pragma once
@@ -32,12 +30,6 @@ namespace fs = std::filesystem;
 struct QuadGrid {
   int nx = 0;  // vertices per row
   int ny = 0;  // rows
-  // Interior rows (1..ny-2) and columns (1..nx-2) along which M may fold
-  // sharply, ascending: M's fairness does not act across them and
-  // subdivision keeps them sharp (a page folded up at a crease).
-  std::vector<int> crease_rows, crease_columns;
-  bool IsCreaseRow(int row) const;
-  bool IsCreaseColumn(int col) const;
   int NumVertices() const { return nx * ny; }
   int NumQuads() const { return (nx - 1) * (ny - 1); }
   int Index(int row, int col) const { return row * nx + col; }

@@ -176,17 +176,8 @@ inline std::array<int, 3> FairTriplet(const QuadGrid& g, int t) {
   const int c = t / (g.ny - 2), r = t % (g.ny - 2) + 1;
   return {g.Index(r - 1, c), g.Index(r, c), g.Index(r + 1, c)};
 }
-// Whether triplet t of M is centred on a crease line it runs across.
-inline bool AcrossCrease(const QuadGrid& g, int t) {
-  if (g.crease_rows.empty() && g.crease_columns.empty()) return false;
-  const int along_rows = std::max(0, g.ny * (g.nx - 2));
-  if (t < along_rows) return g.IsCreaseColumn(t % (g.nx - 2) + 1);
-  return g.IsCreaseRow((t - along_rows) % (g.ny - 2) + 1);
-}
-// dims 0..2 (M) or 3..4 (M'): one row per coordinate; none for M across a
-// crease (M folds there; M' stays straight across it).
+// dims 0..2 (M) or 3..4 (M'): one row per coordinate.
 inline int FairRows(const State& s, int t, bool flat, Row* rows) {
-  if (!flat && AcrossCrease(s.grid, t)) return 0;
   const auto v = FairTriplet(s.grid, t);
   const int first = flat ? 3 : 0, n = flat ? 2 : 3;
   for (int k = 0; k < n; ++k) {

@@ -23,7 +23,7 @@ std::vector<V> Subdivide(const QuadGrid& g, const std::vector<V>& p) {
   for (int r = 0; r < ny; ++r)
     for (int c = 0; c + 1 < nx; ++c) {
       const V mid = (P(r, c) + P(r, c + 1)) / 2;
-      if (r == 0 || r == ny - 1 || g.IsCreaseRow(r))
+      if (r == 0 || r == ny - 1)
         out_at(2 * r, 2 * c + 1) = mid;
       else
         out_at(2 * r, 2 * c + 1) = (P(r, c) + P(r, c + 1) + F(r - 1, c) + F(r, c)) / 4;
@@ -32,7 +32,7 @@ std::vector<V> Subdivide(const QuadGrid& g, const std::vector<V>& p) {
   for (int r = 0; r + 1 < ny; ++r)
     for (int c = 0; c < nx; ++c) {
       const V mid = (P(r, c) + P(r + 1, c)) / 2;
-      if (c == 0 || c == nx - 1 || g.IsCreaseColumn(c))
+      if (c == 0 || c == nx - 1)
         out_at(2 * r + 1, 2 * c) = mid;
       else
         out_at(2 * r + 1, 2 * c) = (P(r, c) + P(r + 1, c) + F(r, c - 1) + F(r, c)) / 4;
@@ -40,15 +40,13 @@ std::vector<V> Subdivide(const QuadGrid& g, const std::vector<V>& p) {
   // Vertex points.
   for (int r = 0; r < ny; ++r)
     for (int c = 0; c < nx; ++c) {
-      // A crease line is a border of the surface on either side of it.
-      const bool along_row = r == 0 || r == ny - 1 || g.IsCreaseRow(r);
-      const bool along_col = c == 0 || c == nx - 1 || g.IsCreaseColumn(c);
+      const bool top = r == 0, bottom = r == ny - 1, left = c == 0, right = c == nx - 1;
       V& o = out_at(2 * r, 2 * c);
-      if (along_row && along_col) {
+      if ((top || bottom) && (left || right)) {
         o = P(r, c);  // corner
-      } else if (along_row) {
+      } else if (top || bottom) {
         o = (P(r, c - 1) + 6 * P(r, c) + P(r, c + 1)) / 8;
-      } else if (along_col) {
+      } else if (left || right) {
         o = (P(r - 1, c) + 6 * P(r, c) + P(r + 1, c)) / 8;
       } else {
         const V f = (F(r - 1, c - 1) + F(r - 1, c) + F(r, c - 1) + F(r, c)) / 4;
@@ -66,8 +64,6 @@ MeshPair SubdivideCatmullClark(const MeshPair& m) {
     throw std::invalid_argument("SubdivideCatmullClark: grid smaller than 2x2");
   MeshPair out;
   out.grid = {2 * m.grid.nx - 1, 2 * m.grid.ny - 1};
-  for (int r : m.grid.crease_rows) out.grid.crease_rows.push_back(2 * r);
-  for (int c : m.grid.crease_columns) out.grid.crease_columns.push_back(2 * c);
   out.mesh3d = Subdivide(m.grid, m.mesh3d);
   out.mesh2d = Subdivide(m.grid, m.mesh2d);
   return out;

@@ -3,9 +3,9 @@
 // and Clark (all interior vertices have valence 4); on the open border the
 // boundary rules that make the border curve a uniform cubic B-spline of the
 // border polyline (edge points at midpoints, vertex points (1, 6, 1)/8), with
-// the four grid corners kept fixed. A crease line of the grid takes the
-// border rules on both sides (it stays as sharp as it was). The scheme is linear, so M' stays
-// planar and both meshes are refined by the same map: the pair stays (approximately) isometric.
+// the four grid corners kept fixed. The scheme is linear, so M' stays planar
+// and both meshes are refined by the same map: the pair stays (approximately)
+// isometric.
 #pragma once
 
 #include "common/grid_mesh.h"

@@ -293,9 +293,6 @@ std::vector<EndFold> FoldEnds(const std::vector<ViewPage>& photos, const Pinhole
     if (best.kept) {
       m->mesh3d = folded.mesh3d;
       m->mesh2d = folded.mesh2d;
-      std::vector<int>& creases = end < 2 ? m->grid.crease_rows : m->grid.crease_columns;
-      creases.push_back(end % 2 == 0 ? best.hinge_line : lines.Lines() - 1 - best.hinge_line);
-      std::sort(creases.begin(), creases.end());
     }
     if (best.hinge_line > 0 || best.mismatch_before > 0) folds.push_back(best);
   }

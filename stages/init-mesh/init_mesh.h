@@ -14,7 +14,9 @@
 //  5. where more of the page's points (seen on the page by every photo that
 //     frames them) lie off M than the reference outline can explain, M and
 //     M' rebuilt from those points alone (page_from_points.h) and refined;
-//  6. M' turned upright by the oriented bounding box of the real boundary
+//  6. an end of M folded up on a grid line where the other photos' page
+//     masks show it standing (end_fold.h);
+//  7. M' turned upright by the oriented bounding box of the real boundary
 //     sides (of the whole mesh when no side is real): top side at small y.
 #pragma once
 
