@@ -83,9 +83,9 @@ double Mismatch(const cv::Mat1b& silhouette, const cv::Mat1b& mask) {
   return double(cv::countNonZero(diff));
 }
 
-// The flap beyond hinge line `h` of `lines` as a plane turned by `angle`
-// (radians) about the hinge from the panel before it, its far edge on the
-// reference photo's rays through M's end; false where no such length is.
+// The flap beyond hinge line `h` of `lines`: the hinge, the frame a turn
+// about it is measured in, and the reference photo's rays through M's end,
+// on which the flap's far edge stays.
 struct Flap {
   std::vector<Eigen::Vector3d> hinge3d;
   std::vector<Eigen::Vector2d> hinge2d;

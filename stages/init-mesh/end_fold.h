@@ -9,7 +9,7 @@
 // they agree clearly better than M as it was.
 #pragma once
 
-#include <string>
+#include <Eigen/Core>
 #include <vector>
 
 #include "common/camera.h"
@@ -66,9 +66,9 @@ struct EndFold {
 };
 
 // The masks' views: the reference (its mask, no distortion) and the other
-// photos; `points`: the page's points M was fitted to. Returns every end's
-// best fold; folds the kept ones into `m` (M and M' alike, M' flat and as
-// long as the flap).
+// photos; `points`: the page's points M was fitted to. Returns the best fold
+// of every end the reference photo does not cut off; folds the kept ones
+// into `m` (M and M' alike, M' flat and as long as the flap).
 std::vector<EndFold> FoldEnds(const std::vector<ViewPage>& photos, const PinholeCamera& reference,
                               const std::vector<Eigen::Vector3d>& points, const EndFoldOptions& o,
                               MeshPair* m);
