@@ -218,10 +218,9 @@ void FaceLikeTheReference(const PinholeCamera& camera, MeshPair* m) {
 // M is rebuilt from those points and refined on them. It is kept if it
 // leaves at most half as many of them off, without reaching farther from
 // them (a layout gone wrong covers the points and much else).
-void RebuildFromPagePoints(const Inputs& in, const Options& o, Result* res) {
+void RebuildFromPagePoints(const Inputs& in, const std::vector<ViewPage>& photos, const Options& o,
+                           Result* res) {
   const PageFromPointsOptions& po = o.page_from_points;
-  std::vector<ViewPage> photos = in.other_photos;
-  photos.push_back({in.reference, {}, in.mask, {}});
   const std::vector<bool> on_page = PagePoints(in.points, photos, po);
   std::vector<Eigen::Vector3d> page;
   for (size_t i = 0; i < in.points.size(); ++i)
@@ -318,14 +317,15 @@ Result Run(const Inputs& in, const Options& o) {
   Refine(points.points, o, &res);
   res.timings.refine = timer.Mark("refine");
 
-  if (!in.other_photos.empty()) RebuildFromPagePoints(in, o, &res);
+  // Every photo's page, the reference's last: what the page's points and the
+  // ends' folds are judged by.
+  std::vector<ViewPage> photos = in.other_photos;
+  photos.push_back({in.reference, {}, in.mask, {}});
+  if (!in.other_photos.empty()) RebuildFromPagePoints(in, photos, o, &res);
   res.timings.page = timer.Mark("page");
 
-  if (!in.other_photos.empty()) {
-    std::vector<ViewPage> photos = in.other_photos;
-    photos.push_back({in.reference, {}, in.mask, {}});
+  if (!in.other_photos.empty())
     res.end_folds = FoldEnds(photos, in.reference, points.points, o.end_fold, &res.meshes);
-  }
   res.timings.ends = timer.Mark("ends");
 
   if (o.upright) TurnUpright(in, &res);

@@ -143,67 +143,62 @@ TEST(InitMeshCli, ATriangularReferenceOutlineStillGivesTheWholePage) {
   EXPECT_LT(isometry::IsometryEdgeError(m).mean, 0.01);
 }
 
-TEST(InitMeshCli, AnEndStandingUpIsFoldedFromTheOtherPhotosMasks) {
+// init-mesh on a receipt whose last fifth stands at `fold_deg`
+// (WriteStandingEndWork), with the end folds and with --no-end-fold.
+struct EndFoldRuns {
+  MeshPair truth, folded, smooth;
+  Json report;  // init.json of the run with the end folds
+};
+EndFoldRuns RunWithAndWithoutEndFold(double fold_deg) {
   TempDir with, without;
-  const MeshPair truth = WriteStandingEndWork(with.path(), 85);
-  WriteStandingEndWork(without.path(), 85);
+  EndFoldRuns runs;
+  runs.truth = WriteStandingEndWork(with.path(), fold_deg);
+  WriteStandingEndWork(without.path(), fold_deg);
   const CommandResult a = RunCommand(InitMeshCommand(with.path()));
-  ASSERT_EQ(a.exit_code, 0) << a.output;
+  EXPECT_EQ(a.exit_code, 0) << a.output;
   const CommandResult b = RunCommand(InitMeshCommand(without.path(), "--no-end-fold"));
-  ASSERT_EQ(b.exit_code, 0) << b.output;
-  const Json report = ReadJsonFile(with / "40_init/init.json");
+  EXPECT_EQ(b.exit_code, 0) << b.output;
+  runs.report = ReadJsonFile(with / "40_init/init.json");
+  runs.folded = ReadMeshPair(with / "40_init");
+  runs.smooth = ReadMeshPair(without / "40_init");
+  return runs;
+}
+
+TEST(InitMeshCli, AnEndStandingUpIsFoldedFromTheOtherPhotosMasks) {
+  const EndFoldRuns runs = RunWithAndWithoutEndFold(85);
   int kept = 0;
-  for (const Json& fold : report["end_folds"])
+  for (const Json& fold : runs.report["end_folds"])
     if (fold["kept"].get<bool>()) {
       ++kept;
       EXPECT_EQ(fold["end"], "last_row") << fold.dump();
     }
-  EXPECT_EQ(kept, 1) << report["end_folds"].dump();
-  const MeshPair m = ReadMeshPair(with / "40_init");
-  const MeshPair smooth = ReadMeshPair(without / "40_init");
-  const double size = isometry::ModelSize(truth);
-  const auto page_to_m = SurfaceDistance(truth, m);
-  const auto page_to_smooth = SurfaceDistance(truth, smooth);
-  auto long_side = [](const MeshPair& pair) {  // M's longer side, as M' has it
-    Eigen::Vector2d lo = pair.mesh2d[0], hi = lo;
-    for (const Eigen::Vector2d& v : pair.mesh2d) {
-      lo = lo.cwiseMin(v);
-      hi = hi.cwiseMax(v);
-    }
-    return (hi - lo).maxCoeff();
-  };
+  EXPECT_EQ(kept, 1) << runs.report["end_folds"].dump();
+  const double size = isometry::ModelSize(runs.truth);
+  const auto page_to_m = SurfaceDistance(runs.truth, runs.folded);
+  const auto page_to_smooth = SurfaceDistance(runs.truth, runs.smooth);
   // M' of the pair may be scaled against the truth: compare its length with
   // its width.
-  auto aspect = [&](const MeshPair& pair) {
-    Eigen::Vector2d lo = pair.mesh2d[0], hi = lo;
-    for (const Eigen::Vector2d& v : pair.mesh2d) {
-      lo = lo.cwiseMin(v);
-      hi = hi.cwiseMax(v);
-    }
-    return long_side(pair) / (hi - lo).minCoeff();
+  auto aspect = [](const MeshPair& pair) {
+    Eigen::AlignedBox2d box;
+    for (const Eigen::Vector2d& v : pair.mesh2d) box.extend(v);
+    return box.sizes().maxCoeff() / box.sizes().minCoeff();
   };
   std::printf(
       "[init] receipt end standing at 85 deg: page to M %.2f %% (max %.2f %%) of the model size, "
       "M' %.3f as long as wide (page 2.5); without the fold %.2f %% (max %.2f %%), %.3f\n",
-      100 * page_to_m.mean / size, 100 * page_to_m.max / size, aspect(m),
-      100 * page_to_smooth.mean / size, 100 * page_to_smooth.max / size, aspect(smooth));
+      100 * page_to_m.mean / size, 100 * page_to_m.max / size, aspect(runs.folded),
+      100 * page_to_smooth.mean / size, 100 * page_to_smooth.max / size, aspect(runs.smooth));
   EXPECT_LT(page_to_m.mean, 0.5 * page_to_smooth.mean);
   EXPECT_LT(page_to_m.max, 0.5 * page_to_smooth.max);
-  EXPECT_NEAR(aspect(m), 2.5, 0.1);
-  EXPECT_LT(aspect(smooth), 2.35);  // the standing end comes out short
+  EXPECT_NEAR(aspect(runs.folded), 2.5, 0.1);
+  EXPECT_LT(aspect(runs.smooth), 2.35);  // the standing end comes out short
 }
 
 TEST(InitMeshCli, AFlatEndWithoutPointsStaysFlat) {
-  TempDir with, without;
-  const MeshPair truth = WriteStandingEndWork(with.path(), 0);
-  WriteStandingEndWork(without.path(), 0);
-  const CommandResult a = RunCommand(InitMeshCommand(with.path()));
-  ASSERT_EQ(a.exit_code, 0) << a.output;
-  const CommandResult b = RunCommand(InitMeshCommand(without.path(), "--no-end-fold"));
-  ASSERT_EQ(b.exit_code, 0) << b.output;
-  const double size = isometry::ModelSize(truth);
-  const auto page_to_m = SurfaceDistance(truth, ReadMeshPair(with / "40_init"));
-  const auto page_to_smooth = SurfaceDistance(truth, ReadMeshPair(without / "40_init"));
+  const EndFoldRuns runs = RunWithAndWithoutEndFold(0);
+  const double size = isometry::ModelSize(runs.truth);
+  const auto page_to_m = SurfaceDistance(runs.truth, runs.folded);
+  const auto page_to_smooth = SurfaceDistance(runs.truth, runs.smooth);
   std::printf(
       "[init] flat receipt, last fifth without points: page to M %.2f %% (max %.2f %%) of the "
       "model size; without the end fold %.2f %% (max %.2f %%)\n",
