@@ -128,10 +128,6 @@ struct SolveOptions {
   // the model size (bounding-box diagonal of M); re-decided every outer
   // iteration (progressive filtering). <= 0 keeps every point.
   double outlier_distance = 0.06;
-  // E_fair(M) spares a crease: each triplet's rows are weighted by
-  // 1 / (1 + (κ/κ0)²), κ its turn over its length (per model size), κ0 this
-  // value, re-decided every outer iteration; 0 = every triplet alike.
-  double crease_curvature = 0;
   IsoNormalization iso_normalization = IsoNormalization::kStrain;
   // Weight of E_iso's edge-length rows against the paper's three diagonal
   // rows per quad (0 = the paper). The diagonals alone leave a quad of M free

@@ -12,9 +12,6 @@ void DeclareSolveOptions(OptionTable& table, SolveOptions* o) {
   table.Value("outlier-distance", &o->outlier_distance, 0.0, 10.0,
               "φ: points farther from M than this fraction of the model size are ignored "
               "(re-decided every outer iteration)");
-  table.Value("crease-curvature", &o->crease_curvature, 0.0, 1e9,
-              "E_fair(M) spares creases: a grid triplet turning by κ per model size weighs "
-              "1/(1+(κ/κ0)²) with κ0 this value (0 = off)");
   table.Choice("iso-normalization", &o->iso_normalization,
                {{"strain", IsoNormalization::kStrain}, {"raw", IsoNormalization::kRaw}},
                "strain: E_iso as mean squared strain (independent of the grid's resolution); "

@@ -65,26 +65,6 @@ void UpdateLines(const SolveOptions& o, Work& w) {
   if (o.project_markers) ProjectMarkers(w.state, w.data);
 }
 
-// The factor on each fairness triplet's rows of M (SolveOptions::crease_curvature).
-void UpdateFairFactors(const SolveOptions& o, Work& w) {
-  using namespace internal;
-  if (!(o.crease_curvature > 0)) return;
-  const int triplets = NumFairTriplets(w.state.grid);
-  w.data.fair3d_factor.assign(size_t(triplets), 1.0);
-  for (int t = 0; t < triplets; ++t) {
-    const auto v = FairTriplet(w.state.grid, t);
-    const Eigen::Vector3d a = w.state.v3[v[1]] - w.state.v3[v[0]],
-                          b = w.state.v3[v[2]] - w.state.v3[v[1]];
-    const double la = a.norm(), lb = b.norm();
-    if (!(la > 0 && lb > 0)) continue;
-    const double turn = std::acos(std::clamp(a.dot(b) / (la * lb), -1.0, 1.0));
-    const double kappa = turn / (0.5 * (la + lb));
-    const double x = kappa / o.crease_curvature;
-    const double weight = 1 / (1 + x * x);
-    w.data.fair3d_factor[size_t(t)] = std::sqrt(weight);
-  }
-}
-
 SolveReport StartReport(const Problem& problem, const Work& w, const GaussNewton* gn) {
   SolveReport report;
   if (gn) {
@@ -153,7 +133,6 @@ Result Solve(const Problem& problem, const SolveOptions& o) {
     if (gn) gn->set_threads(threads);
     ir.threads = threads;
     UpdateFootpoints(w.state, w.data, o.outlier_distance, threads);
-    UpdateFairFactors(o, w);
     // The callback first: it may regroup markers into new lines, which are
     // then fitted and projected onto like any others.
     if (o.on_outer_iteration) CallOuterIteration(o, it, w);

@@ -3,7 +3,6 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 #include <optional>
@@ -188,173 +187,6 @@ double PointsLost(const MeshPair& before, const MeshPair& after,
   return double(lost) / double(points.size());
 }
 
-// The mismatch of all of M's silhouettes against the masks (fraction of the
-// masks' total area).
-double SilhouetteMismatch(const MeshPair& m, const std::vector<Silhouette>& views,
-                          double total_area) {
-  const EndLines rows{&m.grid, 0};
-  double mismatch = 0;
-  for (const Silhouette& view : views) {
-    std::vector<std::optional<cv::Point2f>> px;
-    px.reserve(m.mesh3d.size());
-    for (const Eigen::Vector3d& x : m.mesh3d) px.push_back(view.Pixel(x));
-    cv::Mat1b image = cv::Mat1b::zeros(view.mask.size());
-    FillLines(rows, 0, rows.Lines() - 1, px, &image);
-    mismatch += Mismatch(image, view.mask);
-  }
-  return mismatch / total_area;
-}
-
-// A flap beyond a hinge anywhere across an end, not only on a grid line: in
-// M' the hinge is the line n·p' = offset + slope·(u·p' − u_mid), n the end's
-// outward direction (along the page's sides) and u across it. The page beyond
-// the hinge is turned about the hinge's image on M (a straight line fitted to
-// it); its columns run on along n and it ends square to them, at the end
-// offset the reference rays through M's end give (their median), or a given
-// one.
-class FreeFlap {
- public:
-  FreeFlap(const MeshPair& m, const EndLines& lines, const PinholeCamera& reference)
-      : m_(m), lines_(lines), locator_(m), centre_(reference.Center()) {
-    const int w = lines.Width(), mid = std::max(1, (lines.Lines() - 1) / 2);
-    Eigen::Vector2d n = Eigen::Vector2d::Zero();
-    for (int j = 0; j < w; ++j)
-      n += (m.mesh2d[size_t(lines.Vertex(0, j))] - m.mesh2d[size_t(lines.Vertex(mid, j))])
-               .normalized();
-    n_ = n.normalized();
-    u_ = Eigen::Vector2d(-n_.y(), n_.x());
-    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-    for (const Eigen::Vector2d& p : m.mesh2d) {
-      lo = std::min(lo, n_.dot(p));
-      hi = std::max(hi, n_.dot(p));
-    }
-    end_offset_ = hi;
-    extent_ = hi - lo;
-    for (int j = 0; j < w; ++j) {
-      const Eigen::Vector3d end = m.mesh3d[size_t(lines.Vertex(0, j))];
-      rays_.push_back(
-          (reference.R.transpose() * reference.CamRay(reference.Project(end))).normalized());
-      u_mid_ += u_.dot(m.mesh2d[size_t(lines.Vertex(0, j))]) / w;
-    }
-  }
-  double end_offset() const { return end_offset_; }
-  double extent() const { return extent_; }
-  // The offset and slope of grid line `h` (a least-squares line through it).
-  void GridLine(int h, double* offset, double* slope) const {
-    Eigen::Matrix2d a = Eigen::Matrix2d::Zero();
-    Eigen::Vector2d b = Eigen::Vector2d::Zero();
-    for (int j = 0; j < lines_.Width(); ++j) {
-      const Eigen::Vector2d& p = m_.mesh2d[size_t(lines_.Vertex(h, j))];
-      const Eigen::Vector2d row(1, u_.dot(p) - u_mid_);
-      a += row * row.transpose();
-      b += row * n_.dot(p);
-    }
-    const Eigen::Vector2d x = a.ldlt().solve(b);
-    *offset = x[0];
-    *slope = x[1];
-  }
-  // M with the flap turned through `angle` (radians) into `out`; the
-  // stretch; 0 when the hinge does not cross M or no stretch fits the rays.
-  double Place(double offset, double slope, double angle, double max_stretch, MeshPair* out,
-               std::optional<double> fixed_end = std::nullopt, double* end_used = nullptr) const {
-    const double norm = std::sqrt(1 + slope * slope);
-    const Eigen::Vector2d out2 = (n_ - slope * u_) / norm, e = (u_ + slope * n_) / norm;
-    const Eigen::Vector2d q0 = u_mid_ * u_ + offset * n_;
-    // The hinge on M: a line fitted to its image, parametrised by M' length.
-    double tau_lo = std::numeric_limits<double>::infinity(), tau_hi = -tau_lo;
-    for (const Eigen::Vector2d& p : m_.mesh2d) {
-      tau_lo = std::min(tau_lo, e.dot(p - q0));
-      tau_hi = std::max(tau_hi, e.dot(p - q0));
-    }
-    constexpr int kSamples = 25;
-    Eigen::Matrix2d a = Eigen::Matrix2d::Zero();
-    Eigen::Matrix<double, 2, 3> b = Eigen::Matrix<double, 2, 3>::Zero();
-    Eigen::Vector3d before = Eigen::Vector3d::Zero();
-    int found = 0, found_before = 0;
-    double tau_found_lo = tau_hi, tau_found_hi = tau_lo;
-    const double step_back = 0.05 * extent_;
-    for (int k = 0; k < kSamples; ++k) {
-      const double tau = tau_lo + (tau_hi - tau_lo) * (k + 0.5) / kSamples;
-      const auto at = locator_.Locate(q0 + tau * e);
-      if (!at) continue;
-      const Eigen::Vector3d x = PointOnMesh3d(m_, *at);
-      const Eigen::Vector2d row(1, tau);
-      a += row * row.transpose();
-      b += row * x.transpose();
-      ++found;
-      tau_found_lo = std::min(tau_found_lo, tau);
-      tau_found_hi = std::max(tau_found_hi, tau);
-      if (const auto back = locator_.Locate(q0 + tau * e - step_back * out2)) {
-        before += x - PointOnMesh3d(m_, *back);
-        ++found_before;
-      }
-    }
-    if (found < 3 || found_before < 2 || tau_found_hi - tau_found_lo < 0.3 * (tau_hi - tau_lo))
-      return 0;
-    const Eigen::Matrix<double, 2, 3> line = a.ldlt().solve(b);
-    const Eigen::Vector3d origin = line.row(0).transpose();
-    const Eigen::Vector3d axis = line.row(1).transpose().normalized();
-    const Eigen::Vector3d along = (before - before.dot(axis) * axis).normalized();
-    const Eigen::Vector3d normal = axis.cross(along);
-    const Eigen::Vector3d d = std::cos(angle) * along + std::sin(angle) * normal;
-    // The flap is the page beyond the hinge: its columns run on along the
-    // page's sides (n in M'), and it ends square to them, where the
-    // reference rays through M's end put it (the median over the columns).
-    const double cos_phi = n_.dot(out2), sin_phi = n_.dot(e);
-    const Eigen::Vector3d along_flap = cos_phi * d + sin_phi * axis;
-    const int w = lines_.Width();
-    std::vector<Eigen::Vector2d> crossing(static_cast<size_t>(w), Eigen::Vector2d::Zero());
-    std::vector<int> beyond(size_t(w), 0);  // vertices of the column past the hinge
-    std::vector<double> ends;
-    for (int j = 0; j < w; ++j) {
-      int i = 0;
-      while (i < lines_.Lines() && out2.dot(m_.mesh2d[size_t(lines_.Vertex(i, j))] - q0) > 0) ++i;
-      if (i == 0 || i == lines_.Lines()) continue;
-      const Eigen::Vector2d& a = m_.mesh2d[size_t(lines_.Vertex(i - 1, j))];
-      const Eigen::Vector2d& b = m_.mesh2d[size_t(lines_.Vertex(i, j))];
-      const double sa = out2.dot(a - q0), sb = out2.dot(b - q0);
-      crossing[size_t(j)] = a + (b - a) * (sa / (sa - sb));
-      beyond[size_t(j)] = i;
-      const Eigen::Vector3d w0 = origin + e.dot(crossing[size_t(j)] - q0) * axis - centre_;
-      const Eigen::Vector3d& r = rays_[size_t(j)];
-      const double k = along_flap.dot(r);
-      if (1 - k * k < 1e-3) continue;
-      const double l = (k * r.dot(w0) - along_flap.dot(w0)) / (1 - k * k);
-      if (l > 0 && r.dot(w0) + l * k > 0) ends.push_back(n_.dot(crossing[size_t(j)]) + l);
-    }
-    if (!fixed_end && ends.size() * 2 < size_t(w)) return 0;
-    const double end = fixed_end ? *fixed_end : Median(ends);
-    if (end_used) *end_used = end;
-    *out = m_;
-    double stretch = 0;
-    for (int j = 0; j < w; ++j) {
-      if (beyond[size_t(j)] == 0) continue;
-      const Eigen::Vector2d& c = crossing[size_t(j)];
-      const double before = n_.dot(m_.mesh2d[size_t(lines_.Vertex(0, j))] - c);
-      const double length = end - n_.dot(c);
-      if (!(before > 0) || !(length > 0) || length > max_stretch * before) return 0;
-      stretch = std::max(stretch, length / before);
-      const Eigen::Vector3d hinge = origin + e.dot(c - q0) * axis;
-      for (int i = 0; i < beyond[size_t(j)]; ++i) {
-        const size_t v = size_t(lines_.Vertex(i, j));
-        const double f = std::clamp(n_.dot(m_.mesh2d[v] - c) / before, 0.0, 1.0);
-        out->mesh3d[v] = hinge + f * length * along_flap;
-        out->mesh2d[v] = c + f * length * n_;
-      }
-    }
-    return stretch;
-  }
-
- private:
-  const MeshPair& m_;
-  EndLines lines_;
-  isometry::FlatMeshLocator locator_;
-  Eigen::Vector3d centre_;
-  Eigen::Vector2d n_, u_;
-  double u_mid_ = 0, end_offset_ = 0, extent_ = 0;
-  std::vector<Eigen::Vector3d> rays_;
-};
-
 // The best hinge and angle of one end against the silhouettes (hinge_line 0:
 // none found).
 EndFold SearchEnd(const MeshPair& m, const EndLines& lines, const PinholeCamera& reference,
@@ -424,59 +256,6 @@ EndFold SearchEnd(const MeshPair& m, const EndLines& lines, const PinholeCamera&
   return best;
 }
 
-// A grid line's fold refined into a free hinge (FreeFlap): coordinate descent
-// over the angle, the hinge's offset and its slope, from the grid line's own.
-struct FreeFold {
-  double offset = 0, slope = 0, angle_deg = 0, mismatch = 0, length = 0;
-  MeshPair meshes;
-  std::optional<double> end;
-};
-std::optional<FreeFold> RefineFreeHinge(const MeshPair& m, const EndLines& lines,
-                                        const PinholeCamera& reference,
-                                        const std::vector<Silhouette>& views, double total_area,
-                                        const EndFold& grid_fold, const EndFoldOptions& o) {
-  const FreeFlap flap(m, lines, reference);
-  FreeFold best;
-  flap.GridLine(grid_fold.hinge_line, &best.offset, &best.slope);
-  best.angle_deg = grid_fold.angle_deg;
-  best.mismatch = std::numeric_limits<double>::infinity();
-  MeshPair trial;
-  const double min_offset = flap.end_offset() - o.max_flap_fraction * flap.extent();
-  auto consider = [&](double offset, double slope, double angle_deg,
-                      std::optional<double> end = std::nullopt) {
-    if (offset < min_offset || offset >= flap.end_offset()) return;
-    double end_used = 0;
-    const double stretch = flap.Place(offset, slope, angle_deg * kPi / 180, o.max_length_ratio,
-                                      &trial, end, &end_used);
-    if (!(stretch > 0)) return;
-    const double mismatch = SilhouetteMismatch(trial, views, total_area);
-    if (mismatch < best.mismatch) {
-      best = {offset, slope, angle_deg, mismatch, end_used - offset, trial, end_used};
-    }
-  };
-  consider(best.offset, best.slope, best.angle_deg);
-  consider(best.offset, 0, best.angle_deg);
-  // The flap's frame may turn the other way round from the grid line's.
-  const double grid_offset = best.offset, grid_slope = best.slope, grid_angle = best.angle_deg;
-  consider(grid_offset, grid_slope, -grid_angle);
-  consider(grid_offset, 0, -grid_angle);
-  if (!std::isfinite(best.mismatch)) return std::nullopt;
-  const double offset_step = 0.004 * flap.extent();
-  for (int round = 0; round < 4; ++round) {
-    const FreeFold start = best;
-    const double end = *best.end;
-    for (int k = -6; k <= 6; ++k) consider(best.offset, best.slope, start.angle_deg + k, end);
-    const double angle = best.angle_deg, slope = best.slope, offset = best.offset;
-    for (int k = -10; k <= 10; ++k) consider(offset + k * offset_step, slope, angle, end);
-    const double at = best.offset;
-    for (int k = -15; k <= 15; ++k) consider(at, slope + 0.01 * k, angle, end);
-    const double slope_now = best.slope;
-    for (int k = -15; k <= 15; ++k) consider(at, slope_now, angle, end + k * offset_step);
-    if (best.mismatch >= start.mismatch) break;
-  }
-  return best;
-}
-
 }  // namespace
 
 std::vector<EndFold> FoldEnds(const std::vector<ViewPage>& photos, const PinholeCamera& reference,
@@ -508,19 +287,6 @@ std::vector<EndFold> FoldEnds(const std::vector<ViewPage>& photos, const Pinhole
     if (best.hinge_line > 0) {
       const Flap flap = MakeFlap(*m, lines, best.hinge_line, reference);
       PlaceFlap(flap, lines, best.hinge_line, best.angle_deg * kPi / 180, best.length, &folded);
-      if (o.free_hinge) {
-        auto free = RefineFreeHinge(*m, lines, reference, views, total_area, best, o);
-        if (free && free->mismatch < best.mismatch_after) {
-          folded = std::move(free->meshes);
-          best.mismatch_after = free->mismatch;
-          best.angle_deg = free->angle_deg;
-          best.length = free->length;
-          best.hinge_slope = free->slope;
-          best.free_hinge = true;
-        }
-        const double free_gain = best.mismatch_before - best.mismatch_after;
-        best.kept = free_gain >= o.min_gain * best.mismatch_before && free_gain >= o.min_gain_area;
-      }
       best.points_lost = PointsLost(*m, folded, points, o.point_distance * isometry::ModelSize(*m));
       best.kept = best.kept && best.points_lost <= o.max_points_lost;
     }

@@ -45,9 +45,6 @@ struct EndFoldOptions {
   // from M: an end the points hold is not folded.
   double max_points_lost = 0.01;
   double point_distance = 0.02;
-  // Trial (off): the best grid line's fold is refined into a hinge anywhere
-  // across the end, its slope and the flap's end searched as well.
-  bool free_hinge = false;
 };
 
 // One end's best fold. `end`: 0 first row, 1 last row, 2 first column, 3
@@ -65,10 +62,6 @@ struct EndFold {
   // Points within reach of M before the fold and not after, net of those
   // the other way (fraction of the points).
   double points_lost = 0;
-  // Refined off the grid line: the hinge's slope against the end's
-  // direction in M' (0: square to the page's sides).
-  bool free_hinge = false;
-  double hinge_slope = 0;
   bool kept = false;
 };
 

@@ -89,9 +89,6 @@ void DeclareOptions(OptionTable& table, Options* o) {
                "fold an end of M up on a grid line where the other photos' page masks show it "
                "standing (--no-end-fold: leave the ends as the points and the reference outline "
                "give them)");
-  table.Switch("end-fold-free-hinge", &o->end_fold.free_hinge,
-               "trial (off by default): refine the end fold's hinge off the grid lines, its slope "
-               "and the flap's end by the masks");
   table.Value("end-fold-gain", &o->end_fold.min_gain, 0.0, 1.0,
               "keep a fold when it removes at least this fraction of the mismatch between M's "
               "silhouettes and the photos' page masks");
@@ -188,8 +185,6 @@ Json ResultToJson(const Inputs& in, const Result& r, const Options& o, const Jso
                      {"length", f.length},
                      {"mask_mismatch_before", f.mismatch_before},
                      {"mask_mismatch_after", f.mismatch_after},
-                     {"free_hinge", f.free_hinge},
-                     {"hinge_slope", f.hinge_slope},
                      {"kept", f.kept}});
   doc["end_folds"] = folds;
   doc["unfold"] = {{"method", "arap"}, {"iterations", r.unfold_iterations}};
