@@ -109,8 +109,7 @@ Flap MakeFlap(const MeshPair& m, const EndLines& lines, int h, const PinholeCame
     along += (m.mesh3d[hv] - m.mesh3d[before]).normalized();
     along2d += (m.mesh2d[hv] - m.mesh2d[before]).normalized();
     const Eigen::Vector3d end = m.mesh3d[size_t(lines.Vertex(0, j))];
-    f.rays.push_back(
-        (reference.R.transpose() * reference.CamRay(reference.Project(end))).normalized());
+    f.rays.push_back(reference.RayDirection(reference.Project(end)));
     f.ray_origin_offsets.push_back(m.mesh3d[hv] - centre);
     for (int i = 0; i < h; ++i)
       f.current_length +=
@@ -206,6 +205,10 @@ EndFold SearchEnd(const MeshPair& m, const EndLines& lines, const PinholeCamera&
     before += Mismatch(all, views[v].mask);
   }
   best.mismatch_before = best.mismatch_after = before / total_area;
+  // A trial overwrites only the flap's lines [0, h) of these, and h grows:
+  // one copy serves every hinge.
+  MeshPair trial = m;
+  std::vector<std::vector<std::optional<cv::Point2f>>> trial_pixels = pixels;
   for (int h = 1; h <= max_hinge; ++h) {
     const Flap flap = MakeFlap(m, lines, h, reference);
     std::vector<cv::Mat1b> base(views.size());
@@ -213,7 +216,6 @@ EndFold SearchEnd(const MeshPair& m, const EndLines& lines, const PinholeCamera&
       base[v] = cv::Mat1b::zeros(views[v].mask.size());
       FillLines(lines, h, lines.Lines() - 1, pixels[v], &base[v]);
     }
-    MeshPair trial = m;
     auto score = [&](double angle_deg, double* length) {
       const double angle = angle_deg * kPi / 180;
       *length = FlapLength(flap, angle);
@@ -221,7 +223,7 @@ EndFold SearchEnd(const MeshPair& m, const EndLines& lines, const PinholeCamera&
       PlaceFlap(flap, lines, h, angle, *length, &trial);
       double mismatch = 0;
       for (size_t v = 0; v < views.size(); ++v) {
-        std::vector<std::optional<cv::Point2f>> px = pixels[v];
+        std::vector<std::optional<cv::Point2f>>& px = trial_pixels[v];
         for (int i = 0; i < h; ++i)
           for (int j = 0; j < lines.Width(); ++j) {
             const size_t idx = size_t(lines.Vertex(i, j));
