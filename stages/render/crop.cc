@@ -227,6 +227,38 @@ CropRect ChooseCrop(std::array<SideFit, 4>* sides_in, const Eigen::Vector4d& vis
   return crop;
 }
 
+SideWarp WarpToSides(const std::array<SideFit, 4>& sides, const CropRect& crop, double max_slant) {
+  SideWarp warp;
+  warp.crop = crop;
+  warp.lines = sides;
+  const double cx = 0.5 * (crop.x0 + crop.x1), cy = 0.5 * (crop.y0 + crop.y1);
+  for (int i = 0; i < 4; ++i)
+    warp.active[i] = sides[i].used && std::abs(SlantOf(sides[i], i)) <= max_slant;
+  if (warp.active[0]) warp.crop.y0 = YAt(sides[0], cx);
+  if (warp.active[1]) warp.crop.x1 = XAt(sides[1], cy);
+  if (warp.active[2]) warp.crop.y1 = YAt(sides[2], cx);
+  if (warp.active[3]) warp.crop.x0 = XAt(sides[3], cy);
+  if (!(warp.crop.Width() > 0 && warp.crop.Height() > 0)) {
+    warp.active = {};
+    warp.crop = crop;
+    return warp;
+  }
+  for (const Eigen::Vector2d& corner :
+       {Eigen::Vector2d(warp.crop.x0, warp.crop.y0), Eigen::Vector2d(warp.crop.x1, warp.crop.y0),
+        Eigen::Vector2d(warp.crop.x0, warp.crop.y1), Eigen::Vector2d(warp.crop.x1, warp.crop.y1)})
+    warp.max_shift = std::max(warp.max_shift, (warp.Apply(corner) - corner).norm());
+  return warp;
+}
+
+Eigen::Vector2d SideWarp::Apply(const Eigen::Vector2d& p) const {
+  const double left = active[3] ? XAt(lines[3], p.y()) : crop.x0;
+  const double right = active[1] ? XAt(lines[1], p.y()) : crop.x1;
+  const double top = active[0] ? YAt(lines[0], p.x()) : crop.y0;
+  const double bottom = active[2] ? YAt(lines[2], p.x()) : crop.y1;
+  return {crop.x0 + (p.x() - left) / (right - left) * crop.Width(),
+          crop.y0 + (p.y() - top) / (bottom - top) * crop.Height()};
+}
+
 PageFormatFit ExtendToPageFormat(CropRect* crop, const std::array<bool, 4>& unseen, double aspect) {
   PageFormatFit fit;
   const bool x_unseen = unseen[1] || unseen[3], y_unseen = unseen[0] || unseen[2];

@@ -61,6 +61,25 @@ struct CropRect {
 // visible box.
 CropRect ChooseCrop(std::array<SideFit, 4>* sides, const Eigen::Vector4d& visible_box);
 
+// M' warped so that the used sides' lines become the crop's edges: where a
+// line runs off its axis (M' a little wrong near that edge), the page between
+// it and the opposite side is stretched or squeezed along that axis instead
+// of the crop being inscribed at the line's tighter end. Separable: x' moves
+// between the left and right lines at the point's y, y' between the top and
+// bottom lines at its x; a side not used keeps the crop's edge.
+struct SideWarp {
+  std::array<bool, 4> active{};
+  std::array<SideFit, 4> lines;
+  CropRect crop;         // the crop after the warp: each active line where it
+                         // crosses the middle of the other axis' extent
+  double max_shift = 0;  // largest move of a crop corner, M' units
+  Eigen::Vector2d Apply(const Eigen::Vector2d& p) const;
+};
+
+// The warp for the used sides within `max_slant` (radians) of their axes;
+// none active (the identity) when no side qualifies.
+SideWarp WarpToSides(const std::array<SideFit, 4>& sides, const CropRect& crop, double max_slant);
+
 // A page cut off where no photo sees its edge ends somewhere past the crop;
 // a paper format of long-to-short ratio `aspect` says where. Lengthens `crop`
 // across the sides flagged in `unseen` (0 top, 1 right, 2 bottom, 3 left) to

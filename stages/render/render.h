@@ -125,6 +125,11 @@ struct RenderOptions {
   // where M gets to the side, and the crop follows the farther of the line
   // and the reached edge (0: only sides too short to fit).
   double reach_partial_below = 0.6;
+  // Warp M' so that the used sides' lines within this many degrees of their
+  // axes become the crop's edges (SideWarp in crop.h): a side a little off
+  // its axis in M' is M' a little wrong there, and the page near it with it.
+  // 0: the crop is inscribed in the lines, at each line's tighter end.
+  double warp_max_slant_deg = 3;
   CutSideOptions cut_sides;
   // kRemove: divide out the light's shading (folds, curls, shadows) so the
   // paper comes out one even colour, as a scan (common/shading.h); kKeep:
@@ -212,10 +217,15 @@ struct RenderResult {
   std::string size_rule;                 // "reference-density", "width", "height", "dpi", "scale"
   bool capped = false;                   // the default size was reduced to max_pixels
   std::array<SideFit, 4> sides;
-  std::array<CutSideEdge, 4> cut_edges;         // the page edge past cut sides
-  std::array<CutSideEdge, 4> reached_sides;     // real sides past M's border
-  PageFormatFit page_format;                    // the crop lengthened past unseen cut sides
-  std::vector<ViewRegistration> registrations;  // of the views textured from
+  // The sides whose lines the crop's edges were warped onto (SideWarp), and
+  // the largest move of a crop corner (M' units).
+  std::array<bool, 4> warped_sides{};
+  double warp_max_shift = 0;
+  Eigen::Vector4d warp_box = Eigen::Vector4d::Zero();  // x0 y0 x1 y1 the lines went to
+  std::array<CutSideEdge, 4> cut_edges;                // the page edge past cut sides
+  std::array<CutSideEdge, 4> reached_sides;            // real sides past M's border
+  PageFormatFit page_format;                           // the crop lengthened past unseen cut sides
+  std::vector<ViewRegistration> registrations;         // of the views textured from
   cv::Vec3b fill;
   double page_fraction = 0;        // output pixels showing the page
   double hidden_fraction = 0;      // output pixels on M' but not seen

@@ -212,6 +212,24 @@ CropStep CropPage(const RenderOptions& options, const RenderInputs& in,
   if (options.reach_real_sides) step.self_view = ReachRealSides(options, in, flat, &visible, r);
   BoundScatteredSides(side_points, rotation, &visible, r);
   step.crop = ChooseCrop(&r->sides, visible);
+  if (options.warp_max_slant_deg > 0) {
+    const SideWarp warp = WarpToSides(r->sides, step.crop, options.warp_max_slant_deg * M_PI / 180);
+    if (std::any_of(warp.active.begin(), warp.active.end(), [](bool a) { return a; })) {
+      for (auto& q : flat) q = warp.Apply(q);
+      for (auto* edges : {&r->cut_edges, &r->reached_sides})
+        for (CutSideEdge& e : *edges)
+          for (auto& q : e.strip.flat) q = warp.Apply(q);
+      r->warped_sides = warp.active;
+      r->warp_max_shift = warp.max_shift;
+      r->warp_box = {warp.crop.x0, warp.crop.y0, warp.crop.x1, warp.crop.y1};
+      Log("page warped so that the sides' lines are the crop's edges (its corners moved by up to " +
+          Fixed(100 * warp.max_shift / std::hypot(warp.crop.Width(), warp.crop.Height()), 2) +
+          " % of the diagonal)");
+      const std::string rule = step.crop.rule;
+      step.crop = warp.crop;
+      step.crop.rule = rule;
+    }
+  }
   for (int i = 0; i < 4; ++i)
     if (r->sides[i].real && !r->sides[i].used && !r->reached_sides[i].measured)
       Log(std::string(kSideNames[i]) + " side not used for the crop: " + r->sides[i].note);

@@ -91,11 +91,10 @@ Json RenderReport(const RenderOptions& options, const RenderInputs& in, const Re
   doc["capped"] = r.capped;
   doc["rotation_deg"] = r.rotation_deg;
   doc["deskew_source"] = r.deskew_source;
-  doc["crop"] = {{"x0", r.crop_x0},
-                 {"y0", r.crop_y0},
-                 {"x1", r.crop_x1},
-                 {"y1", r.crop_y1},
-                 {"rule", r.crop_rule}};
+  doc["crop"] = {{"x0", r.crop_x0}, {"y0", r.crop_y0},     {"x1", r.crop_x1},
+                 {"y1", r.crop_y1}, {"rule", r.crop_rule}, {"warp_max_shift", r.warp_max_shift}};
+  if (r.warp_max_shift > 0)
+    doc["crop"]["warp_box"] = {r.warp_box[0], r.warp_box[1], r.warp_box[2], r.warp_box[3]};
   Json sides = Json::object();
   for (int i = 0; i < 4; ++i) {
     const SideFit& s = r.sides[i];
@@ -104,6 +103,7 @@ Json RenderReport(const RenderOptions& options, const RenderInputs& in, const Re
       j["point"] = Vec2(s.point);
       j["direction"] = Vec2(s.direction);
       j["rms"] = s.rms;
+      j["warped"] = r.warped_sides[i];
     }
     if (!s.note.empty()) j["note"] = s.note;
     if (s.scattered) j["median_bound"] = s.median_bound;

@@ -100,6 +100,9 @@ void DeclareOptions(OptionTable& table, RenderOptions* o) {
               "also reach a real side of which fewer than this fraction of the samples map onto M "
               "(they are only where M gets to it), and crop at the farther of its line and the "
               "reached edge (0 = only sides too short to fit)");
+  table.Value("warp-max-slant-deg", &o->warp_max_slant_deg, 0.0, 45.0,
+              "warp the page so that the boundary sides' lines in M' within this many degrees of "
+              "their axes become the crop's edges (0: inscribe the crop in the lines)");
   table.Switch("extend-cut-sides", &o->extend_cut_sides,
                "where the reference image cuts the page off, look for the page edge past it in the "
                "other views' page masks (<boundary>/views/*/mask.png) and extend the crop to it; "

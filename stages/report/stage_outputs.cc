@@ -1,11 +1,13 @@
 #include "stages/report/stage_outputs.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <map>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 #include <vector>
 
 #include "common/cli.h"
@@ -37,11 +39,38 @@ cv::Mat DrawFeatureLines(const cv::Mat& rectified, const Json& render, const Jso
   // Size before the quarter turns.
   const int w = turns % 2 ? rectified.rows : rectified.cols;
   const int h = turns % 2 ? rectified.cols : rectified.rows;
+  // The box the warp put the sides' lines on (render.json's schema).
+  const Json box = render["crop"].value("warp_box", Json::array());
+  const bool has_box = box.is_array() && box.size() == 4;
+  const double wx0 = has_box ? box[0].get<double>() : 0, wy0 = has_box ? box[1].get<double>() : 0;
+  const double wx1 = has_box ? box[2].get<double>() : 1, wy1 = has_box ? box[3].get<double>() : 1;
+  // The sides' lines render warped the page onto (render.json's schema):
+  // point and direction, or none.
+  std::array<std::optional<std::array<double, 4>>, 4> warped;  // top right bottom left
+  const char* names[4] = {"top", "right", "bottom", "left"};
+  for (int i = 0; i < 4; ++i) {
+    const Json side = render.value("/sides"_json_pointer, Json::object()).value(names[i], Json());
+    if (has_box && side.is_object() && side.value("warped", false) && side.contains("point") &&
+        side.contains("direction"))
+      warped[i] = std::array<double, 4>{
+          side["point"][0].get<double>(), side["point"][1].get<double>(),
+          side["direction"][0].get<double>(), side["direction"][1].get<double>()};
+  }
+  auto across = [&](int i, double along, double otherwise) {
+    if (!warped[i]) return otherwise;
+    const auto& [px, py, dx, dy] = *warped[i];
+    return i % 2 == 0 ? py + (along - px) * dy / dx : px + (along - py) * dx / dy;
+  };
   const double c = std::cos(angle), sn = std::sin(angle);
   auto to_px = [&](const Json& p) {
     const double fx = p[0].get<double>(), fy = p[1].get<double>();
-    const double u = (c * fx - sn * fy - x0) * scale - 0.5;
-    const double v = (sn * fx + c * fy - y0) * scale - 0.5;
+    const double tx = c * fx - sn * fy, ty = sn * fx + c * fy;
+    const double left = across(3, ty, wx0), right = across(1, ty, wx1);
+    const double top = across(0, tx, wy0), bottom = across(2, tx, wy1);
+    const double wx = wx0 + (tx - left) / (right - left) * (wx1 - wx0);
+    const double wy = wy0 + (ty - top) / (bottom - top) * (wy1 - wy0);
+    const double u = (wx - x0) * scale - 0.5;
+    const double v = (wy - y0) * scale - 0.5;
     switch (turns) {  // as cv::rotate turns the image clockwise
       case 1:
         return cv::Point2d(h - 1 - v, u);

@@ -445,11 +445,19 @@ TEST(RenderScene, TiltedFlatMeshIsTurnedUpright) {
   EXPECT_NEAR(r.crop_y1 - r.crop_y0, s.page_h, 2 / r.pixels_per_unit);
   render::RenderOptions keep;
   keep.deskew = false;
+  keep.warp_max_slant_deg = 0;
   const render::RenderResult tilted = render::Run(keep, InputsOf(s));
   EXPECT_EQ(tilted.rotation_deg, 0);
   // Inscribed in the tilted page: smaller on both axes.
   EXPECT_LT(tilted.crop_x1 - tilted.crop_x0, s.page_w * 0.97);
   EXPECT_LT(tilted.crop_y1 - tilted.crop_y0, s.page_h * 0.97);
+  // Warped onto the tilted sides' lines instead: the whole page, sheared.
+  keep.warp_max_slant_deg = 5;
+  const render::RenderResult warped = render::Run(keep, InputsOf(s));
+  for (int i = 0; i < 4; ++i) EXPECT_TRUE(warped.warped_sides[i]) << i;
+  EXPECT_NEAR(warped.crop_x1 - warped.crop_x0, s.page_w, 0.01 * s.page_w);
+  EXPECT_NEAR(warped.crop_y1 - warped.crop_y0, s.page_h, 0.01 * s.page_h);
+  EXPECT_GT(warped.page_fraction, 0.99);
 }
 
 TEST(RenderInputs, InconsistentInputsAreRejected) {
@@ -557,6 +565,49 @@ TEST(RenderCrop, SlantedSidesBoundTheCropInscribed) {
   EXPECT_NEAR(crop.y1, 1, 1e-9);
   auto steep = sides_with_right_slant(5);
   EXPECT_NEAR(render::ChooseCrop(&steep, box).x1, 1 - 0.5 * std::tan(5 * M_PI / 180), 1e-9);
+}
+
+TEST(RenderCrop, WarpTakesSlantedSidesToTheCropEdges) {
+  // Unit square whose right side runs from (1.02, 0) to (0.98, 1) and whose
+  // bottom side from (0, 1) to (1, 1.03); top and left are on their axes.
+  std::vector<Eigen::Vector2d> top, bottom, left, right;
+  for (int i = 0; i <= 100; ++i) {
+    const double u = i * 0.01;
+    top.emplace_back(u, 0);
+    bottom.emplace_back(u, 1 + 0.03 * u);
+    left.emplace_back(0, u);
+    right.emplace_back(1.02 - 0.04 * u, u);
+  }
+  std::array<render::SideFit, 4> sides;
+  sides[0] = render::FitSideLine(0, true, top, 101);
+  sides[1] = render::FitSideLine(1, true, right, 101);
+  sides[2] = render::FitSideLine(2, true, bottom, 101);
+  sides[3] = render::FitSideLine(3, true, left, 101);
+  const render::CropRect inscribed = render::ChooseCrop(&sides, Eigen::Vector4d(-1, -1, 2, 2));
+  const render::SideWarp warp = render::WarpToSides(sides, inscribed, 5 * M_PI / 180);
+  ASSERT_TRUE(warp.active[0] && warp.active[1] && warp.active[2] && warp.active[3]);
+  // The crop's edges are the lines where they cross the middle of the crop.
+  EXPECT_NEAR(warp.crop.x1, 1.0, 1e-3);
+  EXPECT_NEAR(warp.crop.y1, 1.015, 1e-3);
+  // Every sample of a side lands on its crop edge; the middle of the page
+  // moves by half the lines' run at most.
+  for (int i = 0; i <= 100; i += 10) {
+    EXPECT_NEAR(warp.Apply(right[i]).x(), warp.crop.x1, 1e-9);
+    EXPECT_NEAR(warp.Apply(bottom[i]).y(), warp.crop.y1, 1e-9);
+    EXPECT_NEAR(warp.Apply(left[i]).x(), warp.crop.x0, 1e-9);
+    EXPECT_NEAR(warp.Apply(top[i]).y(), warp.crop.y0, 1e-9);
+  }
+  EXPECT_LT((warp.Apply({0.5, 0.5}) - Eigen::Vector2d(0.5, 0.5)).norm(), 0.011);
+  EXPECT_NEAR(warp.max_shift, std::hypot(0.02, 0.015), 1e-3);  // the bottom-right corner
+  // A side past the slant limit stays inscribed (its edge not warped).
+  const render::SideWarp some = render::WarpToSides(sides, inscribed, 2 * M_PI / 180);
+  EXPECT_FALSE(some.active[1]);  // 2.3 degrees
+  EXPECT_TRUE(some.active[2]);   // 1.7 degrees
+  EXPECT_NEAR(some.crop.x1, inscribed.x1, 1e-12);
+  EXPECT_NEAR(some.Apply({inscribed.x1, 0.3}).x(), inscribed.x1, 1e-12);
+  // No side used: the identity.
+  const render::SideWarp none = render::WarpToSides({}, inscribed, 5 * M_PI / 180);
+  EXPECT_EQ((none.Apply({0.3, 0.7}) - Eigen::Vector2d(0.3, 0.7)).norm(), 0);
 }
 
 // The columns of a scene's grid that the reference view sees whole: M and M'
