@@ -23,6 +23,25 @@ TEST(DrawFeatureLines, DrawsOptimizesLines) {
   EXPECT_EQ(LinesNote(lines), "Feature lines straightened in M': 1 text (50_optimize/lines.json).");
 }
 
+// render warped M' so that its slanted right side is the crop's edge: a line
+// along that side is drawn along the image's edge column, not slanted.
+TEST(DrawFeatureLines, FollowsRendersWarpOntoTheSides) {
+  const cv::Mat rectified(48, 64, CV_8UC3, cv::Scalar(255, 255, 255));
+  const Json render = Json::parse(R"({
+    "inputs": {"meshes": "work/set01/50_optimize"}, "rotation_deg": 0, "pixels_per_unit": 60,
+    "crop": {"x0": 0, "y0": 0, "warp_box": [0, 0, 1, 0.8]},
+    "sides": {"right": {"warped": true, "point": [1.05, 0.4], "direction": [-0.05, 1]}}})");
+  // On the right side's line: x = 1.065 at y = 0.1, 1.035 at y = 0.7.
+  const Json lines =
+      Json::parse(R"({"lines": [{"kind": "edge", "flat": [[1.065, 0.1], [1.035, 0.7]]}]})");
+  const cv::Mat out = DrawFeatureLines(rectified, render, lines);
+  auto drawn_in_column = [&](int col) {
+    return cv::norm(out.col(col), rectified.col(col), cv::NORM_L1) > 0;
+  };
+  EXPECT_TRUE(drawn_in_column(59) || drawn_in_column(60));
+  EXPECT_FALSE(drawn_in_column(63));  // where the line's top end is without the warp
+}
+
 // The fuzzer's input (fuzz/lines_fuzzer.cc): a point of a line that is not
 // [x, y] was read past the end of its array.
 TEST(DrawFeatureLines, RejectsAPointThatIsNotXY) {
