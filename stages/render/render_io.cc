@@ -1,5 +1,6 @@
 // Reading render's inputs, render.json, and writing the outputs (all or
 // nothing).
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <opencv2/imgcodecs.hpp>
@@ -93,7 +94,8 @@ Json RenderReport(const RenderOptions& options, const RenderInputs& in, const Re
   doc["deskew_source"] = r.deskew_source;
   doc["crop"] = {{"x0", r.crop_x0}, {"y0", r.crop_y0},     {"x1", r.crop_x1},
                  {"y1", r.crop_y1}, {"rule", r.crop_rule}, {"warp_max_shift", r.warp_max_shift}};
-  if (r.warp_max_shift > 0)
+  const auto& w = r.warped_sides;
+  if (std::find(w.begin(), w.end(), true) != w.end())
     doc["crop"]["warp_box"] = {r.warp_box[0], r.warp_box[1], r.warp_box[2], r.warp_box[3]};
   Json sides = Json::object();
   for (int i = 0; i < 4; ++i) {

@@ -48,8 +48,9 @@ cv::Mat DrawFeatureLines(const cv::Mat& rectified, const Json& render, const Jso
   // point and direction, or none.
   std::array<std::optional<std::array<double, 4>>, 4> warped;  // top right bottom left
   const char* names[4] = {"top", "right", "bottom", "left"};
+  const Json sides = render.value("/sides"_json_pointer, Json::object());
   for (int i = 0; i < 4; ++i) {
-    const Json side = render.value("/sides"_json_pointer, Json::object()).value(names[i], Json());
+    const Json side = sides.is_object() ? sides.value(names[i], Json()) : Json();
     if (has_box && side.is_object() && side.value("warped", false) && side.contains("point") &&
         side.contains("direction"))
       warped[i] = std::array<double, 4>{
