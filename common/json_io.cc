@@ -5,8 +5,8 @@
 #include <sstream>
 
 #include "common/atomic_file.h"
-#include "common/cli.h"
 #include "common/errors.h"
+#include "common/program.h"
 
 namespace docunfold {
 

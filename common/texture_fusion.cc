@@ -7,7 +7,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/imgproc/detail/gcgraph.hpp>
 
-#include "common/cli.h"
+#include "common/program.h"
 #include "common/statistics.h"
 #include "common/texture_fusion_internal.h"
 #include "common/texture_sampler.h"

@@ -51,7 +51,7 @@
 
 #include "common/grid_mesh.h"
 #include "common/json_io.h"
-#include "common/option_table.h"
+#include "common/option_table_fwd.h"
 
 namespace docunfold::isometry {
 

@@ -1,5 +1,6 @@
 // The solver's flags, declared once for every stage that runs it.
 #include "common/isometry/isometry.h"
+#include "common/option_table.h"
 
 namespace docunfold::isometry {
 

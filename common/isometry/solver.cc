@@ -11,11 +11,11 @@
 #include <omp.h>
 #endif
 
-#include "common/cli.h"
 #include "common/cpu_share.h"
 #include "common/isometry/gauss_newton.h"
 #include "common/isometry/isometry.h"
 #include "common/isometry/solver_internal.h"
+#include "common/program.h"
 
 namespace docunfold::isometry {
 

@@ -9,11 +9,12 @@
 #include <vector>
 
 #include "common/atomic_file.h"
-#include "common/cli.h"
 #include "common/dataset.h"
 #include "common/errors.h"
 #include "common/json_io.h"
+#include "common/option_table.h"
 #include "common/photo.h"
+#include "common/program.h"
 #include "common/raster.h"
 #include "common/shading.h"
 #include "common/statistics.h"

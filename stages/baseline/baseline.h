@@ -20,7 +20,7 @@
 #include <vector>
 
 #include "common/camera.h"
-#include "common/option_table.h"
+#include "common/option_table_fwd.h"
 #include "common/ply.h"
 #include "common/texture_fusion.h"
 

@@ -8,8 +8,9 @@
 #include <opencv2/core/eigen.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "common/cli.h"
 #include "common/errors.h"
+#include "common/option_table.h"
+#include "common/program.h"
 #include "stages/densify/densify_internal.h"
 
 namespace docunfold::densify {

@@ -34,7 +34,7 @@
 
 #include "common/camera.h"
 #include "common/json_io.h"
-#include "common/option_table.h"
+#include "common/option_table_fwd.h"
 #include "common/page_files.h"
 #include "common/ply.h"
 #include "common/point_source.h"

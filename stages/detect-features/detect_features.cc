@@ -5,8 +5,9 @@
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 
-#include "common/cli.h"
 #include "common/errors.h"
+#include "common/option_table.h"
+#include "common/program.h"
 #include "stages/detect-features/feature_parts.h"
 
 namespace docunfold::features {

@@ -21,7 +21,7 @@
 #include <vector>
 
 #include "common/json_io.h"
-#include "common/option_table.h"
+#include "common/option_table_fwd.h"
 
 namespace docunfold::features {
 

@@ -6,7 +6,7 @@
 #include <map>
 #include <opencv2/imgproc.hpp>
 
-#include "common/cli.h"
+#include "common/program.h"
 #include "stages/detect-features/feature_parts.h"
 
 namespace docunfold::features::detail {

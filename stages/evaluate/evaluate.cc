@@ -9,10 +9,11 @@
 
 #include "common/atomic_file.h"
 #include "common/camera.h"
-#include "common/cli.h"
 #include "common/dataset.h"
 #include "common/errors.h"
+#include "common/option_table.h"
 #include "common/ply.h"
+#include "common/program.h"
 #include "common/raster.h"
 #include "stages/evaluate/geometry_metrics.h"
 #include "stages/evaluate/image_metrics.h"

@@ -10,7 +10,7 @@
 #include <string>
 
 #include "common/json_io.h"
-#include "common/option_table.h"
+#include "common/option_table_fwd.h"
 
 namespace docunfold::evaluate {
 

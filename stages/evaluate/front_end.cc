@@ -9,8 +9,8 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "common/cli.h"
 #include "common/errors.h"
+#include "common/program.h"
 
 namespace docunfold::evaluate {
 namespace {

@@ -7,8 +7,8 @@
 #include <utility>
 #include <vector>
 
-#include "common/cli.h"
 #include "common/errors.h"
+#include "common/program.h"
 #include "stages/init-mesh/init_mesh_internal.h"
 
 namespace docunfold::init_mesh {

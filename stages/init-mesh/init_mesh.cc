@@ -7,7 +7,6 @@
 #include <string>
 #include <vector>
 
-#include "common/cli.h"
 #include "common/depth_field.h"
 #include "common/errors.h"
 #include "common/isometry/mesh_index.h"
@@ -15,6 +14,7 @@
 #include "common/isometry/unfold.h"
 #include "common/page_files.h"
 #include "common/point_index.h"
+#include "common/program.h"
 #include "common/statistics.h"
 #include "stages/init-mesh/init_mesh_internal.h"
 

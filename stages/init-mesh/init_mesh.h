@@ -31,7 +31,7 @@
 #include "common/grid_mesh.h"
 #include "common/isometry/isometry.h"
 #include "common/json_io.h"
-#include "common/option_table.h"
+#include "common/option_table_fwd.h"
 #include "common/page_files.h"
 #include "common/point_source.h"
 #include "stages/init-mesh/end_fold.h"

@@ -9,10 +9,11 @@
 #include <vector>
 
 #include "common/atomic_file.h"
-#include "common/cli.h"
 #include "common/errors.h"
+#include "common/option_table.h"
 #include "common/page_files.h"
 #include "common/ply.h"
+#include "common/program.h"
 #include "stages/init-mesh/init_mesh.h"
 
 namespace docunfold::init_mesh {

@@ -6,9 +6,9 @@
 #include <cstdio>
 
 #include "common/axis_direction.h"
-#include "common/cli.h"
 #include "common/errors.h"
 #include "common/isometry/subdivision.h"
+#include "common/program.h"
 
 namespace docunfold::optimize {
 namespace {

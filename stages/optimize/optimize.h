@@ -13,7 +13,7 @@
 #include "common/camera.h"
 #include "common/grid_mesh.h"
 #include "common/isometry/isometry.h"
-#include "common/option_table.h"
+#include "common/option_table_fwd.h"
 #include "common/page_files.h"
 #include "stages/optimize/feature_lines.h"
 

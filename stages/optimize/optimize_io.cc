@@ -7,6 +7,7 @@
 #include "common/atomic_file.h"
 #include "common/errors.h"
 #include "common/gltf.h"
+#include "common/option_table.h"
 #include "common/ply.h"
 
 namespace docunfold::optimize {

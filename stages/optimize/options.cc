@@ -1,5 +1,6 @@
 // optimize's flags: the solver's, declared once for every stage that runs it
 // (isometry::DeclareSolveOptions), and optimize's own.
+#include "common/option_table.h"
 #include "stages/optimize/optimize.h"
 
 namespace docunfold::optimize {

@@ -10,9 +10,10 @@
 #include <sstream>
 
 #include "common/atomic_file.h"
-#include "common/cli.h"
 #include "common/errors.h"
 #include "common/markup.h"
+#include "common/option_table.h"
+#include "common/program.h"
 #include "common/shading.h"
 #include "stages/pdf/markup_scale.h"
 #include "stages/pdf/pdf_file.h"

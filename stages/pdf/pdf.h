@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "common/json_io.h"
-#include "common/option_table.h"
+#include "common/option_table_fwd.h"
 #include "stages/pdf/page_reader.h"
 #include "stages/pdf/page_size.h"
 #include "stages/pdf/text_size.h"

@@ -11,8 +11,8 @@
 #include <opencv2/imgproc.hpp>
 #include <optional>
 
-#include "common/cli.h"
 #include "common/errors.h"
+#include "common/program.h"
 #include "common/raster.h"
 #include "stages/render/orientation.h"
 #include "stages/render/render_internal.h"

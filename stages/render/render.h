@@ -19,7 +19,7 @@
 #include "common/camera.h"
 #include "common/grid_mesh.h"
 #include "common/json_io.h"
-#include "common/option_table.h"
+#include "common/option_table_fwd.h"
 #include "common/page_files.h"
 #include "common/shading.h"
 #include "common/texture_fusion.h"

@@ -6,8 +6,8 @@
 #include <cmath>
 #include <cstdio>
 
-#include "common/cli.h"
 #include "common/errors.h"
+#include "common/program.h"
 #include "common/statistics.h"
 #include "stages/render/render_internal.h"
 

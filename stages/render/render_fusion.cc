@@ -2,7 +2,6 @@
 // common/texture_fusion.h with the reference photo and the other views'.
 #include <opencv2/imgproc.hpp>
 
-#include "common/cli.h"
 #include "stages/render/render_internal.h"
 
 namespace docunfold::render {

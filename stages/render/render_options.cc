@@ -2,6 +2,7 @@
 #include <exception>
 #include <string>
 
+#include "common/option_table.h"
 #include "stages/render/render.h"
 
 namespace docunfold::render {

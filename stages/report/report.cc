@@ -11,13 +11,14 @@
 #include <sstream>
 
 #include "common/camera.h"
-#include "common/cli.h"
 #include "common/dataset.h"
 #include "common/errors.h"
 #include "common/grid_mesh.h"
 #include "common/json_io.h"
+#include "common/option_table.h"
 #include "common/photo.h"
 #include "common/ply.h"
+#include "common/program.h"
 #include "common/texture_fusion.h"
 #include "stages/report/html.h"
 #include "stages/report/mesh_views.h"

@@ -6,7 +6,7 @@
 #include <filesystem>
 #include <string>
 
-#include "common/option_table.h"
+#include "common/option_table_fwd.h"
 
 namespace docunfold::report {
 

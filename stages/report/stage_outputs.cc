@@ -10,8 +10,8 @@
 #include <optional>
 #include <vector>
 
-#include "common/cli.h"
 #include "common/errors.h"
+#include "common/program.h"
 #include "stages/report/html.h"
 
 namespace docunfold::report {

@@ -5,8 +5,8 @@
 
 #include "common/atomic_file.h"
 #include "common/camera.h"
-#include "common/cli.h"
 #include "common/errors.h"
+#include "common/program.h"
 #include "stages/segment-boundary/segment_boundary.h"
 
 namespace docunfold::boundary {

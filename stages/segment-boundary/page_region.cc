@@ -5,9 +5,9 @@
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 
-#include "common/cli.h"
 #include "common/errors.h"
 #include "common/image_sampling.h"
+#include "common/program.h"
 #include "stages/segment-boundary/boundary_internal.h"
 
 namespace docunfold::boundary::internal {

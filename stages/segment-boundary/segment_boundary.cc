@@ -4,8 +4,9 @@
 #include <chrono>
 #include <cmath>
 
-#include "common/cli.h"
 #include "common/errors.h"
+#include "common/option_table.h"
+#include "common/program.h"
 #include "stages/segment-boundary/boundary_internal.h"
 #include "stages/segment-boundary/text_orientation.h"
 

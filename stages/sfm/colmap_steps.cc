@@ -8,8 +8,8 @@
 #include <regex>
 
 #include "common/atomic_file.h"
-#include "common/cli.h"
 #include "common/errors.h"
+#include "common/program.h"
 #include "stages/sfm/matching.h"
 #include "stages/sfm/sfm_internal.h"
 

@@ -8,9 +8,9 @@
 #include <tuple>
 
 #include "common/atomic_file.h"
-#include "common/cli.h"
 #include "common/dataset.h"
 #include "common/errors.h"
+#include "common/program.h"
 
 namespace docunfold::sfm {
 

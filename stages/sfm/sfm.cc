@@ -11,11 +11,12 @@
 #include <set>
 
 #include "common/atomic_file.h"
-#include "common/cli.h"
 #include "common/dataset.h"
 #include "common/errors.h"
+#include "common/option_table.h"
 #include "common/photo.h"
 #include "common/ply.h"
+#include "common/program.h"
 #include "common/statistics.h"
 #include "stages/sfm/sfm_internal.h"
 

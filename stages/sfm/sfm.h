@@ -27,7 +27,7 @@
 
 #include "common/camera.h"
 #include "common/json_io.h"
-#include "common/option_table.h"
+#include "common/option_table_fwd.h"
 #include "stages/sfm/photo_set.h"
 #include "stages/sfm/reference_view.h"
 

@@ -11,9 +11,10 @@
 #include <utility>
 
 #include "common/atomic_file.h"
-#include "common/cli.h"
 #include "common/errors.h"
+#include "common/option_table.h"
 #include "common/ply.h"
+#include "common/program.h"
 
 namespace docunfold::synth {
 namespace {

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "common/json_io.h"
-#include "common/option_table.h"
+#include "common/option_table_fwd.h"
 #include "stages/synth/folds.h"
 #include "stages/synth/page.h"
 #include "stages/synth/scene.h"

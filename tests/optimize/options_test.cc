@@ -2,6 +2,7 @@
 // that parse into it.
 #include <gtest/gtest.h>
 
+#include "common/option_table.h"
 #include "stages/optimize/optimize.h"
 
 namespace docunfold::optimize {

@@ -23,6 +23,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "common/json_io.h"
+#include "common/option_table.h"
 #include "stages/sfm/sfm.h"
 #include "stages/sfm/subprocess.h"
 #include "tests/sfm/sfm_eval.h"
