@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -458,6 +459,21 @@ TEST(RenderScene, TiltedFlatMeshIsTurnedUpright) {
   EXPECT_NEAR(warped.crop_x1 - warped.crop_x0, s.page_w, 0.01 * s.page_w);
   EXPECT_NEAR(warped.crop_y1 - warped.crop_y0, s.page_h, 0.01 * s.page_h);
   EXPECT_GT(warped.page_fraction, 0.99);
+}
+
+TEST(RenderScene, ReportGivesTheWarpBoxWheneverASideIsWarped) {
+  const SyntheticScene s = MakeScene({});
+  const render::RenderInputs in = InputsOf(s);
+  render::RenderResult r = render::Run({}, in);
+  ASSERT_TRUE(std::count(r.warped_sides.begin(), r.warped_sides.end(), true) > 0);
+  auto has_box = [&] {
+    return render::RenderReport({}, in, r, Json::object())["crop"].contains("warp_box");
+  };
+  EXPECT_TRUE(has_box());
+  r.warp_max_shift = 0;  // a warp that moves no corner still maps through the box
+  EXPECT_TRUE(has_box());
+  r.warped_sides = {};
+  EXPECT_FALSE(has_box());
 }
 
 TEST(RenderInputs, InconsistentInputsAreRejected) {
