@@ -14,7 +14,13 @@ namespace docunfold {
 void LimitOpenMpThreads(char** argv) {
   if (std::getenv("OMP_THREAD_LIMIT") != nullptr) return;
   ::setenv("OMP_THREAD_LIMIT", "1", 1);
-  ::execv("/proc/self/exe", argv);  // returns only on failure: run as we are
+  // The program's own path, not /proc/self/exe: the process would be named
+  // "exe" (in ps and top, and to pgrep and killall).
+  char path[4096];
+  const ssize_t n = ::readlink("/proc/self/exe", path, sizeof path - 1);
+  if (n <= 0) return;
+  path[n] = '\0';
+  ::execv(path, argv);  // returns only on failure: run as we are
 }
 
 namespace {
