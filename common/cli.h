@@ -15,7 +15,8 @@ namespace docunfold {
 // it throws to an exit code, printing exactly one line
 // "<program>: <kind>: <message>" to stderr. CLI11 parse errors become exit 2
 // (or 0 for --help / --version). `--help-markdown` prints the options' table
-// for docs/stages/ instead.
+// for docs/stages/ instead. Before `body`, malloc is set to keep the memory
+// the stage frees, instead of giving it back to the kernel (cli.cc).
 int RunStage(const std::string& program, OptionTable& options, int argc, char** argv,
              const std::function<void()>& body);
 
