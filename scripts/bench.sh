@@ -42,6 +42,7 @@
 # and, when the binaries exist, docunfold-reference (render --texture
 # reference), docunfold-init (render on 40_init), docunfold-nofeatures and
 # docunfold-boundary (optimize --no-feature-lines / --boundary-only, then render),
+# docunfold-from-truth (optimize started from the true surface, then render),
 # and docunfold-deshaded and oracle-deshaded (render / baseline --shading
 # remove: the light's shading divided out of the final meshes' rendering and
 # of the oracle alike).
@@ -237,25 +238,42 @@ make_row_docunfold-init() {
 points_args() {
   if [[ -f $work/25_points/points.ply ]]; then echo --points "$work/25_points/points.ply"; fi
 }
-optimize_variant() {  # optimize_variant <row> <suffix> <optimize flag>
-  local row=$1 suffix=$2 flag=$3
+optimize_variant() {  # optimize_variant <row> <suffix> <init dir> [optimize flag...]
+  local row=$1 suffix=$2 init=$3
+  shift 3
   { have optimize && have render; } || { reason="no optimize or render binary"; return 1; }
-  [[ -f $work/40_init/mesh3d.ply && -f $work/30_features/features.json ]] ||
-    { reason="no 40_init/ or 30_features/"; return 1; }
+  [[ -f $init/mesh3d.ply && -f $work/30_features/features.json ]] ||
+    { reason="no $(basename "$init")/ or 30_features/"; return 1; }
   mesh_dir=$work/50_optimize_$suffix
   timed "$row" "$bin/optimize" --sfm "$work/10_sfm" --boundary "$work/20_boundary" \
-    --features "$work/30_features/features.json" --init "$work/40_init" \
-    $(points_args) --out "$mesh_dir" "$flag" || return
+    --features "$work/30_features/features.json" --init "$init" \
+    $(points_args) --out "$mesh_dir" "$@" || return
   timed "$row" "$bin/render" --sfm "$work/10_sfm" --boundary "$work/20_boundary" \
     --meshes "$mesh_dir" --out "$work/60_render_$suffix" --images "$data/images" \
     --features "$work/30_features/features.json" || return
   image=$work/60_render_$suffix/rectified.png
 }
-make_row_docunfold-nofeatures() { optimize_variant docunfold-nofeatures nofeatures --no-feature-lines; }
-make_row_docunfold-boundary() { optimize_variant docunfold-boundary boundary --boundary-only; }
+make_row_docunfold-nofeatures() {
+  optimize_variant docunfold-nofeatures nofeatures "$work/40_init" --no-feature-lines
+}
+make_row_docunfold-boundary() {
+  optimize_variant docunfold-boundary boundary "$work/40_init" --boundary-only
+}
+# Optimize started from the true surface instead of init-mesh's meshes (the
+# truth on init-mesh's grid, taken into sfm's frame by build/tests/truth-init):
+# what optimize itself loses, apart from what init-mesh and the points lose.
+make_row_docunfold-from-truth() {
+  [[ -x $BUILD/tests/truth-init ]] || { reason="no $BUILD/tests/truth-init"; return 1; }
+  [[ -f $data/ground_truth/mesh.ply ]] || { reason="no ground_truth/mesh.ply"; return 1; }
+  [[ -f $work/40_init/mesh3d.ply ]] || { reason="no 40_init/mesh3d.ply"; return 1; }
+  timed docunfold-from-truth "$BUILD/tests/truth-init" "$data" "$work" "$work/40_init_truth" ||
+    { reason="truth-init failed: $(tail -n 1 "$work/bench/docunfold-from-truth.log")"; return 1; }
+  optimize_variant docunfold-from-truth truth "$work/40_init_truth"
+}
 
 ROWS=(homography oracle oracle-seen oracle-multiview docunfold docunfold-reference docunfold-init
-      docunfold-nofeatures docunfold-boundary oracle-deshaded docunfold-deshaded)
+      docunfold-nofeatures docunfold-boundary docunfold-from-truth oracle-deshaded
+      docunfold-deshaded)
 if [[ -n ${BENCH_ONLY:-} ]]; then read -r -a ROWS <<< "$BENCH_ONLY"; fi
 read -r -a extra_rows <<< "${BENCH_ROWS:-}"
 

@@ -31,7 +31,8 @@ FIGURES = [("ms_ssim", "MS-SSIM ↑", "%.4f"), ("ld", "LD ↓", "%.2f"), ("li_d"
            ("isometry_mean", "isometry ↓", "%.4f")]
 ROW_ORDER = ["homography", "oracle", "oracle-seen", "oracle-multiview", "docunfold",
              "docunfold-reference", "docunfold-init", "docunfold-nofeatures",
-             "docunfold-boundary", "oracle-deshaded", "docunfold-deshaded"]
+             "docunfold-boundary", "docunfold-from-truth", "oracle-deshaded",
+             "docunfold-deshaded"]
 
 
 def read_jsonl(path):
@@ -329,7 +330,9 @@ def markdown(result):
               "cameras by render's texture fusion, cropped like `oracle-seen` (the ceiling for "
               "texturing from all the photos); `docunfold` = 60_render/rectified.png (texture fusion); "
               "`docunfold-reference` = the same meshes textured from the reference photo alone "
-              "(render `--texture reference`, the paper's way); `-deshaded` = "
+              "(render `--texture reference`, the paper's way); `docunfold-from-truth` = optimize "
+              "started from the true surface on init-mesh's grid in sfm's frame, then render "
+              "(what optimize itself loses); `-deshaded` = "
               "the same with the light's shading divided out (render/baseline `--shading "
               "remove`): compare `docunfold-deshaded` with `oracle-deshaded`, not with "
               "`oracle`." % (
