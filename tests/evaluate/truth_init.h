@@ -12,13 +12,19 @@
 
 namespace docunfold::testing {
 
-// M: the true surface at the grid's vertices, (s, t) = (col / (nx - 1),
-// row / (ny - 1)) of flat.png, taken into `sfm_cameras`' frame by the
-// similarity of the camera centres (evaluate's alignment, the inverse way).
-// M': its exact flattening, the page's width and height in the same units,
-// x right and y down as flat.png. Throws std::runtime_error when the cameras
-// cannot be aligned or the grid is smaller than 2 x 2.
+// M: the true surface at the grid's vertices, evenly spaced in (s, t) of
+// flat.png over the page grown by `margin` (a fraction of its width and of its
+// height) on every side, taken into `sfm_cameras`' frame by the similarity of
+// the camera centres (evaluate's alignment, the inverse way). Past the page
+// the surface runs on in the tangent plane at its border, as init-mesh's M
+// runs on past the page so that the rays through the outline meet it. M': its
+// exact flattening in the same units, upright in the reference view of
+// `sfm_cameras` as init-mesh's is (flat.png's axes turned by the quarter turn
+// the view shows the page at; unturned when there is no reference), the grid's
+// rows along its x. Throws std::runtime_error when the cameras cannot be
+// aligned, the reference view sees the page from behind or edge-on, or the grid
+// is smaller than 2 x 2.
 MeshPair TrueSurfaceOnGrid(const GroundTruth& gt, const CameraSet& sfm_cameras,
-                           const QuadGrid& grid);
+                           const QuadGrid& grid, double margin = 0.01);
 
 }  // namespace docunfold::testing

@@ -32,7 +32,7 @@ TEST(TruthInit, TrueSurfaceOnGridIsTheTruthInSfmsFrame) {
   const Eigen::Vector3d offset(0.3, -1.2, 4.0);
   const CameraSet sfm = InOtherFrame(gt->cameras, scale, Q, offset);
   const QuadGrid grid{9, 13};
-  const MeshPair m = TrueSurfaceOnGrid(*gt, sfm, grid);
+  const MeshPair m = TrueSurfaceOnGrid(*gt, sfm, grid, /*margin=*/0);
   ASSERT_EQ(int(m.mesh3d.size()), grid.NumVertices());
   ASSERT_EQ(int(m.mesh2d.size()), grid.NumVertices());
   const double diagonal = gt->Diagonal() * scale;
@@ -51,6 +51,55 @@ TEST(TruthInit, TrueSurfaceOnGridIsTheTruthInSfmsFrame) {
   }
   // The corners are the page's: M' spans the page, M's corners are 3D corners.
   EXPECT_NEAR((m.mesh2d.back() - m.mesh2d.front()).norm(), diagonal, 1e-9);
+}
+
+TEST(TruthInit, MarginContinuesThePageIsometrically) {
+  const auto gt = LoadGroundTruth(SampleDir("set02"));
+  ASSERT_TRUE(gt);
+  const QuadGrid grid{9, 13};
+  const double margin = 0.05;
+  const MeshPair m = TrueSurfaceOnGrid(*gt, gt->cameras, grid, margin);
+  // M' spans the grown page; its first row and column lie outside the page.
+  EXPECT_NEAR(m.mesh2d[0].x(), -margin * gt->width_m, 1e-12);
+  EXPECT_NEAR(m.mesh2d[0].y(), -margin * gt->height_m, 1e-12);
+  EXPECT_NEAR(m.mesh2d.back().x(), (1 + margin) * gt->width_m, 1e-12);
+  // Edges in the margin keep their flat length (the tangent plane is flat).
+  for (int row = 0; row < grid.ny; ++row) {
+    for (int col : {0, grid.nx - 2}) {
+      const int a = grid.Index(row, col), b = grid.Index(row, col + 1);
+      const double flat = (m.mesh2d[b] - m.mesh2d[a]).norm();
+      EXPECT_NEAR((m.mesh3d[b] - m.mesh3d[a]).norm() / flat, 1.0, 0.01) << "row " << row;
+    }
+  }
+}
+
+// However the reference view shows the page turned, M' is upright in it:
+// the grid's rows run right in that view and its columns down, as init-mesh's.
+TEST(TruthInit, FlatTwinIsUprightInTheReferenceView) {
+  const auto gt = LoadGroundTruth(SampleDir("set02"));
+  ASSERT_TRUE(gt);
+  const QuadGrid grid{9, 13};
+  for (int quarter = 0; quarter < 4; ++quarter) {
+    CameraSet cameras = gt->cameras;
+    PinholeCamera& reference = cameras.views[1];
+    const Eigen::Matrix3d turn =
+        Eigen::AngleAxisd(quarter * M_PI / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    reference.R = turn * reference.R;
+    reference.t = turn * reference.t;
+    cameras.reference = reference.image;
+    const MeshPair m = TrueSurfaceOnGrid(*gt, cameras, grid);
+    const int centre = grid.Index(grid.ny / 2, grid.nx / 2);
+    const Eigen::Vector2d at = reference.Project(m.mesh3d[centre]);
+    const Eigen::Vector2d right = reference.Project(m.mesh3d[centre + 1]) - at;
+    const Eigen::Vector2d down = reference.Project(m.mesh3d[centre + grid.nx]) - at;
+    EXPECT_GT(right.x(), std::abs(right.y())) << quarter << " quarter turns";
+    EXPECT_GT(down.y(), std::abs(down.x())) << quarter << " quarter turns";
+    // M' keeps the page's size, turned with it.
+    const Eigen::Vector2d span = m.mesh2d.back() - m.mesh2d.front();
+    const double w = gt->width_m * 1.02, h = gt->height_m * 1.02;
+    EXPECT_NEAR(std::abs(span.x()), quarter % 2 ? h : w, 1e-9);
+    EXPECT_NEAR(std::abs(span.y()), quarter % 2 ? w : h, 1e-9);
+  }
 }
 
 TEST(TruthInit, RefusesCamerasItCannotAlign) {
