@@ -1,9 +1,11 @@
 #include "tests/evaluate/truth_init.h"
 
+#include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
 #include <optional>
 #include <stdexcept>
+#include <utility>
 
 #include "stages/evaluate/geometry_metrics.h"
 
@@ -37,31 +39,59 @@ Eigen::Vector3d ContinuedPagePoint(const GroundTruth& gt, double s, double t) {
   return at + (s - sc) * gt.width_m * along_s + (t - tc) * gt.height_m * along_t;
 }
 
-// The quarter turn taking flat.png's axes (page x right, y down) to the way
-// `reference` shows the page, as a matrix with entries in {-1, 0, 1}:
-// init-mesh's M' is upright in the reference view, its sides named there.
-Eigen::Matrix2d QuarterTurnInView(const GroundTruth& gt, const PinholeCamera& reference,
-                                  const evaluate::Similarity& truth_from_sfm) {
-  const Eigen::Matrix3d R = truth_from_sfm.R.transpose();
-  auto pixel = [&](double s, double t) {
-    return reference.Project(R * (PagePoint(gt, s, t) - truth_from_sfm.t) / truth_from_sfm.scale);
-  };
-  const Eigen::Vector2d along_s = (pixel(0.6, 0.5) - pixel(0.4, 0.5)).normalized();
-  const Eigen::Vector2d along_t = (pixel(0.5, 0.6) - pixel(0.5, 0.4)).normalized();
+// The 3D directions of M' x and y at a grid vertex (a least-squares fit to
+// its neighbours), normalized.
+std::pair<Eigen::Vector3d, Eigen::Vector3d> FlatAxesOnMesh(const MeshPair& m, int row, int col) {
+  Eigen::MatrixXd flat(0, 2), space(0, 3);
+  const int centre = m.grid.Index(row, col);
+  for (auto [dr, dc] : {std::pair{0, 1}, {0, -1}, {1, 0}, {-1, 0}}) {
+    const int r = row + dr, c = col + dc;
+    if (r < 0 || c < 0 || r >= m.grid.ny || c >= m.grid.nx) continue;
+    const int v = m.grid.Index(r, c);
+    flat.conservativeResize(flat.rows() + 1, 2);
+    space.conservativeResize(space.rows() + 1, 3);
+    flat.row(flat.rows() - 1) = (m.mesh2d[v] - m.mesh2d[centre]).transpose();
+    space.row(space.rows() - 1) = (m.mesh3d[v] - m.mesh3d[centre]).transpose();
+  }
+  const Eigen::MatrixXd jacobian = flat.colPivHouseholderQr().solve(space);  // 2 x 3
+  return {jacobian.row(0).transpose().normalized(), jacobian.row(1).transpose().normalized()};
+}
+
+// The quarter turn taking flat.png's axes (x right, y down) to those of
+// `like`'s M' at its middle vertex, as a matrix with entries in {-1, 0, 1}:
+// init-mesh turns its M' upright by the text, not as the photo shows it.
+Eigen::Matrix2d QuarterTurnOf(const GroundTruth& gt, const MeshPair& like,
+                              const evaluate::Similarity& truth_from_sfm) {
+  const int row = like.grid.ny / 2, col = like.grid.nx / 2;
+  const auto [x_axis, y_axis] = FlatAxesOnMesh(like, row, col);
+  // The page's own axes where the true surface is nearest that vertex.
+  const Eigen::Vector3d at = truth_from_sfm(like.mesh3d[like.grid.Index(row, col)]);
+  size_t nearest = 0;
+  for (size_t v = 1; v < gt.mesh.vertices.size(); ++v)
+    if ((gt.mesh.vertices[v] - at).squaredNorm() < (gt.mesh.vertices[nearest] - at).squaredNorm())
+      nearest = v;
+  const double s = std::clamp(double(gt.mesh.FindProperty("s")->values[nearest]), 0.01, 0.99);
+  const double t = std::clamp(double(gt.mesh.FindProperty("t")->values[nearest]), 0.01, 0.99);
+  const Eigen::Vector3d along_s =
+      (PagePoint(gt, s + 0.01, t) - PagePoint(gt, s - 0.01, t)).normalized();
+  const Eigen::Vector3d along_t =
+      (PagePoint(gt, s, t + 0.01) - PagePoint(gt, s, t - 0.01)).normalized();
+  const Eigen::Vector3d x_truth = truth_from_sfm.R * x_axis, y_truth = truth_from_sfm.R * y_axis;
   Eigen::Matrix2d turn;
-  turn << along_s.x(), along_t.x(), along_s.y(), along_t.y();
-  for (int i = 0; i < 4; ++i)
-    turn(i) = std::abs(turn(i)) >= M_SQRT1_2 ? std::copysign(1.0, turn(i)) : 0.0;
+  turn << x_truth.dot(along_s), x_truth.dot(along_t), y_truth.dot(along_s), y_truth.dot(along_t);
+  for (int r = 0; r < 2; ++r)
+    for (int c = 0; c < 2; ++c)
+      turn(r, c) = std::abs(turn(r, c)) >= M_SQRT1_2 ? std::copysign(1.0, turn(r, c)) : 0.0;
   if (std::abs(turn.determinant() - 1) > 1e-9)
-    throw std::runtime_error("the reference view " + reference.image +
-                             " sees the page from behind or edge-on");
+    throw std::runtime_error("the given meshes' flat twin is no quarter turn of the page");
   return turn;
 }
 
 }  // namespace
 
 MeshPair TrueSurfaceOnGrid(const GroundTruth& gt, const CameraSet& sfm_cameras,
-                           const QuadGrid& grid, double margin) {
+                           const MeshPair& like, double margin) {
+  const QuadGrid& grid = like.grid;
   if (grid.nx < 2 || grid.ny < 2)
     throw std::runtime_error("a grid of " + std::to_string(grid.nx) + " x " +
                              std::to_string(grid.ny) + " vertices has no quad");
@@ -71,9 +101,8 @@ MeshPair TrueSurfaceOnGrid(const GroundTruth& gt, const CameraSet& sfm_cameras,
   const evaluate::Similarity& truth_from_sfm = alignment->truth_from_sfm;
   const Eigen::Matrix3d sfm_from_truth_R = truth_from_sfm.R.transpose();
   const double sfm_from_truth_scale = 1.0 / truth_from_sfm.scale;
-  const PinholeCamera* reference = sfm_cameras.Find(sfm_cameras.reference);
   const Eigen::Matrix2d turn =
-      reference ? QuarterTurnInView(gt, *reference, truth_from_sfm) : Eigen::Matrix2d::Identity();
+      like.mesh3d.empty() ? Eigen::Matrix2d::Identity() : QuarterTurnOf(gt, like, truth_from_sfm);
 
   // The grown page in M' (metres, turned): its box, spanned by the grid.
   const Eigen::Vector2d size(gt.width_m, gt.height_m);

@@ -26,7 +26,7 @@ int main(int argc, char** argv) {
     }
     const CameraSet cameras = ReadCameras(work / "10_sfm" / "cameras.json");
     const MeshPair init = ReadMeshPair(work / "40_init");
-    const MeshPair truth = TrueSurfaceOnGrid(*gt, cameras, init.grid);
+    const MeshPair truth = TrueSurfaceOnGrid(*gt, cameras, init);
     MeshPairWriteOptions options;
     if (const PinholeCamera* reference = cameras.Find(cameras.reference)) {
       options.reference_camera = *reference;
