@@ -35,7 +35,8 @@
 //    as in the paper; in model-size units, it weakens 4x per subdivision, as
 //    the paper intends for the tiny λ3 that must not smooth creases away);
 //  - E_line = 1/H2 Σ_markers on a line (n·p' − c)², E_ray = 1/H2 Σ_markers
-//    dist(p, ray)², H2 = number of markers (in model-size units squared);
+//    w dist(p, ray)², w the marker's weight (1 but for optimize's hull
+//    markers), H2 = the sum of the weights (in model-size units squared);
 //  - the outlier distance φ is a fraction of the model size (0.06 as in the
 //    paper "for a normalized model").
 // Reported term values are in these units; meshes and lines are returned in
@@ -92,6 +93,7 @@ struct Marker {
   // the ray normal to `across` and may slide within it (an outline: the
   // plane through the camera centre and a tangent line of the silhouette).
   Eigen::Vector3d across = Eigen::Vector3d::Zero();
+  double weight = 1;  // of its E_ray rows, and its share of H2 (> 0)
 };
 
 struct Problem {

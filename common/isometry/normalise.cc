@@ -48,8 +48,8 @@ void Validate(const Problem& p) {
       throw std::invalid_argument("isometry: marker on line " + std::to_string(m.line) + " of " +
                                   std::to_string(p.lines.size()));
     if (!m.ray_origin.allFinite() || !(m.ray_direction.norm() > 0) || !m.where.bary.allFinite() ||
-        !m.across.allFinite())
-      throw std::invalid_argument("isometry: marker with a bad ray or barycentrics");
+        !m.across.allFinite() || !(m.weight > 0) || !std::isfinite(m.weight))
+      throw std::invalid_argument("isometry: marker with a bad ray, barycentrics or weight");
   }
 }
 
@@ -70,6 +70,7 @@ Work Normalise(const Problem& p, const SolveOptions& o) {
     m.ray_origin = (m.ray_origin - f.center3) * f.scale;
     m.ray_direction.normalize();
     w.data.markers.push_back(m);
+    w.data.marker_weights += m.weight;
   }
   w.data.beta_point = o.beta_point;
   w.data.beta_normal = o.beta_normal;

@@ -38,6 +38,7 @@ struct StepData {
   std::vector<Eigen::Vector3d> points;
   std::vector<Footpoint> footpoints;  // one per point
   std::vector<Marker> markers;        // rays in the normalised frame
+  double marker_weights = 0;          // H2: the sum of the markers' weights
   double iso_scale = 1;               // multiplies every c_iso (see IsoNormalization)
   double iso_edge_weight = 0;         // edge rows' share of E_iso (SolveOptions::iso_edges)
   double beta_point = 1;
@@ -202,7 +203,7 @@ inline int LineRows(const State& s, const StepData& data, int m, Row* rows) {
   const Eigen::Vector3d& w = mk.where.bary;
   const Eigen::Vector2d p = w[0] * s.v2[t[0]] + w[1] * s.v2[t[1]] + w[2] * s.v2[t[2]];
   const Eigen::Vector2d n = line.Normal();
-  const double k = 1 / std::sqrt(double(data.markers.size()));
+  const double k = 1 / std::sqrt(data.marker_weights);
   Row& r = rows[0];
   r.Reset();
   r.value = k * (n.dot(p) - line.offset);
@@ -235,7 +236,8 @@ inline int RayRows(const State& s, const StepData& data, int m, Row* rows) {
   } else {
     OrthogonalFrame(mk.ray_direction, &e[0], &e[1]);
   }
-  const double k = 1 / std::sqrt(double(data.markers.size()));
+  // sqrt(1) is exact: weight-1 markers get exactly 1/sqrt(H2).
+  const double k = std::sqrt(mk.weight) / std::sqrt(data.marker_weights);
   const int n = plane ? 1 : 2;
   for (int j = 0; j < n; ++j) {
     Row& r = rows[j];

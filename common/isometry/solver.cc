@@ -41,7 +41,11 @@ void CallOuterIteration(const SolveOptions& o, int it, Work& w) {
   std::vector<FeatureLine> lines = DenormaliseLines(w.state, w.frame);
   o.on_outer_iteration({it, &meshes, &markers, &lines});
   w.data.markers.clear();
-  for (const Marker& m : markers) w.data.markers.push_back(NormaliseMarker(m, w.frame));
+  w.data.marker_weights = 0;
+  for (const Marker& m : markers) {
+    w.data.markers.push_back(NormaliseMarker(m, w.frame));
+    w.data.marker_weights += m.weight;
+  }
   w.state.lines.clear();
   for (FeatureLine l : lines) {
     l.offset = (l.offset - l.Normal().dot(w.frame.center2)) * w.frame.scale;

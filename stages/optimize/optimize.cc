@@ -131,7 +131,9 @@ std::vector<LineRecord> RoundLines(const isometry::Result& solved, const Groupin
 std::vector<bool> SolveRound(const OptimizeInputs& in, const OptimizeOptions& o,
                              const std::vector<Segment>& segments,
                              const std::vector<Eigen::Vector3d>& region_points,
-                             isometry::SolveOptions so, RoundResult* round) {
+                             const std::vector<HullView>& hull_views,
+                             const cv::Mat1b& reference_page, isometry::SolveOptions so,
+                             RoundResult* round) {
   isometry::Problem problem;
   problem.meshes = round->meshes;
   problem.points = region_points;
@@ -156,6 +158,11 @@ std::vector<bool> SolveRound(const OptimizeInputs& in, const OptimizeOptions& o,
           c.markers->push_back(current.markers[i]);
           kept.push_back(int(i));
         }
+      if (o.mask_hull) {
+        const auto hull = HullMarkers(*c.meshes, in.reference, reference_page, hull_views, o.hull);
+        c.markers->insert(c.markers->end(), hull.begin(), hull.end());
+        round->hull_markers = int(hull.size());
+      }
     };
   }
   isometry::Result solved = isometry::Solve(problem, so);
@@ -165,6 +172,25 @@ std::vector<bool> SolveRound(const OptimizeInputs& in, const OptimizeOptions& o,
   return solved.point_inlier;
 }
 
+void LogHullViews(const std::vector<HullViewCheck>& checks) {
+  std::string used, left_out;
+  for (const HullViewCheck& c : checks) {
+    if (c.used) {
+      used += (used.empty() ? "" : ", ") + c.image;
+    } else {
+      left_out += (left_out.empty() ? "" : ", ") + c.image + " (" +
+                  Fixed(100.0 * c.points_outside / std::max(1, c.points_seen), 1) +
+                  " % of the points outside it)";
+    }
+  }
+  if (checks.empty()) {
+    Log("mask hull: no other photo's page mask (20_boundary/views/)");
+  } else {
+    Log("mask hull: the page masks of " + (used.empty() ? std::string("no photo") : used) +
+        (left_out.empty() ? "" : "; not used: " + left_out));
+  }
+}
+
 void LogRound(const RoundResult& round) {
   const MeshPair& meshes = round.meshes;
   const isometry::SolveReport& report = round.report;
@@ -172,11 +198,11 @@ void LogRound(const RoundResult& round) {
   char buf[256];
   std::snprintf(buf, sizeof buf,
                 "round %d: %dx%d grid, %zu iterations (%s), F %.4g, %d lines, %d markers "
-                "(%d side markers off their side), %d/%d points inside, %.1f s",
+                "(%d side markers off their side, %d hull), %d/%d points inside, %.1f s",
                 round.round, meshes.grid.nx, meshes.grid.ny, report.iterations.size(),
                 report.stop_reason.c_str(), last.F, last.lines, last.markers,
-                round.side_markers_dropped, last.inliers, last.inliers + last.outliers,
-                report.seconds);
+                round.side_markers_dropped, round.hull_markers, last.inliers,
+                last.inliers + last.outliers, report.seconds);
   Log(buf);
 }
 
@@ -214,6 +240,14 @@ OptimizeResult Run(const OptimizeInputs& in, const OptimizeOptions& o) {
   MeshPair meshes = in.init;
   if (o.upright_by_lines && !segments.empty())
     TurnUprightByLines(in, o, segments, &meshes, &result);
+  std::vector<HullView> hull_views;
+  cv::Mat1b reference_page;
+  if (o.mask_hull) {
+    hull_views = PrepareHullViews(in.other_views);
+    reference_page = ContourRegion(in.boundary, 0);
+    result.hull_views = MarkMaskDoubts(region_points, o.hull, &hull_views);
+    LogHullViews(result.hull_views);
+  }
   isometry::Weights weights = o.solve.weights;
   if (segments.empty()) weights.line = weights.ray = 0;
   for (int r = 0; r < o.rounds; ++r) {
@@ -227,8 +261,8 @@ OptimizeResult Run(const OptimizeInputs& in, const OptimizeOptions& o) {
     round.weights = weights;
     round.start_seconds = SecondsSince(start);
     round.meshes = meshes;
-    result.inliers =
-        SolveRound(in, o, segments, region_points, RoundSolveOptions(o, r, weights), &round);
+    result.inliers = SolveRound(in, o, segments, region_points, hull_views, reference_page,
+                                RoundSolveOptions(o, r, weights), &round);
     meshes = round.meshes;
     LogRound(round);
     result.rounds.push_back(std::move(round));

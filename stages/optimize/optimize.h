@@ -16,6 +16,7 @@
 #include "common/option_table_fwd.h"
 #include "common/page_files.h"
 #include "stages/optimize/feature_lines.h"
+#include "stages/optimize/mask_hull.h"
 
 namespace docunfold::optimize {
 
@@ -79,6 +80,12 @@ struct OptimizeOptions {
   double upright_min_share = 0.5;
   CastOptions cast;
   GroupingOptions grouping;
+  // The other photos' page masks as a visual hull (mask_hull.h): page
+  // vertices projecting outside one get hull markers, re-decided every outer
+  // iteration with the other markers. See docs/decisions/optimize.md, "The
+  // other photos' masks as a visual hull".
+  bool mask_hull = true;
+  HullOptions hull;
 };
 
 // Declares optimize's flags into `table`, bound to `options`' fields: the
@@ -99,6 +106,7 @@ struct OptimizeInputs {
   std::vector<std::array<uint8_t, 3>> point_colors;  // empty, or one per point
   Boundary boundary;
   FeatureFile features;
+  std::vector<ViewPage> other_views;  // 20_boundary/views/*/mask.png
 };
 
 // A feature line at the end of a round, for lines.json.
@@ -120,6 +128,7 @@ struct RoundResult {
   // Page-side markers DropSideOutliers took off their side in the round's
   // last outer iteration.
   int side_markers_dropped = 0;
+  int hull_markers = 0;      // in the round's last outer iteration
   double start_seconds = 0;  // since optimize started
 };
 
@@ -131,11 +140,12 @@ struct OptimizeResult {
   // The reader's down in the final M' (unit), from the feature file's
   // text_down through an affine fit of the final lines' pixels to M'.
   std::optional<Eigen::Vector2d> text_down_flat;
-  double upright_turn_deg = 0;  // M' turned by this before the first round
-  std::vector<bool> inliers;    // per region point, after the last round
-  int segments = 0;             // feature segments given (text + edge)
-  int segments_off_page = 0;    // of those, dropped: their samples miss M
-  int boundary_lines = 0;       // real boundary sides used
+  double upright_turn_deg = 0;            // M' turned by this before the first round
+  std::vector<bool> inliers;              // per region point, after the last round
+  int segments = 0;                       // feature segments given (text + edge)
+  int segments_off_page = 0;              // of those, dropped: their samples miss M
+  int boundary_lines = 0;                 // real boundary sides used
+  std::vector<HullViewCheck> hull_views;  // the other photos' masks (mask_hull)
   double seconds = 0;
 };
 

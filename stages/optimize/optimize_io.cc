@@ -58,6 +58,8 @@ OptimizeInputs ReadInputs(const InputPaths& paths) {
                      " image, but the reference view is " + std::to_string(ref->width) + "x" +
                      std::to_string(ref->height));
   in.init = ReadMeshPair(paths.init);
+  if (fs::is_directory(paths.boundary))
+    in.other_views = ReadOtherViewPages(cameras, paths.sfm / "cameras.json", paths.boundary);
   return in;
 }
 
@@ -92,6 +94,12 @@ Json LogJson(const OptimizeResult& result, const Json& options_record) {
                            {"segments", result.line_direction.lines},
                            {"turned_deg", result.upright_turn_deg}};
   doc["boundary_lines"] = result.boundary_lines;
+  doc["mask_hull"] = Json::array();
+  for (const HullViewCheck& c : result.hull_views)
+    doc["mask_hull"].push_back({{"image", c.image},
+                                {"points_seen", c.points_seen},
+                                {"points_outside", c.points_outside},
+                                {"used", c.used}});
   doc["points_in_region"] = result.region_points.size();
   doc["seconds"] = result.seconds;
   doc["rounds"] = Json::array();
@@ -108,6 +116,7 @@ Json LogJson(const OptimizeResult& result, const Json& options_record) {
                              {"solver", solver},
                              {"lines", r.lines.size()},
                              {"side_markers_dropped", r.side_markers_dropped},
+                             {"hull_markers", r.hull_markers},
                              {"iterations", iterations}});
   }
   return doc;

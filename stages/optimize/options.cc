@@ -34,6 +34,13 @@ void DeclareOptions(OptionTable& table, OptimizeOptions* o) {
               "this many times farther from its line than a sample inside may be (0 = keep all)");
   table.Switch("feature-lines", &o->features,
                "text lines, rules and real page sides straightened in M' (off: an ablation)");
+  table.Switch("mask-hull", &o->mask_hull,
+               "hold page vertices that project outside another photo's page mask to that "
+               "mask's outline (the photos' masks as a visual hull)");
+  table.Value("hull-weight", &o->hull.weight, 0.001, 1e6,
+              "weight of such a vertex in E_ray (a text sample's is 1)");
+  table.Value("hull-outside-px", &o->hull.outside_px, 0.0, 1000.0,
+              "a page vertex farther than this outside a photo's mask (its pixels) is held");
   table.Switch("boundary-only", &o->boundary_only,
                "only the real page sides as lines (an ablation)");
   table.Switch("projection", &o->solve.project_markers,

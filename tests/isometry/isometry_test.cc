@@ -145,9 +145,14 @@ TEST(Isometry, AnalyticJacobianMatchesFiniteDifferencesForEveryTerm) {
     m.ray_origin = Eigen::Vector3d(uni(rng), uni(rng), 0);
     m.ray_direction = Eigen::Vector3d(uni(rng), uni(rng), 1).normalized();
     m.line = i < 2 ? 0 : (i < 4 ? 1 : -1);
-    // The last is held to a plane through its ray only (one row).
-    if (i == 4) m.across = m.ray_direction.cross(Eigen::Vector3d(1, 0, 0)).normalized();
+    // The last is held to a plane through its ray only (one row), with a
+    // weight of its own.
+    if (i == 4) {
+      m.across = m.ray_direction.cross(Eigen::Vector3d(1, 0, 0)).normalized();
+      m.weight = 2.5;
+    }
     d.markers.push_back(m);
+    d.marker_weights += m.weight;
   }
   const double h = 1e-6;
   const auto check = [&](int term) {
@@ -572,14 +577,61 @@ TEST(Isometry, RejectsInconsistentProblems) {
   bad.points.push_back(Eigen::Vector3d(NAN, 0, 0));
   EXPECT_THROW(isometry::Solve(bad), std::invalid_argument);
   bad = p;
-  bad.markers.push_back({{99, Eigen::Vector3d(1, 0, 0)}, {}, Eigen::Vector3d::UnitZ(), -1});
+  bad.markers.push_back(
+      {{99, Eigen::Vector3d(1, 0, 0)}, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), -1});
   EXPECT_THROW(isometry::Solve(bad), std::invalid_argument);
   bad = p;
-  bad.markers.push_back({{0, Eigen::Vector3d(1, 0, 0)}, {}, Eigen::Vector3d::UnitZ(), 3});
+  bad.markers.push_back(
+      {{0, Eigen::Vector3d(1, 0, 0)}, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), 3});
   EXPECT_THROW(isometry::Solve(bad), std::invalid_argument);
+  for (const double weight : {0.0, -1.0, double(NAN)}) {
+    bad = p;
+    isometry::Marker m;
+    m.where = {0, Eigen::Vector3d(1, 0, 0)};
+    m.weight = weight;
+    bad.markers.push_back(m);
+    EXPECT_THROW(isometry::Solve(bad), std::invalid_argument) << weight;
+  }
   bad = p;
   for (auto& v : bad.meshes.mesh3d) v.setZero();
   EXPECT_THROW(isometry::Solve(bad), std::invalid_argument);
+}
+
+TEST(Isometry, AMarkerOfWeightKCountsAsKCopies) {
+  // Plane markers on a curled sheet, pulled off it: one of weight 3 gives the
+  // same solve as three copies of weight 1 (E_ray and H2 alike).
+  const MeshPair sheet = CurledSheet(9, 7, 0.8, 0.6, 0.6);
+  Problem weighted;
+  weighted.meshes = sheet;
+  for (int i = 0; i < 6; ++i) {
+    isometry::Marker m;
+    m.where = {7 * i + 3, Eigen::Vector3d(0.2, 0.3, 0.5)};
+    const Eigen::Vector3d x = PointOnMesh3d(sheet, m.where) + Eigen::Vector3d(0, 0, 0.03 * i);
+    m.ray_origin = Eigen::Vector3d(0, 0, -2);
+    m.ray_direction = (x - m.ray_origin).normalized();
+    m.across = m.ray_direction.cross(Eigen::Vector3d(0, 1, 0)).normalized();
+    weighted.markers.push_back(m);
+  }
+  Problem copies = weighted;
+  weighted.markers[2].weight = 3;
+  copies.markers.push_back(copies.markers[2]);
+  copies.markers.push_back(copies.markers[2]);
+  SolveOptions o;
+  o.weights.dist = 0;
+  o.max_outer_iterations = 5;
+  const auto a = isometry::Solve(weighted, o), b = isometry::Solve(copies, o);
+  double worst = 0;
+  for (size_t v = 0; v < a.meshes.mesh3d.size(); ++v)
+    worst = std::max(worst, (a.meshes.mesh3d[v] - b.meshes.mesh3d[v]).norm());
+  EXPECT_LT(worst, 1e-9);
+  EXPECT_NEAR(a.report.iterations.back().terms.ray, b.report.iterations.back().terms.ray, 1e-12);
+  // and not as one copy.
+  weighted.markers[2].weight = 1;
+  const auto c = isometry::Solve(weighted, o);
+  double moved = 0;
+  for (size_t v = 0; v < a.meshes.mesh3d.size(); ++v)
+    moved = std::max(moved, (a.meshes.mesh3d[v] - c.meshes.mesh3d[v]).norm());
+  EXPECT_GT(moved, 1e-4);
 }
 
 // --- subdivision, unfolding, queries ----------------------------------------

@@ -1,0 +1,140 @@
+#include "stages/optimize/mask_hull.h"
+
+#include <algorithm>
+#include <cmath>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+
+namespace docunfold::optimize {
+namespace {
+
+// The vertex as a point on the meshes (a corner of one of its quads).
+SurfacePoint VertexPoint(const QuadGrid& grid, int row, int col) {
+  const int qr = std::min(row, grid.ny - 2), qc = std::min(col, grid.nx - 2);
+  const int q = qr * (grid.nx - 1) + qc;
+  const int dr = row - qr, dc = col - qc;  // corner (dr, dc) of quad q
+  SurfacePoint p;
+  if (dr == 1 && dc == 0) {  // corner 3: triangle 2q+1 holds corners 0 2 3
+    p.triangle = 2 * q + 1;
+    p.bary = Eigen::Vector3d(0, 0, 1);
+    return p;
+  }
+  p.triangle = 2 * q;
+  const int corner = dr == 0 ? dc : 2;  // 0, 1 or 2
+  p.bary = Eigen::Vector3d::Zero();
+  p.bary[corner] = 1;
+  return p;
+}
+
+float Bilinear(const cv::Mat1f& m, double x, double y) {
+  const int x0 = std::clamp(int(std::floor(x)), 0, m.cols - 2);
+  const int y0 = std::clamp(int(std::floor(y)), 0, m.rows - 2);
+  const double fx = std::clamp(x - x0, 0.0, 1.0), fy = std::clamp(y - y0, 0.0, 1.0);
+  return float((1 - fy) * ((1 - fx) * m(y0, x0) + fx * m(y0, x0 + 1)) +
+               fy * ((1 - fx) * m(y0 + 1, x0) + fx * m(y0 + 1, x0 + 1)));
+}
+
+// The undistorted pixel of a photo pixel (the photo's own K).
+Eigen::Vector2d Undistort(const HullView& v, const Eigen::Vector2d& pixel) {
+  cv::Mat K(3, 3, CV_64F), dist(1, 4, CV_64F);
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) K.at<double>(r, c) = v.page.camera.K(r, c);
+  for (int i = 0; i < 4; ++i) dist.at<double>(0, i) = v.page.distortion[i];
+  std::vector<cv::Point2d> in{{pixel.x(), pixel.y()}}, out;
+  cv::undistortPoints(in, out, K, dist, cv::noArray(), K);
+  return {out[0].x, out[0].y};
+}
+
+}  // namespace
+
+std::vector<HullView> PrepareHullViews(std::vector<ViewPage> pages) {
+  std::vector<HullView> views;
+  for (ViewPage& page : pages) {
+    HullView v;
+    cv::Mat1b outside_pixels = page.mask == 0;
+    cv::distanceTransform(outside_pixels, v.outside, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+    cv::Sobel(v.outside, v.dx, CV_32F, 1, 0, 3, 1.0 / 8);
+    cv::Sobel(v.outside, v.dy, CV_32F, 0, 1, 3, 1.0 / 8);
+    v.doubt = cv::Mat1b::zeros(v.outside.size());
+    v.page = std::move(page);
+    views.push_back(std::move(v));
+  }
+  return views;
+}
+
+std::vector<HullViewCheck> MarkMaskDoubts(const std::vector<Eigen::Vector3d>& points,
+                                          const HullOptions& o, std::vector<HullView>* views) {
+  std::vector<HullViewCheck> checks;
+  for (HullView& v : *views) {
+    v.doubt = cv::Mat1b::zeros(v.outside.size());
+    int out = 0, seen = 0;
+    for (const Eigen::Vector3d& x : points) {
+      const auto u = ProjectDistorted(v.page.camera, v.page.distortion, x);
+      if (!u || u->x() < 0 || u->y() < 0 || u->x() > v.outside.cols - 1 ||
+          u->y() > v.outside.rows - 1)
+        continue;
+      ++seen;
+      if (Bilinear(v.outside, u->x(), u->y()) <= o.outside_px) continue;
+      cv::circle(v.doubt, cv::Point(int(std::lround(u->x())), int(std::lround(u->y()))),
+                 int(std::lround(o.doubt_radius_px)), 255, cv::FILLED);
+      ++out;
+    }
+    const bool used = out <= o.max_points_outside * seen;
+    if (!used) v.doubt.setTo(255);
+    checks.push_back({v.page.camera.image, seen, out, used});
+  }
+  return checks;
+}
+
+std::vector<isometry::Marker> HullMarkers(const MeshPair& meshes, const PinholeCamera& reference,
+                                          const cv::Mat1b& reference_page,
+                                          const std::vector<HullView>& views,
+                                          const HullOptions& o) {
+  cv::Mat1b inner;
+  const int k = 2 * int(std::ceil(o.page_inset_px)) + 1;
+  cv::erode(reference_page, inner, cv::getStructuringElement(cv::MORPH_ELLIPSE, {k, k}));
+  std::vector<isometry::Marker> markers;
+  const QuadGrid& g = meshes.grid;
+  const int step = std::max(1, (std::max(g.nx, g.ny) - 1) / std::max(1, o.lattice_rows - 1));
+  for (int row = 0; row < g.ny; row += step)
+    for (int col = 0; col < g.nx; col += step) {
+      const Eigen::Vector3d& x = meshes.mesh3d[g.Index(row, col)];
+      if (reference.CamFromWorld(x).z() <= 0) continue;
+      const Eigen::Vector2d r = reference.Project(x);
+      const int rx = int(std::lround(r.x())), ry = int(std::lround(r.y()));
+      if (rx < 0 || ry < 0 || rx >= inner.cols || ry >= inner.rows || !inner(ry, rx)) continue;
+      for (const HullView& v : views) {
+        const auto u = ProjectDistorted(v.page.camera, v.page.distortion, x);
+        if (!u) continue;
+        const double b = o.image_border_px;
+        if (u->x() < b || u->y() < b || u->x() > v.outside.cols - 1 - b ||
+            u->y() > v.outside.rows - 1 - b)
+          continue;
+        if (v.doubt(int(std::lround(u->y())), int(std::lround(u->x())))) continue;
+        const double d = Bilinear(v.outside, u->x(), u->y());
+        if (d <= o.outside_px) continue;
+        Eigen::Vector2d grad(Bilinear(v.dx, u->x(), u->y()), Bilinear(v.dy, u->x(), u->y()));
+        if (grad.norm() < 1e-3) continue;
+        grad.normalize();
+        // The outline's nearest point and its tangent, as undistorted pixels.
+        const Eigen::Vector2d edge = *u - d * grad;
+        const Eigen::Vector2d tangent(-grad.y(), grad.x());
+        const Eigen::Vector2d e0 = Undistort(v, edge), e1 = Undistort(v, edge + 10 * tangent);
+        const Eigen::Vector3d d0 = v.page.camera.RayDirection(e0);
+        const Eigen::Vector3d d1 = v.page.camera.RayDirection(e1);
+        Eigen::Vector3d across = d0.cross(d1);
+        if (across.norm() < 1e-12) continue;
+        across.normalize();
+        isometry::Marker m;
+        m.where = VertexPoint(g, row, col);
+        m.ray_origin = v.page.camera.Center();
+        m.ray_direction = d0;
+        m.across = across;
+        m.weight = o.weight;
+        markers.push_back(m);
+      }
+    }
+  return markers;
+}
+
+}  // namespace docunfold::optimize
