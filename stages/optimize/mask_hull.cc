@@ -26,6 +26,8 @@ SurfacePoint VertexPoint(const QuadGrid& grid, int row, int col) {
   return p;
 }
 
+// Bilinear interpolation with double weights (common/image_sampling.h's
+// SampleBilinear weighs in float), clamped to the image.
 float Bilinear(const cv::Mat1f& m, double x, double y) {
   const int x0 = std::clamp(int(std::floor(x)), 0, m.cols - 2);
   const int y0 = std::clamp(int(std::floor(y)), 0, m.rows - 2);
@@ -38,8 +40,8 @@ float Bilinear(const cv::Mat1f& m, double x, double y) {
 Eigen::Vector2d Undistort(const HullView& v, const Eigen::Vector2d& pixel) {
   cv::Mat K(3, 3, CV_64F), dist(1, 4, CV_64F);
   for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) K.at<double>(r, c) = v.page.camera.K(r, c);
-  for (int i = 0; i < 4; ++i) dist.at<double>(0, i) = v.page.distortion[i];
+    for (int c = 0; c < 3; ++c) K.at<double>(r, c) = v.camera.K(r, c);
+  for (int i = 0; i < 4; ++i) dist.at<double>(0, i) = v.distortion[i];
   std::vector<cv::Point2d> in{{pixel.x(), pixel.y()}}, out;
   cv::undistortPoints(in, out, K, dist, cv::noArray(), K);
   return {out[0].x, out[0].y};
@@ -47,16 +49,21 @@ Eigen::Vector2d Undistort(const HullView& v, const Eigen::Vector2d& pixel) {
 
 }  // namespace
 
-std::vector<HullView> PrepareHullViews(std::vector<ViewPage> pages) {
+std::vector<HullView> PrepareHullViews(const std::vector<ViewPage>& pages, int max_side) {
   std::vector<HullView> views;
-  for (ViewPage& page : pages) {
+  for (const ViewPage& page : pages) {
     HullView v;
+    v.camera = page.camera;
+    v.distortion = page.distortion;
+    v.scale = std::min(1.0, double(max_side) / std::max(page.mask.cols, page.mask.rows));
     cv::Mat1b outside_pixels = page.mask == 0;
+    if (v.scale < 1)
+      cv::resize(outside_pixels, outside_pixels, cv::Size(), v.scale, v.scale, cv::INTER_AREA);
     cv::distanceTransform(outside_pixels, v.outside, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+    if (v.scale < 1) v.outside /= v.scale;
     cv::Sobel(v.outside, v.dx, CV_32F, 1, 0, 3, 1.0 / 8);
     cv::Sobel(v.outside, v.dy, CV_32F, 0, 1, 3, 1.0 / 8);
     v.doubt = cv::Mat1b::zeros(v.outside.size());
-    v.page = std::move(page);
     views.push_back(std::move(v));
   }
   return views;
@@ -69,30 +76,35 @@ std::vector<HullViewCheck> MarkMaskDoubts(const std::vector<Eigen::Vector3d>& po
     v.doubt = cv::Mat1b::zeros(v.outside.size());
     int out = 0, seen = 0;
     for (const Eigen::Vector3d& x : points) {
-      const auto u = ProjectDistorted(v.page.camera, v.page.distortion, x);
-      if (!u || u->x() < 0 || u->y() < 0 || u->x() > v.outside.cols - 1 ||
-          u->y() > v.outside.rows - 1)
+      const auto photo = ProjectDistorted(v.camera, v.distortion, x);
+      if (!photo) continue;
+      const Eigen::Vector2d u = v.scale * *photo;
+      if (u.x() < 0 || u.y() < 0 || u.x() > v.outside.cols - 1 || u.y() > v.outside.rows - 1)
         continue;
       ++seen;
-      if (Bilinear(v.outside, u->x(), u->y()) <= o.outside_px) continue;
-      cv::circle(v.doubt, cv::Point(int(std::lround(u->x())), int(std::lround(u->y()))),
-                 int(std::lround(o.doubt_radius_px)), 255, cv::FILLED);
+      if (Bilinear(v.outside, u.x(), u.y()) <= o.outside_px) continue;
+      cv::circle(v.doubt, cv::Point(int(std::lround(u.x())), int(std::lround(u.y()))),
+                 int(std::lround(v.scale * o.doubt_radius_px)), 255, cv::FILLED);
       ++out;
     }
     const bool used = out <= o.max_points_outside * seen;
     if (!used) v.doubt.setTo(255);
-    checks.push_back({v.page.camera.image, seen, out, used});
+    checks.push_back({v.camera.image, seen, out, used});
   }
   return checks;
 }
 
-std::vector<isometry::Marker> HullMarkers(const MeshPair& meshes, const PinholeCamera& reference,
-                                          const cv::Mat1b& reference_page,
-                                          const std::vector<HullView>& views,
-                                          const HullOptions& o) {
+cv::Mat1b PageInterior(const cv::Mat1b& reference_page, const HullOptions& o) {
   cv::Mat1b inner;
   const int k = 2 * int(std::ceil(o.page_inset_px)) + 1;
   cv::erode(reference_page, inner, cv::getStructuringElement(cv::MORPH_ELLIPSE, {k, k}));
+  return inner;
+}
+
+std::vector<isometry::Marker> HullMarkers(const MeshPair& meshes, const PinholeCamera& reference,
+                                          const cv::Mat1b& inner,
+                                          const std::vector<HullView>& views,
+                                          const HullOptions& o) {
   std::vector<isometry::Marker> markers;
   const QuadGrid& g = meshes.grid;
   const int step = std::max(1, (std::max(g.nx, g.ny) - 1) / std::max(1, o.lattice_rows - 1));
@@ -104,30 +116,31 @@ std::vector<isometry::Marker> HullMarkers(const MeshPair& meshes, const PinholeC
       const int rx = int(std::lround(r.x())), ry = int(std::lround(r.y()));
       if (rx < 0 || ry < 0 || rx >= inner.cols || ry >= inner.rows || !inner(ry, rx)) continue;
       for (const HullView& v : views) {
-        const auto u = ProjectDistorted(v.page.camera, v.page.distortion, x);
-        if (!u) continue;
-        const double b = o.image_border_px;
-        if (u->x() < b || u->y() < b || u->x() > v.outside.cols - 1 - b ||
-            u->y() > v.outside.rows - 1 - b)
+        const auto photo = ProjectDistorted(v.camera, v.distortion, x);
+        if (!photo) continue;
+        const double b = v.scale * o.image_border_px;
+        const Eigen::Vector2d u = v.scale * *photo;
+        if (u.x() < b || u.y() < b || u.x() > v.outside.cols - 1 - b ||
+            u.y() > v.outside.rows - 1 - b)
           continue;
-        if (v.doubt(int(std::lround(u->y())), int(std::lround(u->x())))) continue;
-        const double d = Bilinear(v.outside, u->x(), u->y());
+        if (v.doubt(int(std::lround(u.y())), int(std::lround(u.x())))) continue;
+        const double d = Bilinear(v.outside, u.x(), u.y());
         if (d <= o.outside_px) continue;
-        Eigen::Vector2d grad(Bilinear(v.dx, u->x(), u->y()), Bilinear(v.dy, u->x(), u->y()));
+        Eigen::Vector2d grad(Bilinear(v.dx, u.x(), u.y()), Bilinear(v.dy, u.x(), u.y()));
         if (grad.norm() < 1e-3) continue;
         grad.normalize();
         // The outline's nearest point and its tangent, as undistorted pixels.
-        const Eigen::Vector2d edge = *u - d * grad;
+        const Eigen::Vector2d edge = *photo - d * grad;
         const Eigen::Vector2d tangent(-grad.y(), grad.x());
         const Eigen::Vector2d e0 = Undistort(v, edge), e1 = Undistort(v, edge + 10 * tangent);
-        const Eigen::Vector3d d0 = v.page.camera.RayDirection(e0);
-        const Eigen::Vector3d d1 = v.page.camera.RayDirection(e1);
+        const Eigen::Vector3d d0 = v.camera.RayDirection(e0);
+        const Eigen::Vector3d d1 = v.camera.RayDirection(e1);
         Eigen::Vector3d across = d0.cross(d1);
         if (across.norm() < 1e-12) continue;
         across.normalize();
         isometry::Marker m;
         m.where = VertexPoint(g, row, col);
-        m.ray_origin = v.page.camera.Center();
+        m.ray_origin = v.camera.Center();
         m.ray_direction = d0;
         m.across = across;
         m.weight = o.weight;

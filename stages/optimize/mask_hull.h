@@ -4,6 +4,7 @@
 // that camera and the mask's outline nearest its projection.
 #pragma once
 
+#include <array>
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
@@ -39,15 +40,20 @@ struct HullOptions {
   int lattice_rows = 31;
 };
 
-// One photo's page mask prepared for HullMarkers.
+// One photo's page mask prepared for HullMarkers, at `scale` times the
+// photo's size (maps index scaled pixels; distances are in photo pixels).
 struct HullView {
-  ViewPage page;
-  cv::Mat1f outside;  // distance to the page, pixels (0 inside)
+  PinholeCamera camera;
+  std::array<double, 4> distortion{};
+  double scale = 1;
+  cv::Mat1f outside;  // distance to the page, photo pixels (0 inside)
   cv::Mat1f dx, dy;   // its gradient
   cv::Mat1b doubt;    // non-zero: the mask is not trusted here
 };
 
-std::vector<HullView> PrepareHullViews(std::vector<ViewPage> pages);
+// The masks at most `max_side` pixels on their longer side (a 48-megapixel
+// photo's distance map would take 700 MB).
+std::vector<HullView> PrepareHullViews(const std::vector<ViewPage>& pages, int max_side = 1600);
 
 // How far the fitted points agree with one photo's mask.
 struct HullViewCheck {
@@ -62,11 +68,14 @@ struct HullViewCheck {
 std::vector<HullViewCheck> MarkMaskDoubts(const std::vector<Eigen::Vector3d>& points,
                                           const HullOptions& options, std::vector<HullView>* views);
 
-// Markers (line -1, with `across`) for every page vertex of `meshes` (its
-// reference projection inside `reference_page` shrunk by page_inset_px)
-// that projects more than outside_px outside some view's mask.
+// The reference page shrunk by page_inset_px: where page vertices project.
+cv::Mat1b PageInterior(const cv::Mat1b& reference_page, const HullOptions& options);
+
+// Markers (line -1, with `across`, weight `options.weight`) for every page
+// vertex of `meshes` (projecting into `page_interior` in the reference) that
+// projects more than outside_px outside some view's mask, where trusted.
 std::vector<isometry::Marker> HullMarkers(const MeshPair& meshes, const PinholeCamera& reference,
-                                          const cv::Mat1b& reference_page,
+                                          const cv::Mat1b& page_interior,
                                           const std::vector<HullView>& views,
                                           const HullOptions& options);
 

@@ -132,7 +132,7 @@ std::vector<bool> SolveRound(const OptimizeInputs& in, const OptimizeOptions& o,
                              const std::vector<Segment>& segments,
                              const std::vector<Eigen::Vector3d>& region_points,
                              const std::vector<HullView>& hull_views,
-                             const cv::Mat1b& reference_page, isometry::SolveOptions so,
+                             const cv::Mat1b& page_interior, isometry::SolveOptions so,
                              RoundResult* round) {
   isometry::Problem problem;
   problem.meshes = round->meshes;
@@ -159,7 +159,7 @@ std::vector<bool> SolveRound(const OptimizeInputs& in, const OptimizeOptions& o,
           kept.push_back(int(i));
         }
       if (o.mask_hull) {
-        const auto hull = HullMarkers(*c.meshes, in.reference, reference_page, hull_views, o.hull);
+        const auto hull = HullMarkers(*c.meshes, in.reference, page_interior, hull_views, o.hull);
         c.markers->insert(c.markers->end(), hull.begin(), hull.end());
         round->hull_markers = int(hull.size());
       }
@@ -241,10 +241,10 @@ OptimizeResult Run(const OptimizeInputs& in, const OptimizeOptions& o) {
   if (o.upright_by_lines && !segments.empty())
     TurnUprightByLines(in, o, segments, &meshes, &result);
   std::vector<HullView> hull_views;
-  cv::Mat1b reference_page;
+  cv::Mat1b page_interior;
   if (o.mask_hull) {
     hull_views = PrepareHullViews(in.other_views);
-    reference_page = ContourRegion(in.boundary, 0);
+    page_interior = PageInterior(ContourRegion(in.boundary, 0), o.hull);
     result.hull_views = MarkMaskDoubts(region_points, o.hull, &hull_views);
     LogHullViews(result.hull_views);
   }
@@ -261,7 +261,7 @@ OptimizeResult Run(const OptimizeInputs& in, const OptimizeOptions& o) {
     round.weights = weights;
     round.start_seconds = SecondsSince(start);
     round.meshes = meshes;
-    result.inliers = SolveRound(in, o, segments, region_points, hull_views, reference_page,
+    result.inliers = SolveRound(in, o, segments, region_points, hull_views, page_interior,
                                 RoundSolveOptions(o, r, weights), &round);
     meshes = round.meshes;
     LogRound(round);

@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/optimize/flat_sheet.h"
+
 namespace docunfold::optimize {
 namespace {
 
@@ -16,13 +18,7 @@ struct Scene {
   Scene() {
     camera.width = camera.height = 800;
     camera.K << 800, 0, 400, 0, 800, 400, 0, 0, 1;
-    meshes.grid = {5, 7};
-    for (int r = 0; r < 7; ++r)
-      for (int c = 0; c < 5; ++c) {
-        const Eigen::Vector2d flat(-0.5 + 0.25 * c, -0.75 + 0.25 * r);
-        meshes.mesh2d.push_back(flat);
-        meshes.mesh3d.emplace_back(flat.x(), flat.y(), 4.0);
-      }
+    meshes = FlatSheetAtDepthFour();
   }
 };
 

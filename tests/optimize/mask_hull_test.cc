@@ -8,6 +8,8 @@
 #include <Eigen/Geometry>
 #include <opencv2/imgproc.hpp>
 
+#include "tests/optimize/flat_sheet.h"
+
 namespace docunfold::optimize {
 namespace {
 
@@ -50,13 +52,7 @@ struct Scene {
   cv::Mat1b everywhere = cv::Mat1b(kSize, kSize, uchar(255));
 
   Scene() {
-    meshes.grid = {5, 7};
-    for (int r = 0; r < 7; ++r)
-      for (int c = 0; c < 5; ++c) {
-        const Eigen::Vector2d flat(-0.5 + 0.25 * c, -0.75 + 0.25 * r);
-        meshes.mesh2d.push_back(flat);
-        meshes.mesh3d.emplace_back(flat.x(), flat.y(), 4.0);
-      }
+    meshes = FlatSheetAtDepthFour();
     ViewPage page;
     page.camera = Camera("view_01.jpg",
                          Eigen::AngleAxisd(25 * M_PI / 180, Eigen::Vector3d::UnitX()).matrix());
@@ -89,9 +85,21 @@ TEST(MaskHull, VerticesOutsideAnotherMaskAreHeldToItsOutline) {
     EXPECT_LE(views[0].outside(cv::Point(int(std::lround(p.x())), int(std::lround(p.y())))), 2)
         << p.transpose();
   }
+  // From the mask at half its size: the same vertices, held to nearly the
+  // same planes.
+  const std::vector<HullView> half = PrepareHullViews(scene.others, kSize / 2);
+  EXPECT_DOUBLE_EQ(half[0].scale, 0.5);
+  const std::vector<isometry::Marker> coarse =
+      HullMarkers(scene.meshes, scene.reference, scene.everywhere, half, options);
+  ASSERT_EQ(coarse.size(), markers.size());
+  for (size_t i = 0; i < coarse.size(); ++i) {
+    EXPECT_EQ(coarse[i].where.triangle, markers[i].where.triangle);
+    EXPECT_LT((coarse[i].across - markers[i].across).norm(), 0.01);
+  }
+
   // The page ends on the reference's page: the last row lies on its border,
   // within page_inset_px, and is not judged.
-  const cv::Mat1b sheet = PageMask(scene.reference, 0.75);
+  const cv::Mat1b sheet = PageInterior(PageMask(scene.reference, 0.75), options);
   EXPECT_TRUE(HullMarkers(scene.meshes, scene.reference, sheet, views, options).empty());
 }
 
