@@ -102,7 +102,7 @@ cv::Mat1b PageInterior(const cv::Mat1b& reference_page, const HullOptions& o) {
 }
 
 std::vector<isometry::Marker> HullMarkers(const MeshPair& meshes, const PinholeCamera& reference,
-                                          const cv::Mat1b& inner,
+                                          const cv::Mat1b& page_interior,
                                           const std::vector<HullView>& views,
                                           const HullOptions& o) {
   std::vector<isometry::Marker> markers;
@@ -114,7 +114,9 @@ std::vector<isometry::Marker> HullMarkers(const MeshPair& meshes, const PinholeC
       if (reference.CamFromWorld(x).z() <= 0) continue;
       const Eigen::Vector2d r = reference.Project(x);
       const int rx = int(std::lround(r.x())), ry = int(std::lround(r.y()));
-      if (rx < 0 || ry < 0 || rx >= inner.cols || ry >= inner.rows || !inner(ry, rx)) continue;
+      if (rx < 0 || ry < 0 || rx >= page_interior.cols || ry >= page_interior.rows ||
+          !page_interior(ry, rx))
+        continue;
       for (const HullView& v : views) {
         const auto photo = ProjectDistorted(v.camera, v.distortion, x);
         if (!photo) continue;
