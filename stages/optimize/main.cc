@@ -28,7 +28,7 @@ int main(int argc, char** argv) {
   optimize::DeclareOutputOptions(table, &output);
 
   return RunStage("optimize", table, argc, argv, [&] {
-    const optimize::OptimizeInputs in = optimize::ReadInputs(paths);
+    const optimize::OptimizeInputs in = optimize::ReadInputs(paths, o.mask_hull);
     const optimize::OptimizeResult r = optimize::Run(in, o);
     optimize::WriteOutputs(out, paths, in, r, table.Record(), output);
     char buf[200];

@@ -242,7 +242,8 @@ OptimizeResult Run(const OptimizeInputs& in, const OptimizeOptions& o) {
     TurnUprightByLines(in, o, segments, &meshes, &result);
   std::vector<HullView> hull_views;
   cv::Mat1b page_interior;
-  if (o.mask_hull) {
+  // The hull holds vertices through E_ray, which is off without segments.
+  if (o.mask_hull && !segments.empty()) {
     hull_views = PrepareHullViews(in.other_views);
     page_interior = PageInterior(ContourRegion(in.boundary, 0), o.hull);
     result.hull_views = MarkMaskDoubts(region_points, o.hull, &hull_views);

@@ -30,7 +30,7 @@ void DeclareOutputOptions(OptionTable& table, OutputOptions* o) {
   table.Switch("scene", &o->scene, "write scene.glb");
 }
 
-OptimizeInputs ReadInputs(const InputPaths& paths) {
+OptimizeInputs ReadInputs(const InputPaths& paths, bool view_masks) {
   OptimizeInputs in;
   const CameraSet cameras = ReadCameras(paths.sfm / "cameras.json");
   const PinholeCamera* ref = cameras.Find(cameras.reference);
@@ -58,7 +58,7 @@ OptimizeInputs ReadInputs(const InputPaths& paths) {
                      " image, but the reference view is " + std::to_string(ref->width) + "x" +
                      std::to_string(ref->height));
   in.init = ReadMeshPair(paths.init);
-  if (fs::is_directory(paths.boundary))
+  if (view_masks && fs::is_directory(paths.boundary))
     in.other_views = ReadOtherViewPages(cameras, paths.sfm / "cameras.json", paths.boundary);
   return in;
 }

@@ -23,8 +23,9 @@ struct InputPaths {
   fs::path PointsFile() const { return points.empty() ? sfm / "points.ply" : points; }
 };
 
-// Reads and checks every input (throws InputError naming file and problem).
-OptimizeInputs ReadInputs(const InputPaths& paths);
+// Reads and checks every input (throws InputError naming file and problem);
+// the other photos' page masks only when `view_masks` (the visual hull's).
+OptimizeInputs ReadInputs(const InputPaths& paths, bool view_masks = true);
 
 struct OutputOptions {
   bool scene = true;         // write scene.glb
