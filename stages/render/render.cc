@@ -270,6 +270,20 @@ Json Orient(const RenderOptions& options, const RenderInputs& in, const PixelToS
   orientation["quarter_turns_clockwise"] = r->quarter_turns;
   return orientation;
 }
+
+// The print straightened in the finished (turned) images, the page mask and
+// the texture labels moved with it.
+void Straighten(const RenderOptions& options, RenderResult* r, StepTimer* timer) {
+  if (!options.straighten.enabled) return;
+  const Straightening s = FindStraightening(r->rectified, options.straighten);
+  r->rectified = ApplyStraightening(r->rectified, s, cv::INTER_CUBIC);
+  r->rectified_grid = ApplyStraightening(r->rectified_grid, s, cv::INTER_CUBIC);
+  r->page_mask = ApplyStraightening(r->page_mask, s, cv::INTER_NEAREST);
+  r->texture_labels = ApplyStraightening(r->texture_labels, s, cv::INTER_NEAREST);
+  r->straightened_rows = s.rows;
+  r->straightened_columns = s.columns;
+  timer->Mark("straighten");
+}
 }  // namespace
 
 RenderResult Run(const RenderOptions& options, const RenderInputs& in) {
@@ -319,6 +333,7 @@ RenderResult Run(const RenderOptions& options, const RenderInputs& in) {
                   &r, &timer);
   timer.Mark("fill_and_grid");
   r.orientation = Orient(options, in, lookup, angle, &r, &timer);
+  Straighten(options, &r, &timer);
   r.timings = timer.steps();
   return r;
 }

@@ -24,6 +24,7 @@
 #include "common/shading.h"
 #include "common/texture_fusion.h"
 #include "stages/render/cut_sides.h"
+#include "stages/render/print_straightening.h"
 
 namespace docunfold::render {
 
@@ -137,6 +138,9 @@ struct RenderOptions {
   // as the benchmark's oracle does).
   Shading shading = Shading::kKeep;
   ShadingOptions shading_removal;
+  // The printed rows and columns straightened in the finished image
+  // (print_straightening.h): the waviness M' left behind.
+  StraightenOptions straighten;
   // kFusion: every photo that sees a part of the page better than the
   // reference does colours it there (common/texture_fusion.h: levelled,
   // registered, seams where the photos agree); kReference: the reference
@@ -233,6 +237,7 @@ struct RenderResult {
   double other_view_fraction = 0;  // output pixels from another view's photo
   bool shading_removed = false;
   double shading_paper_fraction = 0;  // of the image taken as paper (shading = remove)
+  StraightenPass straightened_rows, straightened_columns;  // options.straighten
   int grid_line_step = 1;
   // Clockwise quarter turns applied to the images after rendering (the crop
   // and pixels_per_unit above refer to the unturned image).

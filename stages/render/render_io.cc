@@ -72,6 +72,19 @@ namespace {
 
 Json Vec2(const Eigen::Vector2d& v) { return Json::array({v.x(), v.y()}); }
 
+// render.json's "straightening": what each direction's pass found.
+Json StraighteningJson(const RenderOptions& options, const RenderResult& r) {
+  auto pass = [](const StraightenPass& p) {
+    return Json{{"strips", p.strips},
+                {"windows", p.windows},
+                {"shifts_found", p.shifts_found},
+                {"max_shift_px", p.max_shift_px}};
+  };
+  return {{"applied", options.straighten.enabled},
+          {"rows", pass(r.straightened_rows)},
+          {"columns", pass(r.straightened_columns)}};
+}
+
 }  // namespace
 
 Json RenderReport(const RenderOptions& options, const RenderInputs& in, const RenderResult& r,
@@ -152,6 +165,7 @@ Json RenderReport(const RenderOptions& options, const RenderInputs& in, const Re
   doc["other_view_fraction"] = r.other_view_fraction;
   doc["shading"] = {{"removed", r.shading_removed}};
   if (r.shading_removed) doc["shading"]["paper_fraction"] = r.shading_paper_fraction;
+  doc["straightening"] = StraighteningJson(options, r);
   Json regs = Json::array();
   for (const ViewRegistration& g : r.registrations)
     regs.push_back({{"view", in.views[g.view].camera.image},

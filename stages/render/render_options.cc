@@ -90,6 +90,9 @@ void DeclareOptions(OptionTable& table, RenderOptions* o) {
                "remove: divide out the light's shading (folds, curls, shadows) so that the paper "
                "comes out one even colour, as from a scanner (far better OCR); keep: the "
                "reference photo's brightness, as the paper's method renders it");
+  table.Switch("straighten", &o->straighten.enabled,
+               "straighten the printed rows and columns in the finished image where M' left them "
+               "a little wavy (off: the image as M' maps it)");
   table.Switch(
       "texture-cut-sides", &o->texture_cut_sides,
       "texture the page found past a cut side from the other views that see it (--images); "
