@@ -53,6 +53,20 @@ double Correlation(const std::vector<double>& a, const std::vector<double>& b, i
   return (sab - sa * sb / n) / std::sqrt(va * vb);
 }
 
+// Whether the window [y0, y1)'s mean profile over every strip has the
+// contrast of printed rows (blank gaps between them).
+bool RowLike(const std::vector<std::vector<double>>& profile, int y0, int y1, double min_contrast) {
+  std::vector<double> mean;
+  for (int y = y0; y < y1; ++y) {
+    double m = 0;
+    for (const std::vector<double>& p : profile) m += p[y];
+    mean.push_back(m / double(profile.size()));
+  }
+  std::sort(mean.begin(), mean.end());
+  const double p10 = mean[mean.size() / 10], p90 = mean[mean.size() * 9 / 10];
+  return p90 > 0 && (p90 - p10) / p90 >= min_contrast;
+}
+
 // The vertical displacement (working pixels) that aligns every strip's ink
 // profile with its window's mean profile, on the grid of windows x strips,
 // smoothed and interpolated to every pixel of `ink`. Empty when the image
@@ -79,6 +93,7 @@ cv::Mat1f RowDisplacement(const cv::Mat1f& ink, const StraightenOptions& o, Stra
     std::vector<double> shift(ns, 0), confidence(ns, 0), weight(ns, 0);
     for (int i = 0; i < ns; ++i)
       for (int y = y0; y < y1; ++y) weight[i] += profile[i][y];
+    if (!RowLike(profile, y0, y1, o.min_row_contrast)) continue;
     // The window's mean profile, each strip aligned to it, three times: a
     // strip with only some of the rows (short words) still finds them.
     for (int round = 0; round < 3; ++round) {
