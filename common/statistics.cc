@@ -13,4 +13,9 @@ double Quantile(std::vector<double> values, double q) {
 
 double Median(std::vector<double> values) { return Quantile(std::move(values), 0.5); }
 
+double ParabolaPeak(const std::vector<double>& g, int i) {
+  const double curvature = g[i - 1] - 2 * g[i] + g[i + 1];
+  return curvature < 0 ? 0.5 * (g[i - 1] - g[i + 1]) / curvature : 0;
+}
+
 }  // namespace docunfold

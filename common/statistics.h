@@ -1,4 +1,5 @@
-// Order statistics of samples, shared by the stages.
+// Order statistics of samples, and the sub-pixel place of a sampled peak,
+// shared by the stages.
 #pragma once
 
 #include <algorithm>
@@ -13,6 +14,11 @@ double Quantile(std::vector<double> values, double q);
 
 // Quantile(values, 0.5): the value at rank n / 2.
 double Median(std::vector<double> values);
+
+// Sub-pixel position of the local maximum g[i] (a parabola through it and
+// its neighbours, 0 <= i - 1 and i + 1 < g.size()), as an offset in samples
+// from i; 0 where the three do not curve down.
+double ParabolaPeak(const std::vector<double>& g, int i);
 
 // The value at rank `k` (0-based, k < n) of the samples, for a caller that
 // fixes its rank another way than Quantile (e.g. n * 95 / 100).

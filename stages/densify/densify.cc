@@ -114,11 +114,6 @@ Eigen::Vector2d ScalePixel(const Eigen::Vector2d& p, double scale) {
   return (p.array() + 0.5) * scale - 0.5;
 }
 
-double ParabolaPeak(const std::vector<double>& g, int i) {
-  const double curvature = g[i - 1] - 2 * g[i] + g[i + 1];
-  return curvature < 0 ? 0.5 * (g[i - 1] - g[i + 1]) / curvature : 0;
-}
-
 void AppendPoint(const Eigen::Vector3d& X, const std::array<uint8_t, 3>& rgb, int views,
                  double reprojection_error, PointSource source, PlyData* points) {
   points->vertices.push_back(X);

@@ -52,10 +52,6 @@ struct Observation {
   Eigen::Vector2d pixel;
 };
 
-// Sub-pixel position of the local maximum g[i] (a parabola through it and
-// its neighbours), as an offset in samples from i.
-double ParabolaPeak(const std::vector<double>& g, int i);
-
 // Appends a point made by densify with its PLY properties (Run sets up
 // track_length, reprojection_error and source, in that order).
 void AppendPoint(const Eigen::Vector3d& X, const std::array<uint8_t, 3>& rgb, int views,

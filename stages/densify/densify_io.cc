@@ -35,8 +35,7 @@ DensifyInputs ReadInputs(const DensifyOptions& o) {
       in.photos.emplace_back();
       continue;
     }
-    in.photos.push_back(
-        ReadViewPhoto(images / view.image, view, cameras_path, PhotoColor::kGray));
+    in.photos.push_back(ReadViewPhoto(images / view.image, view, cameras_path, PhotoColor::kGray));
   }
   const fs::path boundary_file =
       fs::is_directory(o.boundary) ? o.boundary / "boundary.json" : o.boundary;

@@ -9,6 +9,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "common/point_index.h"
+#include "common/statistics.h"
 #include "stages/densify/densify_internal.h"
 
 namespace docunfold::densify::detail {

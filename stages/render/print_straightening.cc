@@ -5,6 +5,8 @@
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
+#include "common/statistics.h"
+
 namespace docunfold::render {
 namespace {
 
@@ -62,8 +64,8 @@ bool RowLike(const std::vector<std::vector<double>>& profile, int y0, int y1, do
     for (const std::vector<double>& p : profile) m += p[y];
     mean.push_back(m / double(profile.size()));
   }
-  std::sort(mean.begin(), mean.end());
-  const double p10 = mean[mean.size() / 10], p90 = mean[mean.size() * 9 / 10];
+  const double p10 = NthSmallest(mean, mean.size() / 10);
+  const double p90 = NthSmallest(mean, mean.size() * 9 / 10);
   return p90 > 0 && (p90 - p10) / p90 >= min_contrast;
 }
 
@@ -115,10 +117,7 @@ cv::Mat1f RowDisplacement(const cv::Mat1f& ink, const StraightenOptions& o, Stra
         if (best <= 0 || best >= 2 * ms || !(c[best] >= o.min_correlation) ||
             std::isnan(c[best - 1]) || std::isnan(c[best + 1]))
           continue;
-        const double a = c[best - 1], b = c[best], d = c[best + 1];
-        double offset = (a - d) / (2 * (a - 2 * b + d));
-        if (!(std::abs(offset) <= 0.5)) offset = 0;
-        shift[i] = best - ms + offset;
+        shift[i] = best - ms + ParabolaPeak(c, best);
         confidence[i] = c[best];
       }
       // Relative to the window's ink-weighted mean: the rows keep their
@@ -174,6 +173,17 @@ cv::Mat1f RowDisplacement(const cv::Mat1f& ink, const StraightenOptions& o, Stra
   return dense;
 }
 
+// Maps that take every pixel of an image of `size` to itself.
+void IdentityMaps(cv::Size size, cv::Mat1f* map_x, cv::Mat1f* map_y) {
+  map_x->create(size);
+  map_y->create(size);
+  for (int y = 0; y < size.height; ++y)
+    for (int x = 0; x < size.width; ++x) {
+      (*map_x)(y, x) = float(x);
+      (*map_y)(y, x) = float(y);
+    }
+}
+
 // `d` (working pixels, working size) at `size`, in output pixels.
 cv::Mat1f ToOutput(const cv::Mat1f& d, cv::Size size) {
   cv::Mat1f out;
@@ -192,13 +202,7 @@ double MaxAbs(const cv::Mat1f& m) {
 Straightening FindStraightening(const cv::Mat& image, const StraightenOptions& o) {
   Straightening s;
   const int W = image.cols, H = image.rows;
-  s.map_x.create(H, W);
-  s.map_y.create(H, W);
-  for (int y = 0; y < H; ++y)
-    for (int x = 0; x < W; ++x) {
-      s.map_x(y, x) = float(x);
-      s.map_y(y, x) = float(y);
-    }
+  IdentityMaps(image.size(), &s.map_x, &s.map_y);
   if (!o.enabled || image.empty()) return s;
   const double scale = std::min(1.0, std::sqrt(o.work_pixels / (double(W) * H)));
   cv::Mat work;
@@ -211,12 +215,9 @@ Straightening FindStraightening(const cv::Mat& image, const StraightenOptions& o
   cv::Mat1f dx;
   if (!dy.empty()) {
     // The columns are found on the copy with its rows straightened.
-    cv::Mat1f wx(work.size()), wy(work.size());
-    for (int y = 0; y < work.rows; ++y)
-      for (int x = 0; x < work.cols; ++x) {
-        wx(y, x) = float(x);
-        wy(y, x) = float(y) + dy(y, x);
-      }
+    cv::Mat1f wx, wy;
+    IdentityMaps(work.size(), &wx, &wy);
+    wy += dy;
     cv::Mat straightened;  // not in place: `work` may share `image`'s pixels
     cv::remap(work, straightened, wx, wy, cv::INTER_LINEAR, cv::BORDER_REPLICATE);
     work = straightened;

@@ -276,10 +276,12 @@ Json Orient(const RenderOptions& options, const RenderInputs& in, const PixelToS
 void Straighten(const RenderOptions& options, RenderResult* r, StepTimer* timer) {
   if (!options.straighten.enabled) return;
   const Straightening s = FindStraightening(r->rectified, options.straighten);
-  r->rectified = ApplyStraightening(r->rectified, s, cv::INTER_CUBIC);
-  r->rectified_grid = ApplyStraightening(r->rectified_grid, s, cv::INTER_CUBIC);
-  r->page_mask = ApplyStraightening(r->page_mask, s, cv::INTER_NEAREST);
-  r->texture_labels = ApplyStraightening(r->texture_labels, s, cv::INTER_NEAREST);
+  if (s.rows.max_shift_px > 0 || s.columns.max_shift_px > 0) {  // else the maps are the identity
+    r->rectified = ApplyStraightening(r->rectified, s, cv::INTER_CUBIC);
+    r->rectified_grid = ApplyStraightening(r->rectified_grid, s, cv::INTER_CUBIC);
+    r->page_mask = ApplyStraightening(r->page_mask, s, cv::INTER_NEAREST);
+    r->texture_labels = ApplyStraightening(r->texture_labels, s, cv::INTER_NEAREST);
+  }
   r->straightened_rows = s.rows;
   r->straightened_columns = s.columns;
   timer->Mark("straighten");
