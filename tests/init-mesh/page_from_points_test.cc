@@ -37,8 +37,10 @@ TEST(PageFromPoints, PagePointsAreInsideThePageInEveryPhotoThatFramesThem) {
   std::vector<ViewPage> photos;
   for (const Eigen::Vector3d& c : {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0.2, 0, 0.1)}) {
     const PinholeCamera cam = Camera(c);
-    photos.push_back(
-        {cam, {}, cv::Mat1b(RasterizeMesh(cam, page.mesh3d, page.grid.Triangles()).face >= 0)});
+    ViewPage photo;
+    photo.camera = cam;
+    photo.mask = cv::Mat1b(RasterizeMesh(cam, page.mesh3d, page.grid.Triangles()).face >= 0);
+    photos.push_back(photo);
   }
   const std::vector<Eigen::Vector3d> points = {
       {0, 0, 1},          // the page's middle
