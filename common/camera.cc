@@ -1,6 +1,7 @@
 #include "common/camera.h"
 
 #include <cmath>
+#include <opencv2/calib3d.hpp>
 
 #include "common/atomic_file.h"
 #include "common/errors.h"
@@ -73,6 +74,22 @@ std::optional<Eigen::Vector2d> ProjectDistorted(const PinholeCamera& camera,
   const Eigen::Vector2d pixel = p.head<2>() / p.z();
   if (!std::isfinite(pixel.x()) || !std::isfinite(pixel.y())) return std::nullopt;
   return pixel;
+}
+
+std::vector<Eigen::Vector2d> UndistortPixels(const PinholeCamera& camera,
+                                             const std::array<double, 4>& distortion,
+                                             const std::vector<Eigen::Vector2d>& pixels) {
+  if (pixels.empty()) return {};
+  cv::Mat K(3, 3, CV_64F), dist(1, 4, CV_64F);
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) K.at<double>(r, c) = camera.K(r, c);
+  for (int i = 0; i < 4; ++i) dist.at<double>(0, i) = distortion[i];
+  std::vector<cv::Point2d> in, out;
+  for (const auto& p : pixels) in.emplace_back(p.x(), p.y());
+  cv::undistortPoints(in, out, K, dist, cv::noArray(), K);
+  std::vector<Eigen::Vector2d> result;
+  for (const auto& p : out) result.emplace_back(p.x, p.y);
+  return result;
 }
 
 cv::Mat ReadViewPhoto(const fs::path& path, const PinholeCamera& view, const fs::path& cameras_file,

@@ -84,6 +84,12 @@ std::optional<Eigen::Vector2d> ProjectDistorted(const PinholeCamera& camera,
                                                 const std::array<double, 4>& distortion,
                                                 const Eigen::Vector3d& x_world);
 
+// The undistorted pixels (in the same camera's K) of photo pixels taken
+// with OpenCV's distortion (k1 k2 p1 p2): ProjectDistorted's inverse.
+std::vector<Eigen::Vector2d> UndistortPixels(const PinholeCamera& camera,
+                                             const std::array<double, 4>& distortion,
+                                             const std::vector<Eigen::Vector2d>& pixels);
+
 // The photo `path` of `view`, read upright by the photo reader (photo.h);
 // InputError naming the file when it is missing, unreadable, damaged or not
 // the size its camera in `cameras_file` says.

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
 namespace docunfold::optimize {
@@ -34,17 +33,6 @@ float Bilinear(const cv::Mat1f& m, double x, double y) {
   const double fx = std::clamp(x - x0, 0.0, 1.0), fy = std::clamp(y - y0, 0.0, 1.0);
   return float((1 - fy) * ((1 - fx) * m(y0, x0) + fx * m(y0, x0 + 1)) +
                fy * ((1 - fx) * m(y0 + 1, x0) + fx * m(y0 + 1, x0 + 1)));
-}
-
-// The undistorted pixel of a photo pixel (the photo's own K).
-Eigen::Vector2d Undistort(const HullView& v, const Eigen::Vector2d& pixel) {
-  cv::Mat K(3, 3, CV_64F), dist(1, 4, CV_64F);
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) K.at<double>(r, c) = v.camera.K(r, c);
-  for (int i = 0; i < 4; ++i) dist.at<double>(0, i) = v.distortion[i];
-  std::vector<cv::Point2d> in{{pixel.x(), pixel.y()}}, out;
-  cv::undistortPoints(in, out, K, dist, cv::noArray(), K);
-  return {out[0].x, out[0].y};
 }
 
 }  // namespace
@@ -134,7 +122,8 @@ std::vector<isometry::Marker> HullMarkers(const MeshPair& meshes, const PinholeC
         // The outline's nearest point and its tangent, as undistorted pixels.
         const Eigen::Vector2d edge = *photo - d * grad;
         const Eigen::Vector2d tangent(-grad.y(), grad.x());
-        const Eigen::Vector2d e0 = Undistort(v, edge), e1 = Undistort(v, edge + 10 * tangent);
+        const auto e = UndistortPixels(v.camera, v.distortion, {edge, edge + 10 * tangent});
+        const Eigen::Vector2d e0 = e[0], e1 = e[1];
         const Eigen::Vector3d d0 = v.camera.RayDirection(e0);
         const Eigen::Vector3d d1 = v.camera.RayDirection(e1);
         Eigen::Vector3d across = d0.cross(d1);

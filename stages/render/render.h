@@ -25,6 +25,7 @@
 #include "common/texture_fusion.h"
 #include "stages/render/cut_sides.h"
 #include "stages/render/print_straightening.h"
+#include "stages/render/view_sides.h"
 
 namespace docunfold::render {
 
@@ -132,6 +133,9 @@ struct RenderOptions {
   // 0: the crop is inscribed in the lines, at each line's tighter end.
   double warp_max_slant_deg = 3;
   CutSideOptions cut_sides;
+  // A side the reference photo sees edge-on, placed from the photo that
+  // sees it best (view_sides.h).
+  EdgeOnSideOptions edge_on_sides;
   // kRemove: divide out the light's shading (folds, curls, shadows) so the
   // paper comes out one even colour, as a scan (common/shading.h); kKeep:
   // the reference photo's brightness, as the paper's method renders it (and
@@ -204,6 +208,13 @@ struct SideFit {
   // after the deskew turn), which then bounds the crop.
   bool scattered = false;
   double median_bound = 0;
+  // Median |cos| between the reference's rays along a used side and M's
+  // normal where they meet it, and the other photo that placed the side
+  // because the reference sees it edge-on (view_sides.h; empty: the
+  // reference), with its own median |cos| there.
+  std::optional<double> reference_cos;  // nullopt: no ray along it meets M
+  std::string placed_by;
+  double placed_by_cos = 0;
 };
 
 struct RenderResult {

@@ -42,6 +42,25 @@ std::array<std::vector<Eigen::Vector2d>, 4> FitSides(const RenderOptions& option
                          std::to_string(r->sides[i].rms / flat_diagonal) + " of M' diagonal)";
     }
   }
+  // A side the reference sees edge-on, from the photo that sees it best.
+  if (options.edge_on_sides.max_cos > 0) {
+    const std::array<SidePlacement, 4> placed = PlaceEdgeOnSides(
+        in.meshes, cam, lookup, in.boundary, r->sides, in.views, options.edge_on_sides);
+    for (int i = 0; i < 4; ++i) {
+      r->sides[i].reference_cos = placed[i].reference_cos;
+      if (placed[i].view.empty()) continue;
+      SideFit fit = FitSideLine(i, true, placed[i].flat, int(placed[i].flat.size()));
+      if (!fit.used || fit.rms > kMaxSideRms * flat_diagonal) continue;
+      fit.reference_cos = placed[i].reference_cos;
+      fit.placed_by = placed[i].view;
+      fit.placed_by_cos = placed[i].view_cos;
+      Log(std::string(kSideNames[i]) + " side: the reference photo sees it edge-on (|cos| " +
+          Fixed(*fit.reference_cos, 2) + "), placed from " + fit.placed_by + " (|cos| " +
+          Fixed(fit.placed_by_cos, 2) + ")");
+      r->sides[i] = fit;
+      side_points[i] = placed[i].flat;
+    }
+  }
   return side_points;
 }
 

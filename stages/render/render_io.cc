@@ -119,6 +119,8 @@ Json RenderReport(const RenderOptions& options, const RenderInputs& in, const Re
       j["direction"] = Vec2(s.direction);
       j["rms"] = s.rms;
       j["warped"] = r.warped_sides[i];
+      if (s.reference_cos) j["reference_cos"] = *s.reference_cos;
+      if (!s.placed_by.empty()) j["placed_by"] = {{"view", s.placed_by}, {"cos", s.placed_by_cos}};
     }
     if (!s.note.empty()) j["note"] = s.note;
     if (s.scattered) j["median_bound"] = s.median_bound;

@@ -1,0 +1,149 @@
+// A page side the reference photo sees edge-on is placed from the photo that
+// sees it squarely (view_sides.h): a page whose right half curls through a
+// quarter turn towards the reference camera, and an M whose curl is a little
+// too wide.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+
+#include "common/raster.h"
+#include "stages/render/crop.h"
+#include "stages/render/render.h"
+#include "stages/render/view_sides.h"
+#include "tests/render/render_fixtures.h"
+
+namespace docunfold::testing {
+namespace {
+
+constexpr double kPageW = 0.42, kPageH = 0.56, kHalf = kPageW / 2;
+
+// The page of MakeScene's geometry (the reference camera at the origin
+// looking down +z, the page at `origin` tilted 20° about x), its right half
+// bent into a cylinder of `radius`; M' runs `past` beyond the page's right
+// edge, along the same curl. `drift` moves the curl outwards (along x), by
+// that much at the page's edge and by the square of the way there before it.
+MeshPair CurledPage(double radius, double past, double drift = 0) {
+  const Eigen::Vector3d origin(-0.22, -0.3, 1.0);
+  const Eigen::Matrix3d tilt =
+      Eigen::AngleAxisd(20 * M_PI / 180, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  MeshPair m;
+  const int nx = 61, ny = 57;
+  m.grid = {nx, ny};
+  for (int r = 0; r < ny; ++r)
+    for (int c = 0; c < nx; ++c) {
+      const double a = (kPageW + past) * c / (nx - 1), b = kPageH * r / (ny - 1);
+      Eigen::Vector3d local(a, b, 0);
+      if (a > kHalf) {
+        const double theta = (a - kHalf) / radius;
+        const double way = (a - kHalf) / kHalf;
+        local = {kHalf + radius * std::sin(theta) + drift * way * way, b,
+                 -radius * (1 - std::cos(theta))};
+      }
+      m.mesh3d.push_back(origin + tilt * local);
+      m.mesh2d.emplace_back(a, b);
+    }
+  return m;
+}
+
+// A camera at `center` looking at `target`, image y along the world's +y.
+PinholeCamera LookingAt(const Eigen::Vector3d& center, const Eigen::Vector3d& target) {
+  PinholeCamera c;
+  c.image = "view_01.png";
+  c.width = 640;
+  c.height = 480;
+  c.K << 500, 0, 319.5, 0, 500, 239.5, 0, 0, 1;
+  const Eigen::Vector3d forward = (target - center).normalized();
+  const Eigen::Vector3d right = Eigen::Vector3d::UnitY().cross(forward).normalized();
+  const Eigen::Vector3d down = forward.cross(right);
+  c.R.row(0) = right;
+  c.R.row(1) = down;
+  c.R.row(2) = forward;
+  c.t = -c.R * center;
+  return c;
+}
+
+// The reference side i's samples on M', and its line.
+render::SideFit ReferenceSide(const MeshPair& mesh, const PinholeCamera& camera,
+                              const PixelToSurface& lookup, const Boundary& boundary, int i) {
+  int samples = 0;
+  const auto flat =
+      render::MapPolylineOntoFlat(mesh, camera, lookup, boundary.sides[i].points, 0, &samples);
+  return render::FitSideLine(i, true, flat, samples);
+}
+
+TEST(RenderEdgeOnSides, ASideTheReferenceSeesEdgeOnIsPlacedFromAPhotoThatSeesItSquarely) {
+  // The truth: the curl turns through 90° (radius = half the page / (pi/2)).
+  const double radius = kHalf / (M_PI / 2);
+  const MeshPair truth = CurledPage(radius, 0);
+  SceneOptions o;
+  o.page_w = kPageW;
+  o.page_h = kPageH;
+  o.radius = radius;
+  const SyntheticScene scene = MakeScene(o);  // its photo and outline: the true page
+  ASSERT_TRUE(scene.real[1]);
+  render::RenderInputs in = InputsOf(scene);
+  // M: the curl 2 mm (of a 420 mm page) too far out at the edge, running 5 %
+  // of the page past it.
+  in.meshes = CurledPage(radius, 0.05 * kPageW, 0.002);
+
+  // The other photo looks at the curled end, whose print faces the page's
+  // left half, from above that half.
+  const Eigen::Vector3d end = truth.mesh3d[truth.grid.Index(28, 60)];
+  render::ViewMask view;
+  view.camera = LookingAt(end + Eigen::Vector3d(-0.7, 0, -0.35), end);
+  const RasterResult raster = RasterizeMesh(view.camera, truth.mesh3d, truth.grid.Triangles());
+  view.mask = raster.face >= 0;
+  ASSERT_GT(cv::countNonZero(view.mask), 10000);
+  in.views = {view};
+
+  const PixelToSurface lookup(in.meshes, in.camera);
+  std::array<render::SideFit, 4> sides;
+  for (int i = 0; i < 4; ++i)
+    sides[i] = ReferenceSide(in.meshes, in.camera, lookup, in.boundary, i);
+  ASSERT_TRUE(sides[1].used);
+  const render::EdgeOnSideOptions options;
+  const auto placed =
+      render::PlaceEdgeOnSides(in.meshes, in.camera, lookup, in.boundary, sides, in.views, options);
+
+  // Only the right side is edge-on, and the other photo sees it squarely.
+  ASSERT_TRUE(placed[1].reference_cos);
+  EXPECT_LT(*placed[1].reference_cos, options.max_cos);
+  for (int i : {0, 2, 3}) {
+    EXPECT_GT(placed[i].reference_cos.value_or(0), options.max_cos) << i;
+    EXPECT_TRUE(placed[i].view.empty()) << i;
+  }
+  ASSERT_EQ(placed[1].view, "view_01.png");
+  EXPECT_GT(placed[1].view_cos, 0.5);
+  const render::SideFit from_view =
+      render::FitSideLine(1, true, placed[1].flat, int(placed[1].flat.size()));
+  ASSERT_TRUE(from_view.used);
+  // The true right edge is x = kPageW in M'; the reference's grazing rays
+  // put it far off on the wrong curl, the other photo's near it.
+  const double mid = kPageH / 2;
+  const double off_reference = std::abs(render::XAt(sides[1], mid) - kPageW);
+  const double off_view = std::abs(render::XAt(from_view, mid) - kPageW);
+  EXPECT_GT(off_reference, 0.01 * kPageW);
+  EXPECT_LT(off_view, 0.4 * off_reference);
+
+  // render places the side so, says so in its result, and without the
+  // option keeps the reference's.
+  const render::RenderResult r = render::Run({}, in);
+  EXPECT_EQ(r.sides[1].placed_by, "view_01.png");
+  EXPECT_LT(r.sides[1].reference_cos.value_or(1), options.max_cos);
+  for (int i : {0, 2, 3}) EXPECT_TRUE(r.sides[i].placed_by.empty()) << i;
+  render::RenderOptions off;
+  off.edge_on_sides.max_cos = 0;
+  const render::RenderResult before = render::Run(off, in);
+  EXPECT_TRUE(before.sides[1].placed_by.empty());
+  EXPECT_LT(std::abs(r.crop_x1 - kPageW), std::abs(before.crop_x1 - kPageW));
+
+  // No other photo: every side from the reference.
+  in.views.clear();
+  const auto alone =
+      render::PlaceEdgeOnSides(in.meshes, in.camera, lookup, in.boundary, sides, in.views, options);
+  for (const auto& p : alone) EXPECT_TRUE(p.view.empty());
+}
+
+}  // namespace
+}  // namespace docunfold::testing
