@@ -12,14 +12,28 @@ namespace docunfold::render {
 
 namespace {
 
-// |cos| between the ray of `pixel` and the normal of the triangle it meets.
+// cos between the ray of `pixel` and the normal of the triangle it meets
+// (by the triangle's winding): its sign tells which side of M the camera sees.
 double RayCos(const MeshPair& mesh, const PinholeCamera& camera, const SurfacePoint& at,
               const Eigen::Vector2d& pixel) {
   const Triangle t = mesh.grid.TriangleOf(at.triangle);
   const Eigen::Vector3d normal = (mesh.mesh3d[t[1]] - mesh.mesh3d[t[0]])
                                      .cross(mesh.mesh3d[t[2]] - mesh.mesh3d[t[0]])
                                      .normalized();
-  return std::abs(normal.dot(camera.RayDirection(pixel)));
+  return normal.dot(camera.RayDirection(pixel));
+}
+
+// The sign of RayCos over most of M seen from `camera`: the side of the page
+// it faces.
+double FacingSign(const MeshPair& mesh, const PinholeCamera& camera) {
+  std::vector<double> cos;
+  const Eigen::Vector3d center = camera.Center();
+  for (const Triangle& t : mesh.grid.Triangles()) {
+    const Eigen::Vector3d a = mesh.mesh3d[t[0]], b = mesh.mesh3d[t[1]], c = mesh.mesh3d[t[2]];
+    const Eigen::Vector3d normal = (b - a).cross(c - a).normalized();
+    cos.push_back(normal.dot(((a + b + c) / 3 - center).normalized()));
+  }
+  return Median(cos) < 0 ? -1.0 : 1.0;
 }
 
 // How far along the surface a unit error in M's depth moves the point a ray
@@ -61,7 +75,8 @@ std::optional<double> MedianRayCos(const MeshPair& mesh, const PinholeCamera& ca
                                    const std::vector<Eigen::Vector2d>& pixels) {
   std::vector<double> cos;
   for (const Eigen::Vector2d& pixel : pixels)
-    if (const auto at = lookup.Lookup(pixel)) cos.push_back(RayCos(mesh, camera, *at, pixel));
+    if (const auto at = lookup.Lookup(pixel))
+      cos.push_back(std::abs(RayCos(mesh, camera, *at, pixel)));
   if (cos.empty()) return std::nullopt;
   return Median(cos);
 }
@@ -86,6 +101,7 @@ std::array<SidePlacement, 4> PlaceEdgeOnSides(const MeshPair& mesh, const Pinhol
     hi = hi.cwiseMax(q);
   }
   const double near = options.near_side * (hi - lo).norm();
+  const double facing = FacingSign(mesh, reference);
   for (const ViewMask& view : views) {
     std::array<std::vector<OutlineOnMesh>, 4> on_side;
     for (const OutlineOnMesh& s : CastOutlineOntoMesh(mesh, view, options.frame_margin)) {
@@ -103,13 +119,17 @@ std::array<SidePlacement, 4> PlaceEdgeOnSides(const MeshPair& mesh, const Pinhol
           second = std::min(second, d);
         }
       }
+      // A photo that sees the page from behind there sees a fold's edge as
+      // readily as the page's (r03's flap, whose dark back one photo's
+      // mask leaves out).
+      if (s.cos * facing <= 0) continue;
       if (nearest >= 0 && edge_on[nearest] && first <= near && second >= 2 * near)
         on_side[nearest].push_back(s);
     }
     for (int i = 0; i < 4; ++i) {
       if (int(on_side[i].size()) < options.min_samples) continue;
       std::vector<double> cos;
-      for (const auto& s : on_side[i]) cos.push_back(s.cos);
+      for (const auto& s : on_side[i]) cos.push_back(std::abs(s.cos));
       const double median = Median(cos);
       const bool better = placed[i].view.empty() ? AlongSurface(median) * options.gain <=
                                                        AlongSurface(*placed[i].reference_cos)

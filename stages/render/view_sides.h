@@ -47,7 +47,7 @@ struct EdgeOnSideOptions {
 // A sample of a photo's page outline cast onto M.
 struct OutlineOnMesh {
   Eigen::Vector2d flat;  // where it lands in M'
-  double cos = 0;        // |cos| between its ray and M's normal there
+  double cos = 0;        // cos between its ray and M's normal (by the triangles' winding)
 };
 
 // The outer contour of `view`'s page mask (photo pixels away from the
@@ -73,9 +73,9 @@ struct SidePlacement {
 
 // For every used side of `sides` (fitted from the reference's boundary,
 // whose pixels are `boundary`) that the reference sees edge-on: the other
-// photo in `views` that sees M most squarely along it, with its outline
-// samples there. Sides not edge-on, or no photo much better, keep an empty
-// view.
+// photo in `views` that sees M most squarely along it, and from the side
+// the reference sees, with its outline samples there. Sides not edge-on, or no photo much better,
+// keep an empty view.
 std::array<SidePlacement, 4> PlaceEdgeOnSides(const MeshPair& mesh, const PinholeCamera& reference,
                                               const PixelToSurface& lookup,
                                               const Boundary& boundary,
