@@ -44,8 +44,9 @@ std::array<std::vector<Eigen::Vector2d>, 4> FitSides(const RenderOptions& option
   }
   // A side the reference sees edge-on, from the photo that sees it best.
   if (options.edge_on_sides.max_cos > 0) {
-    const std::array<SidePlacement, 4> placed = PlaceEdgeOnSides(
-        in.meshes, cam, lookup, in.boundary, r->sides, in.views, options.edge_on_sides);
+    const std::array<SidePlacement, 4> placed =
+        PlaceEdgeOnSides(in.meshes, cam, lookup, in.boundary, r->sides, in.views, flat_diagonal,
+                         options.edge_on_sides);
     for (int i = 0; i < 4; ++i) {
       r->sides[i].reference_cos = placed[i].reference_cos;
       if (placed[i].view.empty()) continue;

@@ -81,12 +81,10 @@ std::optional<double> MedianRayCos(const MeshPair& mesh, const PinholeCamera& ca
   return Median(cos);
 }
 
-std::array<SidePlacement, 4> PlaceEdgeOnSides(const MeshPair& mesh, const PinholeCamera& reference,
-                                              const PixelToSurface& lookup,
-                                              const Boundary& boundary,
-                                              const std::array<SideFit, 4>& sides,
-                                              const std::vector<ViewMask>& views,
-                                              const EdgeOnSideOptions& options) {
+std::array<SidePlacement, 4> PlaceEdgeOnSides(
+    const MeshPair& mesh, const PinholeCamera& reference, const PixelToSurface& lookup,
+    const Boundary& boundary, const std::array<SideFit, 4>& sides,
+    const std::vector<ViewMask>& views, double flat_diagonal, const EdgeOnSideOptions& options) {
   std::array<SidePlacement, 4> placed;
   std::array<bool, 4> edge_on{};
   for (int i = 0; i < 4; ++i) {
@@ -95,12 +93,7 @@ std::array<SidePlacement, 4> PlaceEdgeOnSides(const MeshPair& mesh, const Pinhol
     edge_on[i] = placed[i].reference_cos && *placed[i].reference_cos < options.max_cos;
   }
   if (std::none_of(edge_on.begin(), edge_on.end(), [](bool e) { return e; })) return placed;
-  Eigen::Vector2d lo = mesh.mesh2d[0], hi = lo;
-  for (const auto& q : mesh.mesh2d) {
-    lo = lo.cwiseMin(q);
-    hi = hi.cwiseMax(q);
-  }
-  const double near = options.near_side * (hi - lo).norm();
+  const double near = options.near_side * flat_diagonal;
   const double facing = FacingSign(mesh, reference);
   for (const ViewMask& view : views) {
     std::array<std::vector<OutlineOnMesh>, 4> on_side;

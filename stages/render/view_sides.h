@@ -74,13 +74,12 @@ struct SidePlacement {
 // For every used side of `sides` (fitted from the reference's boundary,
 // whose pixels are `boundary`) that the reference sees edge-on: the other
 // photo in `views` that sees M most squarely along it, and from the side
-// the reference sees, with its outline samples there. Sides not edge-on, or no photo much better,
-// keep an empty view.
-std::array<SidePlacement, 4> PlaceEdgeOnSides(const MeshPair& mesh, const PinholeCamera& reference,
-                                              const PixelToSurface& lookup,
-                                              const Boundary& boundary,
-                                              const std::array<SideFit, 4>& sides,
-                                              const std::vector<ViewMask>& views,
-                                              const EdgeOnSideOptions& options);
+// the reference sees, with its outline samples there (`flat_diagonal`: M's
+// diagonal in M', the unit of options.near_side). Sides not edge-on, or no
+// photo much better, keep an empty view.
+std::array<SidePlacement, 4> PlaceEdgeOnSides(
+    const MeshPair& mesh, const PinholeCamera& reference, const PixelToSurface& lookup,
+    const Boundary& boundary, const std::array<SideFit, 4>& sides,
+    const std::vector<ViewMask>& views, double flat_diagonal, const EdgeOnSideOptions& options);
 
 }  // namespace docunfold::render

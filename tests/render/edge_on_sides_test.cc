@@ -1,7 +1,7 @@
 // A page side the reference photo sees edge-on is placed from the photo that
 // sees it squarely (view_sides.h): a page whose right half curls through a
-// quarter turn towards the reference camera, and an M whose curl is a little
-// too wide.
+// quarter turn towards the reference camera, and an M whose curl lies a
+// little too far out.
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -98,13 +98,14 @@ TEST(RenderEdgeOnSides, ASideTheReferenceSeesEdgeOnIsPlacedFromAPhotoThatSeesItS
   in.views = {view};
 
   const PixelToSurface lookup(in.meshes, in.camera);
+  const double flat_diagonal = std::hypot(1.05 * kPageW, kPageH);  // M' spans this
   std::array<render::SideFit, 4> sides;
   for (int i = 0; i < 4; ++i)
     sides[i] = ReferenceSide(in.meshes, in.camera, lookup, in.boundary, i);
   ASSERT_TRUE(sides[1].used);
   const render::EdgeOnSideOptions options;
-  const auto placed =
-      render::PlaceEdgeOnSides(in.meshes, in.camera, lookup, in.boundary, sides, in.views, options);
+  const auto placed = render::PlaceEdgeOnSides(in.meshes, in.camera, lookup, in.boundary, sides,
+                                               in.views, flat_diagonal, options);
 
   // Only the right side is edge-on, and the other photo sees it squarely.
   ASSERT_TRUE(placed[1].reference_cos);
@@ -140,8 +141,8 @@ TEST(RenderEdgeOnSides, ASideTheReferenceSeesEdgeOnIsPlacedFromAPhotoThatSeesItS
 
   // No other photo: every side from the reference.
   in.views.clear();
-  const auto alone =
-      render::PlaceEdgeOnSides(in.meshes, in.camera, lookup, in.boundary, sides, in.views, options);
+  const auto alone = render::PlaceEdgeOnSides(in.meshes, in.camera, lookup, in.boundary, sides,
+                                              in.views, flat_diagonal, options);
   for (const auto& p : alone) EXPECT_TRUE(p.view.empty());
 }
 
