@@ -6,6 +6,7 @@
 #include <libexif/exif-data.h>
 #include <libheif/heif.h>
 
+#include <algorithm>
 #include <cmath>
 #include <csetjmp>
 #include <cstdlib>
@@ -231,8 +232,14 @@ void DecodeHeif(std::string_view bytes, const std::string& name, PhotoColor colo
   std::unique_ptr<heif_image_handle, void (*)(const heif_image_handle*)> handle(
       raw_handle, heif_image_handle_release);
   ReadHeifExif(handle.get(), &photo->metadata);
-  CheckClaimedSize(heif_image_handle_get_width(handle.get()),
-                   heif_image_handle_get_height(handle.get()), bytes.size(), name);
+  const int ispe_width = heif_image_handle_get_ispe_width(handle.get());
+  const int ispe_height = heif_image_handle_get_ispe_height(handle.get());
+  CheckClaimedSize(ispe_width, ispe_height, bytes.size(), name);
+  // A grid's canvas is as large as its own descriptor says, which libheif
+  // does not compare with the image's size ('ispe'): a file of a few hundred
+  // bytes could make it allocate gigabytes. Its limit (a side may not reach
+  // it) is used when the image is decoded.
+  heif_context_set_maximum_image_size_limit(context.get(), std::max(ispe_width, ispe_height) + 1);
   // As heif-convert does: an image without a bit depth is not decoded.
   if (heif_image_handle_get_luma_bits_per_pixel(handle.get()) < 0)
     throw PhotoError(name, true, "the image has no defined bit depth");

@@ -145,6 +145,19 @@ TEST(ReadPhoto, RefusesHeifWithoutBitDepthAtOnce) {
   }
 }
 
+// Found by the photo fuzzer: a 562-byte HEIF whose 48x32 image is a grid
+// with a 12288x8192 canvas; libheif allocated the canvas (300 MB) before its
+// one tile failed to decode. The canvas may not be larger than the image.
+TEST(ReadPhoto, RefusesHeifGridLargerThanItsImageBeforeAllocatingIt) {
+  try {
+    ReadPhoto(SourceDir() / "tests/data/photos/grid-larger-than-its-image.heic");
+    FAIL() << "decoded";
+  } catch (const PhotoError& e) {
+    EXPECT_TRUE(e.damaged()) << e.what();
+    EXPECT_NE(std::string(e.what()).find("12288x"), std::string::npos) << e.what();
+  }
+}
+
 TEST(FocalPixelsFrom35mm, UsesTheDiagonal) {
   // A 4:3 photo 4032 px wide at 26 mm equivalent (a common phone main camera).
   EXPECT_NEAR(FocalPixelsFrom35mm(26, 4032, 3024), 26 * 5040 / 43.2666, 0.5);
