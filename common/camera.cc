@@ -76,17 +76,17 @@ std::optional<Eigen::Vector2d> ProjectDistorted(const PinholeCamera& camera,
   return pixel;
 }
 
-std::vector<Eigen::Vector2d> UndistortPixels(const PinholeCamera& camera,
+std::vector<Eigen::Vector2d> UndistortPixels(const Eigen::Matrix3d& K,
                                              const std::array<double, 4>& distortion,
                                              const std::vector<Eigen::Vector2d>& pixels) {
   if (pixels.empty()) return {};
-  cv::Mat K(3, 3, CV_64F), dist(1, 4, CV_64F);
+  cv::Mat cv_K(3, 3, CV_64F), dist(1, 4, CV_64F);
   for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) K.at<double>(r, c) = camera.K(r, c);
+    for (int c = 0; c < 3; ++c) cv_K.at<double>(r, c) = K(r, c);
   for (int i = 0; i < 4; ++i) dist.at<double>(0, i) = distortion[i];
   std::vector<cv::Point2d> in, out;
   for (const auto& p : pixels) in.emplace_back(p.x(), p.y());
-  cv::undistortPoints(in, out, K, dist, cv::noArray(), K);
+  cv::undistortPoints(in, out, cv_K, dist, cv::noArray(), cv_K);
   std::vector<Eigen::Vector2d> result;
   for (const auto& p : out) result.emplace_back(p.x, p.y);
   return result;

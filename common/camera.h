@@ -84,9 +84,9 @@ std::optional<Eigen::Vector2d> ProjectDistorted(const PinholeCamera& camera,
                                                 const std::array<double, 4>& distortion,
                                                 const Eigen::Vector3d& x_world);
 
-// The undistorted pixels (in the same camera's K) of photo pixels taken
+// The undistorted pixels (in the same intrinsics K) of photo pixels taken
 // with OpenCV's distortion (k1 k2 p1 p2): ProjectDistorted's inverse.
-std::vector<Eigen::Vector2d> UndistortPixels(const PinholeCamera& camera,
+std::vector<Eigen::Vector2d> UndistortPixels(const Eigen::Matrix3d& K,
                                              const std::array<double, 4>& distortion,
                                              const std::vector<Eigen::Vector2d>& pixels);
 

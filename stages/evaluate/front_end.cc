@@ -114,15 +114,7 @@ TruthInView Undistort(const TruthInView& truth, const Undistortion& lens) {
   const cv::Mat K = ToCvK(lens.K);
   const cv::Mat dist = (cv::Mat_<double>(1, 4) << lens.coefficients[0], lens.coefficients[1],
                         lens.coefficients[2], lens.coefficients[3]);
-  auto move = [&](const Polyline& in) {
-    if (in.empty()) return in;
-    std::vector<cv::Point2d> from, to;
-    for (const auto& p : in) from.emplace_back(p.x(), p.y());
-    cv::undistortPoints(from, to, K, dist, cv::noArray(), K);
-    Polyline out;
-    for (const auto& p : to) out.emplace_back(p.x, p.y);
-    return out;
-  };
+  auto move = [&](const Polyline& in) { return UndistortPixels(lens.K, lens.coefficients, in); };
   TruthInView t = truth;
   // The same map sfm's UndistortPhoto applies to the photo.
   cv::Mat map1, map2;

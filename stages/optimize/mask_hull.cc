@@ -122,7 +122,7 @@ std::vector<isometry::Marker> HullMarkers(const MeshPair& meshes, const PinholeC
         // The outline's nearest point and its tangent, as undistorted pixels.
         const Eigen::Vector2d edge = *photo - d * grad;
         const Eigen::Vector2d tangent(-grad.y(), grad.x());
-        const auto e = UndistortPixels(v.camera, v.distortion, {edge, edge + 10 * tangent});
+        const auto e = UndistortPixels(v.camera.K, v.distortion, {edge, edge + 10 * tangent});
         const Eigen::Vector2d e0 = e[0], e1 = e[1];
         const Eigen::Vector3d d0 = v.camera.RayDirection(e0);
         const Eigen::Vector3d d1 = v.camera.RayDirection(e1);

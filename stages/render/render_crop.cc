@@ -25,6 +25,9 @@ std::array<std::vector<Eigen::Vector2d>, 4> FitSides(const RenderOptions& option
     flat_hi = flat_hi.cwiseMax(q);
   }
   const double flat_diagonal = (flat_hi - flat_lo).norm();
+  // A side whose samples scatter about their line is not a straight page
+  // edge seen on M (the boundary runs over a fold, or M is far off there).
+  auto scatters = [&](const SideFit& fit) { return fit.rms > kMaxSideRms * flat_diagonal; };
   std::array<std::vector<Eigen::Vector2d>, 4> side_points;
   const double snap_px = options.side_snap * std::hypot(cam.width, cam.height);
   for (int i = 0; i < 4; ++i) {
@@ -33,9 +36,7 @@ std::array<std::vector<Eigen::Vector2d>, 4> FitSides(const RenderOptions& option
     if (side.real)
       side_points[i] = MapPolylineOntoFlat(in.meshes, cam, lookup, side.points, snap_px, &samples);
     r->sides[i] = FitSideLine(i, side.real, side_points[i], samples);
-    // A side whose samples scatter about their line is not a straight page
-    // edge seen on M (the boundary runs over a fold, or M is far off there).
-    if (r->sides[i].used && r->sides[i].rms > kMaxSideRms * flat_diagonal) {
+    if (r->sides[i].used && scatters(r->sides[i])) {
       r->sides[i].used = false;
       r->sides[i].scattered = true;
       r->sides[i].note = "samples scatter about their line (rms " +
@@ -51,7 +52,7 @@ std::array<std::vector<Eigen::Vector2d>, 4> FitSides(const RenderOptions& option
       r->sides[i].reference_cos = placed[i].reference_cos;
       if (placed[i].view.empty()) continue;
       SideFit fit = FitSideLine(i, true, placed[i].flat, int(placed[i].flat.size()));
-      if (!fit.used || fit.rms > kMaxSideRms * flat_diagonal) continue;
+      if (!fit.used || scatters(fit)) continue;
       fit.reference_cos = placed[i].reference_cos;
       fit.placed_by = placed[i].view;
       fit.placed_by_cos = placed[i].view_cos;

@@ -63,7 +63,8 @@ std::vector<OutlineOnMesh> CastOutlineOntoMesh(const MeshPair& mesh, const ViewM
       photo_pixels.emplace_back(p.x + 0.5, p.y + 0.5);
   const PixelToSurface lookup(mesh, view.camera);
   std::vector<OutlineOnMesh> out;
-  for (const Eigen::Vector2d& pixel : UndistortPixels(view.camera, view.distortion, photo_pixels)) {
+  for (const Eigen::Vector2d& pixel :
+       UndistortPixels(view.camera.K, view.distortion, photo_pixels)) {
     const auto at = lookup.Lookup(pixel);
     if (at) out.push_back({PointOnMesh2d(mesh, *at), RayCos(mesh, view.camera, *at, pixel)});
   }
