@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
 
 #include "common/atomic_file.h"
 #include "common/errors.h"
@@ -80,9 +81,8 @@ std::vector<Eigen::Vector2d> UndistortPixels(const Eigen::Matrix3d& K,
                                              const std::array<double, 4>& distortion,
                                              const std::vector<Eigen::Vector2d>& pixels) {
   if (pixels.empty()) return {};
-  cv::Mat cv_K(3, 3, CV_64F), dist(1, 4, CV_64F);
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) cv_K.at<double>(r, c) = K(r, c);
+  cv::Mat cv_K, dist(1, 4, CV_64F);
+  cv::eigen2cv(K, cv_K);
   for (int i = 0; i < 4; ++i) dist.at<double>(0, i) = distortion[i];
   std::vector<cv::Point2d> in, out;
   for (const auto& p : pixels) in.emplace_back(p.x(), p.y());

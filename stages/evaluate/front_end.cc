@@ -6,6 +6,7 @@
 #include <limits>
 #include <map>
 #include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -45,13 +46,6 @@ void WalkPolyline(const Polyline& line, double step_px, Visit visit) {
 // part / whole, or `if_empty` when there is nothing to share.
 double Share(double part, double whole, double if_empty) {
   return whole > 0 ? part / whole : if_empty;
-}
-
-cv::Mat ToCvK(const Eigen::Matrix3d& K) {
-  cv::Mat out(3, 3, CV_64F);
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) out.at<double>(r, c) = K(r, c);
-  return out;
 }
 
 }  // namespace
@@ -111,7 +105,8 @@ bool Undistortion::Any() const {
 
 TruthInView Undistort(const TruthInView& truth, const Undistortion& lens) {
   if (!lens.Any()) return truth;
-  const cv::Mat K = ToCvK(lens.K);
+  cv::Mat K;
+  cv::eigen2cv(lens.K, K);
   const cv::Mat dist = (cv::Mat_<double>(1, 4) << lens.coefficients[0], lens.coefficients[1],
                         lens.coefficients[2], lens.coefficients[3]);
   auto move = [&](const Polyline& in) { return UndistortPixels(lens.K, lens.coefficients, in); };
