@@ -11,7 +11,8 @@ enum class PointSource : uint8_t {
   kTexture = 1,  // print followed by optical flow from the reference view
   kOutline = 2,  // the page's real sides matched along epipolar lines
   kStep = 3,     // shading steps of blank paper (a fold's crease)
+  kSwept = 4,    // print found by sweeping depth along the reference's rays
 };
-constexpr int kPointSourceCount = 4;
+constexpr int kPointSourceCount = 5;
 
 }  // namespace docunfold

@@ -71,6 +71,14 @@ void DeclareOptions(OptionTable& table, DensifyOptions* o) {
   table.Value("step-side-radius", &o->steps.side_radius_px, 1.0, 10000.0,
               "steps: a point must lie on the surface of the known points within this "
               "radius on each side of its step (working-copy px)");
+  table.Switch("sweep", &o->sweep.enabled,
+               "swept points: print no other pass reached, found by sweeping depth along the "
+               "reference's rays around the surface of the points so far (NCC in the other "
+               "photos)");
+  table.Value("sweep-rounds", &o->sweep.rounds, 1, 100,
+              "sweep: rounds, each around the surface of the points so far");
+  table.Value("sweep-min-ncc", &o->sweep.min_ncc, -1.0, 1.0,
+              "sweep: NCC each of the two best photos must reach at the chosen depth");
   table.Switch("keep-hidden", &o->keep_hidden,
                "keep sfm points of the document region that the reference view shows in "
                "another colour (else they are left out as behind the page)");
@@ -245,8 +253,8 @@ SfmPoints StartWithSfmPoints(const DensifyInputs& in, const DensifyOptions& o,
       "docunfold densify: sfm's points (source 0; those the reference view " +
           in.cameras.reference +
           " shows in another colour, behind the page, left out), then points triangulated "
-          "from the texture of the page (1), from its outline (2) and from shading steps of "
-          "blank paper (3), cameras of 10_sfm held fixed",
+          "from the texture of the page (1), from its outline (2), from shading steps of "
+          "blank paper (3) and found by sweeping depth (4), cameras of 10_sfm held fixed",
       "frame: that of 10_sfm/cameras.json (camera of the reference view " + in.cameras.reference +
           ")"};
   return sfm;
@@ -367,6 +375,14 @@ DensifyResult Run(const DensifyInputs& in, const DensifyOptions& o) {
         " texture points more with the other photos brought onto the reference through the "
         "points' surface, " +
         Fixed(r.seconds_surface, 2) + " s");
+  if (o.sweep.enabled && matching) {
+    std::vector<Eigen::Vector3d> known = sfm.page_points;
+    known.insert(known.end(), r.points.vertices.begin() + first_new_point, r.points.vertices.end());
+    detail::AddSweptPoints(w.ref, w.others, w.region, w.page, known, in.reference, o.sweep, &r);
+    r.seconds_sweep = timer.Mark("sweep");
+    Log(std::to_string(r.sweep.points) + " swept points from " +
+        std::to_string(r.sweep.candidates) + " candidates, " + Fixed(r.seconds_sweep, 2) + " s");
+  }
   r.seconds_total = timer.Total();
   return r;
 }

@@ -11,7 +11,9 @@
 //    a sharp, straight step there too); a depth that at least two other
 //    photos agree on, and no other depth does as well, is triangulated;
 //  - shading steps: steps of blank paper (a fold's crease) on copies blurred
-//    so that print is gone, matched like the outline.
+//    so that print is gone, matched like the outline;
+//  - swept: print the others missed, found by sweeping depth along the
+//    reference's rays around the surface of the points so far (SweepOptions).
 // Blank paper gives SIFT nothing, so COLMAP's cloud leaves margins and flaps
 // empty; their outline points and the text's points fill most of that.
 //
@@ -20,7 +22,7 @@
 //                behind the page in the reference view (HiddenOptions), then
 //                the new ones; x y z, red green blue, track_length,
 //                reprojection_error (pixels of the working copies), source
-//                (PointSource: 0 sfm, 1 texture, 2 outline, 3 step)
+//                (PointSource: 0 sfm, 1 texture, 2 outline, 3 step, 4 swept)
 //   points.json  docunfold.points: counts, per-view statistics, options, times
 //   overlay.png  the reference image with the points by source
 #pragma once
@@ -156,6 +158,42 @@ struct HiddenOptions {
   int window_px = 1;  // nearest colour within this many pixels of the projection
 };
 
+// Points where no other pass reached: a panel the reference sees at a
+// grazing angle shows its print squeezed, and neither the flow nor the
+// edges match it. Each printed reference patch there is carried into the
+// other photos through the plane of the points' own surface (DepthField,
+// planar) at a series of depths along its ray and scored by NCC; in
+// `rounds` rounds, each around the surface of the points so far (see
+// docs/decisions/densify.md, "Points found by sweeping depth").
+struct SweepOptions {
+  bool enabled = true;  // swept points at all
+  int rounds = 3;
+  double step_px = 4;        // candidate grid (working-copy px)
+  double min_gap_px = 12;    // candidates at least this far from every point so far
+  int patch_radius = 4;      // 9 x 9 patches ...
+  int edge_gap_px = 3;       // ... at least this far inside the page's mask
+  double min_variance = 25;  // grey variance of the patch (grey levels squared)
+  // Print, not a straight line: the structure tensor's smaller eigenvalue
+  // (7 x 7) at least `min_corner` of its 95th percentile over the page, and
+  // over `isotropy_window` px at least `min_isotropy` of the larger one. A
+  // dashed rule or a crease is one-dimensional and its depth slides along it.
+  double min_corner = 0.05;
+  double min_isotropy = 0.2;
+  int isotropy_window = 15;
+  double depth_range = 0.15;   // swept over +- this fraction of the surface's depth
+  int depth_steps = 81;        // uniform in 1/depth
+  double min_ncc = 0.6;        // each of the two best photos at the peak
+  int unique_steps = 3;        // no depth more than this many steps from the peak ...
+  double unique_margin = 0.1;  // ... scores within this of it
+  // A point's depth / surface depth within this of the median of the found
+  // candidates within `neighbour_radius_px` (at least 3 of them).
+  double max_ratio_deviation = 0.01;
+  double neighbour_radius_px = 24;
+  double visibility_slack = 0.02;  // depth-buffer tolerance in the other photos (fraction)
+  int surface_neighbours = 16;     // DepthField's planar fit
+  double surface_grid_px = 8;      // the surface's grid (working-copy px)
+};
+
 struct DensifyOptions {
   fs::path data_dir;  // data set folder (with images/)
   fs::path sfm_dir;   // 10_sfm/
@@ -169,6 +207,7 @@ struct DensifyOptions {
   TextureOptions texture;
   OutlineOptions outline;
   StepOptions steps;
+  SweepOptions sweep;
   // Keep the sfm points the reference view shows in another colour
   // (HiddenOptions) instead of leaving them out.
   bool keep_hidden = false;
@@ -210,7 +249,11 @@ struct EdgeCounts {
 struct DensifyResult {
   PlyData points;  // sfm's points, then texture, outline and step points
   int sfm_points = 0, sfm_points_in_region = 0, texture_points = 0;
-  int texture_points_surface = 0;       // of texture_points, from the second pass
+  int texture_points_surface = 0;  // of texture_points, from the second pass
+  struct {
+    int candidates = 0;  // reference pixels swept, over all rounds
+    int points = 0;
+  } sweep;
   std::vector<Eigen::Vector3d> hidden;  // sfm points left out (HiddenOptions)
   int texture_samples = 0;              // textured grid pixels in the region
   EdgeCounts outline;                   // samples on the real sides (OutlineOptions)
@@ -218,7 +261,7 @@ struct DensifyResult {
   double working_scale = 1;             // working copies / photos
   std::vector<ViewStats> views;
   double seconds_reading = 0, seconds_texture = 0, seconds_outline = 0, seconds_surface = 0,
-         seconds_steps = 0, seconds_total = 0;
+         seconds_steps = 0, seconds_sweep = 0, seconds_total = 0;
   std::vector<std::string> warnings;
 };
 

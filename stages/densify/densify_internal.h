@@ -14,6 +14,7 @@
 #include "common/page_files.h"
 #include "common/ply.h"
 #include "common/point_source.h"
+#include "common/raster.h"
 #include "stages/densify/densify.h"
 
 namespace docunfold::densify::detail {
@@ -90,6 +91,15 @@ void AddSurfaceTexturePoints(const View& ref, const std::vector<View>& others,
                              const cv::Mat1b& region, const std::vector<Eigen::Vector3d>& known,
                              const cv::Mat& reference_bgr, const TextureOptions& o,
                              std::vector<Track>* tracks, DensifyResult* result);
+
+// --- swept points (swept_points.cc) -----------------------------------------
+
+// Points on the print of `page` that no point is near yet, found by sweeping
+// depth around the surface of `known` points (over `region`) and checked in
+// the other views (SweepOptions); appended to result->points.
+void AddSweptPoints(const View& ref, const std::vector<View>& others, const cv::Mat1b& region,
+                    const cv::Mat1b& page, const std::vector<Eigen::Vector3d>& known,
+                    const cv::Mat& reference_bgr, const SweepOptions& o, DensifyResult* result);
 
 // --- outline and shading-step points (edge_points.cc) ------------------------
 

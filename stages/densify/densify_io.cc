@@ -50,14 +50,16 @@ DensifyInputs ReadInputs(const DensifyOptions& o) {
 namespace {
 
 // The reference image dimmed, the points by source, the hidden ones as red
-// crosses, and a legend (without shading steps when `steps_enabled` is off).
-cv::Mat DrawOverlay(const DensifyInputs& in, const DensifyResult& r, bool steps_enabled) {
+// crosses, and a legend (without the passes `options` turns off).
+cv::Mat DrawOverlay(const DensifyInputs& in, const DensifyResult& r,
+                    const DensifyOptions& options) {
   cv::Mat overlay = in.reference * 0.55;
   const PinholeCamera& ref = *in.cameras.Find(in.cameras.reference);
   const double radius_scale = std::max(1.0, std::max(ref.width, ref.height) / 1600.0);
-  // By PointSource: sfm, texture, outline, step.
+  // By PointSource: sfm, texture, outline, step, swept.
   const cv::Scalar colours[kPointSourceCount] = {cv::Scalar(255, 200, 0), cv::Scalar(80, 220, 80),
-                                                 cv::Scalar(255, 0, 255), cv::Scalar(0, 230, 255)};
+                                                 cv::Scalar(255, 0, 255), cv::Scalar(0, 230, 255),
+                                                 cv::Scalar(0, 140, 255)};
   const std::vector<double>& source = r.points.properties[2].values;
   for (int pass = 0; pass < kPointSourceCount; ++pass)
     for (size_t i = 0; i < r.points.vertices.size(); ++i) {
@@ -86,15 +88,17 @@ cv::Mat DrawOverlay(const DensifyInputs& in, const DensifyResult& r, bool steps_
   const double font = 0.8 * radius_scale;
   const int thick = int(std::lround(2 * radius_scale));
   const int sfm_kept = r.sfm_points_in_region - int(r.hidden.size());
-  const std::string legend[5] = {"sfm " + std::to_string(sfm_kept),
+  const std::string legend[6] = {"sfm " + std::to_string(sfm_kept),
                                  "texture " + std::to_string(r.texture_points),
                                  "outline " + std::to_string(r.outline.points),
                                  "shading steps " + std::to_string(r.steps.points),
+                                 "swept " + std::to_string(r.sweep.points),
                                  "hidden (left out) " + std::to_string(r.hidden.size())};
-  const cv::Scalar legend_colours[5] = {colours[0], colours[1], colours[2], colours[3],
-                                        hidden_colour};
-  for (int i = 0, row = 0; i < 5; ++i) {
-    if (i == int(PointSource::kStep) && !steps_enabled) continue;
+  const cv::Scalar legend_colours[6] = {colours[0], colours[1], colours[2],
+                                        colours[3], colours[4], hidden_colour};
+  for (int i = 0, row = 0; i < 6; ++i) {
+    if (i == int(PointSource::kStep) && !options.steps.enabled) continue;
+    if (i == int(PointSource::kSwept) && !options.sweep.enabled) continue;
     cv::putText(overlay, legend[i],
                 cv::Point(int(20 * radius_scale), int((40 + 34 * row++) * radius_scale)),
                 cv::FONT_HERSHEY_SIMPLEX, font, legend_colours[i], thick, cv::LINE_AA);
@@ -121,10 +125,12 @@ Json PointsJson(const DensifyInputs& in, const DensifyResult& r, const Json& opt
                    {"texture_surface_prewarp", r.texture_points_surface},
                    {"outline", r.outline.points},
                    {"steps", r.steps.points},
+                   {"swept", r.sweep.points},
                    {"total", r.points.vertices.size()}};
   doc["texture"] = {{"samples", r.texture_samples}};
   doc["outline"] = CountsJson(r.outline);
   doc["steps"] = CountsJson(r.steps);
+  doc["sweep"] = {{"candidates", r.sweep.candidates}};
   doc["views"] = Json::array();
   for (const ViewStats& v : r.views)
     doc["views"].push_back({{"image", v.image},
@@ -136,7 +142,8 @@ Json PointsJson(const DensifyInputs& in, const DensifyResult& r, const Json& opt
   doc["warnings"] = r.warnings;
   doc["seconds"] = {{"reading", r.seconds_reading}, {"texture", r.seconds_texture},
                     {"outline", r.seconds_outline}, {"texture_surface_prewarp", r.seconds_surface},
-                    {"steps", r.seconds_steps},     {"total", r.seconds_total}};
+                    {"steps", r.seconds_steps},     {"sweep", r.seconds_sweep},
+                    {"total", r.seconds_total}};
   return doc;
 }
 
@@ -146,7 +153,7 @@ void WriteOutputs(const DensifyInputs& in, const DensifyResult& r, const Densify
                   const Json& options_record) {
   EnsureDirectory(o.out_dir);
   WritePly(o.out_dir / "points.ply", r.points);
-  WriteImageAtomic(o.out_dir / "overlay.png", DrawOverlay(in, r, o.steps.enabled),
+  WriteImageAtomic(o.out_dir / "overlay.png", DrawOverlay(in, r, o),
                    {cv::IMWRITE_PNG_COMPRESSION, 1});
   WriteJsonAtomic(o.out_dir / "points.json", PointsJson(in, r, options_record));
 }

@@ -10,7 +10,8 @@ int main(int argc, char** argv) {
       "Adds 3D points of the page to sfm's sparse cloud, cameras held fixed: "
       "text and print followed from the reference view into the other photos by "
       "optical flow, and the page's outline and the shading steps of its blank paper "
-      "(a fold's crease) matched along epipolar lines. Writes "
+      "(a fold's crease) matched along epipolar lines, and print the others missed found "
+      "by sweeping depth around the surface of those points. Writes "
       "points.ply (sfm's points first), points.json and overlay.png."};
   OptionTable table(app);
   densify::DensifyOptions o;
@@ -31,6 +32,7 @@ int main(int argc, char** argv) {
         std::to_string(r.hidden.size()) + " hidden behind the page left out) + " +
         std::to_string(r.texture_points) + " texture + " + std::to_string(r.outline.points) +
         " outline" + (o.steps.enabled ? " + " + std::to_string(r.steps.points) + " step" : "") +
-        " points, " + Fixed(r.seconds_total, 2) + " s");
+        (o.sweep.enabled ? " + " + std::to_string(r.sweep.points) + " swept" : "") + " points, " +
+        Fixed(r.seconds_total, 2) + " s");
   });
 }

@@ -262,8 +262,8 @@ void MeshSection(const ReportOptions& o, const Json& cameras, Page* page, fs::pa
     if (!points_overlay.empty()) {
       const Json counts = TryJson(o.work / "25_points/points.json");
       std::string caption =
-          "The points fitted (25_points/overlay.png): sfm's (blue), texture "
-          "(green) and outline (magenta) points of densify.";
+          "The points fitted (25_points/overlay.png): sfm's (blue), and densify's texture "
+          "(green), outline (magenta), shading-step (yellow) and swept (orange) points.";
       caption += PointsCounts(counts);
       page->Add(Figure(InlineImage(points_overlay, o.figure_width / 2 + 100, "points"), caption));
     }

@@ -129,7 +129,8 @@ std::string PointsCounts(const Json& points) {
     return std::to_string(n.get<long long>());
   };
   return " " + count("sfm_in_region") + " sfm points on the page, " + count("texture") +
-         " texture, " + count("outline") + " outline.";
+         " texture, " + count("outline") + " outline, " + count("steps") + " shading-step, " +
+         count("swept") + " swept.";
 }
 
 std::string PdfWordsSvg(const cv::Mat& page_image, const Json& pdf, int width) {

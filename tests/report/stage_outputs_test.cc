@@ -81,7 +81,7 @@ TEST(DrawFeatureLines, RejectsQuarterTurnsThatAreNotAnInteger) {
 
 TEST(PointsCounts, RejectsCountsThatAreNotIntegers) {
   EXPECT_EQ(PointsCounts(Json::parse(R"({"points": {"sfm_in_region": 3, "texture": 4}})")),
-            " 3 sfm points on the page, 4 texture, 0 outline.");
+            " 3 sfm points on the page, 4 texture, 0 outline, 0 shading-step, 0 swept.");
   try {
     PointsCounts(Json::parse(R"({"points": {"texture": 1e300}})"));
     ADD_FAILURE() << "counted without error";
