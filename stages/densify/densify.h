@@ -164,7 +164,7 @@ struct HiddenOptions {
 // other photos through the plane of the points' own surface (DepthField,
 // planar) at a series of depths along its ray and scored by NCC; in
 // `rounds` rounds, each around the surface of the points so far (see
-// docs/decisions/densify.md, "Points found by sweeping depth").
+// docs/decisions/densify.md, "Swept points").
 struct SweepOptions {
   bool enabled = true;  // swept points at all
   int rounds = 3;
