@@ -6,10 +6,12 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <memory>
 #include <opencv2/core.hpp>
 #include <vector>
 
 #include "common/camera.h"
+#include "common/depth_field.h"
 #include "common/image_sampling.h"
 #include "common/page_files.h"
 #include "common/ply.h"
@@ -64,6 +66,19 @@ bool TriangulateChecked(const std::vector<Observation>& obs, double max_error, d
                         Eigen::Vector3d* point, double* mean_error);
 
 // --- texture points (texture_points.cc) -------------------------------------
+
+// Structure-tensor minimum eigenvalue (7 x 7) of `grey` (corner strength:
+// print has it, blank paper and straight edges little), and in `threshold`
+// `fraction` of its 95th percentile over `region`. Empty when `region` is.
+cv::Mat1f CornerStrength(const cv::Mat1b& grey, const cv::Mat1b& region, double fraction,
+                         double* threshold);
+
+// The depth the `known` points give each pixel of `camera` (DepthField,
+// planar over the `neighbours` nearest, RBF scale `scale_px`); nullptr with
+// fewer than 16 of them in front of it.
+std::unique_ptr<DepthField> SurfaceOfPoints(const PinholeCamera& camera,
+                                            const std::vector<Eigen::Vector3d>& known,
+                                            int neighbours, double scale_px);
 
 // A textured sample of the reference view and where the flow found it in
 // the other views; `done` once it is triangulated.

@@ -7,7 +7,6 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "common/depth_field.h"
 #include "common/raster.h"
 #include "common/statistics.h"
 #include "stages/densify/densify_internal.h"
@@ -45,17 +44,10 @@ double Ncc(const std::vector<float>& a, const std::vector<float>& b) {
 void PointsSurface(const View& ref, const cv::Mat1b& region,
                    const std::vector<Eigen::Vector3d>& known, const SweepOptions& o,
                    std::vector<Eigen::Vector3d>* vertices, std::vector<Triangle>* triangles) {
-  std::vector<Eigen::Vector2d> pixels;
-  std::vector<double> depths;
-  for (const Eigen::Vector3d& X : known) {
-    const Eigen::Vector3d xc = ref.camera.CamFromWorld(X);
-    if (!(xc.z() > 0)) continue;
-    pixels.push_back(ref.camera.ProjectCam(xc));
-    depths.push_back(xc.z());
-  }
-  if (pixels.size() < size_t(o.surface_neighbours)) return;
-  const DepthField depth(pixels, depths, o.surface_neighbours, 2 * o.surface_grid_px,
-                         DepthModel::kPlanar, o.surface_neighbours);
+  const std::unique_ptr<DepthField> surface =
+      SurfaceOfPoints(ref.camera, known, o.surface_neighbours, 2 * o.surface_grid_px);
+  if (!surface) return;
+  const DepthField& depth = *surface;
   cv::Mat1b grown;
   cv::dilate(region, grown, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(9, 9)));
   const cv::Rect box = cv::boundingRect(grown);
@@ -109,15 +101,9 @@ std::vector<Candidate> Candidates(const View& ref, const cv::Mat1b& page,
   ref.grey.convertTo(grey, CV_32F);
   cv::blur(grey, mean, cv::Size(2 * r + 1, 2 * r + 1));
   cv::blur(grey.mul(grey), mean_sq, cv::Size(2 * r + 1, 2 * r + 1));
-  cv::Mat1f corner;
-  cv::cornerMinEigenVal(ref.grey, corner, 7, 3);
-  std::vector<float> page_corner;
-  for (int y = 0; y < page.rows; ++y)
-    for (int x = 0; x < page.cols; ++x)
-      if (page(y, x)) page_corner.push_back(corner(y, x));
-  if (page_corner.empty()) return {};
-  const size_t q95 = page_corner.size() * 95 / 100;
-  const double min_corner = o.min_corner * NthSmallest(std::move(page_corner), q95);
+  double min_corner = 0;
+  const cv::Mat1f corner = CornerStrength(ref.grey, page, o.min_corner, &min_corner);
+  if (corner.empty()) return {};
   cv::Mat eigen;  // per pixel: l1, l2, eigenvectors
   cv::cornerEigenValsAndVecs(ref.grey, eigen, o.isotropy_window, 3);
 

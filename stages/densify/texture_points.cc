@@ -12,6 +12,37 @@
 #include "stages/densify/densify_internal.h"
 
 namespace docunfold::densify::detail {
+
+cv::Mat1f CornerStrength(const cv::Mat1b& grey, const cv::Mat1b& region, double fraction,
+                         double* threshold) {
+  cv::Mat1f strength;
+  cv::cornerMinEigenVal(grey, strength, 7, 3);
+  std::vector<float> values;
+  for (int y = 0; y < region.rows; ++y)
+    for (int x = 0; x < region.cols; ++x)
+      if (region(y, x)) values.push_back(strength(y, x));
+  if (values.empty()) return {};
+  const size_t q95 = values.size() * 95 / 100;
+  *threshold = fraction * NthSmallest(std::move(values), q95);
+  return strength;
+}
+
+std::unique_ptr<DepthField> SurfaceOfPoints(const PinholeCamera& camera,
+                                            const std::vector<Eigen::Vector3d>& known,
+                                            int neighbours, double scale_px) {
+  std::vector<Eigen::Vector2d> pixels;
+  std::vector<double> depths;
+  for (const Eigen::Vector3d& X : known) {
+    const Eigen::Vector3d xc = camera.CamFromWorld(X);
+    if (!(xc.z() > 0)) continue;
+    pixels.push_back(camera.ProjectCam(xc));
+    depths.push_back(xc.z());
+  }
+  if (pixels.size() < 16) return nullptr;
+  return std::make_unique<DepthField>(pixels, depths, neighbours, scale_px, DepthModel::kPlanar,
+                                      neighbours);
+}
+
 namespace {
 
 // Homography taking reference pixels of the page to `view`'s pixels, fitted
@@ -35,15 +66,9 @@ cv::Mat PageHomography(const View& ref, const View& view,
 // Every `step_px`-th pixel of the region with enough texture (text, print).
 std::vector<Track> TextureSamples(const View& ref, const cv::Mat1b& region,
                                   const TextureOptions& o) {
-  cv::Mat1f texture;
-  cv::cornerMinEigenVal(ref.grey, texture, 7, 3);
-  std::vector<float> values;
-  for (int y = 0; y < region.rows; ++y)
-    for (int x = 0; x < region.cols; ++x)
-      if (region(y, x)) values.push_back(texture(y, x));
-  if (values.empty()) return {};
-  const size_t q95 = values.size() * 95 / 100;
-  const double threshold = o.min_texture * NthSmallest(std::move(values), q95);
+  double threshold = 0;
+  const cv::Mat1f texture = CornerStrength(ref.grey, region, o.min_texture, &threshold);
+  if (texture.empty()) return {};
   std::vector<Track> tracks;
   const double step = std::max(1.0, o.step_px);
   for (double y = 0; y < region.rows; y += step)
@@ -145,17 +170,10 @@ void FollowByHomography(const View& ref, const std::vector<View>& others,
 void FollowBySurface(const View& ref, const std::vector<View>& others, const cv::Mat1b& region,
                      const std::vector<Eigen::Vector3d>& known, const TextureOptions& o,
                      std::vector<Track>* tracks, DensifyResult* result) {
-  std::vector<Eigen::Vector2d> pixels;
-  std::vector<double> depths;
-  for (const Eigen::Vector3d& X : known) {
-    const Eigen::Vector3d xc = ref.camera.CamFromWorld(X);
-    if (!(xc.z() > 0)) continue;
-    pixels.push_back(ref.camera.ProjectCam(xc));
-    depths.push_back(xc.z());
-  }
-  if (pixels.size() < 16) return;
-  const DepthField depth(pixels, depths, o.surface_neighbours, 2 * o.surface_grid_px,
-                         DepthModel::kPlanar, o.surface_neighbours);
+  const std::unique_ptr<DepthField> surface =
+      SurfaceOfPoints(ref.camera, known, o.surface_neighbours, 2 * o.surface_grid_px);
+  if (!surface) return;
+  const DepthField& depth = *surface;
   // Inverse depth on a coarse grid over the region's box, interpolated
   // bilinearly in between.
   const cv::Rect box = cv::boundingRect(region);
