@@ -380,6 +380,58 @@ TEST(Densify, TheFarSideOfAFoldGetsPointsThroughTheSurfaceOfTheFirst) {
   EXPECT_LT(errors.back(), 0.02 * diagonal);
 }
 
+// With only sfm's points on the top half, the sweep carries the reference's
+// patches into the other photos through the surface of the points so far and
+// reaches the far side of the fold round by round, on the page.
+TEST(Densify, SweptPointsReachTheFarSideOfAFoldOnThePage) {
+  const FoldedScene scene = MakeFoldedScene();
+  DensifyInputs in = PhotoInputs(scene.cameras, scene.photos);
+  const PinholeCamera& ref = scene.cameras.views[0];
+  const double r = scene.texture.cols - 0.5, b = scene.texture.rows - 0.5;
+  for (const Eigen::Vector3d& X :
+       {scene.Point(-0.5, -0.5), scene.Point(r, -0.5), scene.Point(r, scene.fold),
+        scene.Point(r, b), scene.Point(-0.5, b), scene.Point(-0.5, scene.fold)})
+    in.boundary.contour.push_back(ref.Project(X));
+  in.boundary.width = ref.width;
+  in.boundary.height = ref.height;
+  in.region = ContourRegion(in.boundary, 0);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(20, 280), v(20, 190);
+  for (int i = 0; i < 150; ++i) in.points.vertices.push_back(scene.Point(u(rng), v(rng)));
+  in.points.colors.assign(in.points.vertices.size(), {128, 128, 128});
+
+  DensifyOptions o;
+  o.texture.enabled = o.outline.enabled = o.steps.enabled = false;
+  const DensifyResult result = densify::Run(in, o);
+  const auto& source = result.points.FindProperty("source")->values;
+  const Eigen::Vector3d hinge = scene.Point(0, scene.fold);
+  std::vector<double> errors;
+  int far = 0;
+  for (size_t i = 0; i < result.points.vertices.size(); ++i) {
+    if (source[i] != double(PointSource::kSwept)) continue;
+    const Eigen::Vector3d& X = result.points.vertices[i];
+    errors.push_back(scene.Distance(X));
+    if ((X - hinge).dot(scene.down2.normalized()) > 0.02) ++far;  // 20 mm past the fold
+  }
+  ASSERT_FALSE(errors.empty());
+  std::sort(errors.begin(), errors.end());
+  const double diagonal = 0.5;
+  std::printf(
+      "[densify] folded page, sweep only: %d swept points (%d past the fold) from %d "
+      "candidates; median %.3f %%, p95 %.3f %%, max %.3f %% of the diagonal off the page\n",
+      result.sweep.points, far, result.sweep.candidates, 100 * errors[errors.size() / 2] / diagonal,
+      100 * errors[errors.size() * 95 / 100] / diagonal, 100 * errors.back() / diagonal);
+  // Measured: 1605 points, 1186 past the fold; median 0.16 %, p95 0.46 %, max
+  // 0.56 % of the diagonal. The depth is one of 81 steps over +-15 %, 0.4 %
+  // of the depth apart, with nothing finer between them. Where the flow
+  // reaches, its points are far more exact (0.006 %, the test above).
+  EXPECT_EQ(int(errors.size()), result.sweep.points);
+  EXPECT_GT(far, 800);
+  EXPECT_LT(errors[errors.size() / 2], 0.0025 * diagonal);
+  EXPECT_LT(errors[errors.size() * 95 / 100], 0.006 * diagonal);
+  EXPECT_LT(errors.back(), 0.01 * diagonal);
+}
+
 // A step in the grey of blank paper (as a fold's shading gives under diffuse
 // light: at the same place on the paper in every photo) gets points, on the
 // page and on the step.
@@ -430,13 +482,16 @@ TEST(Densify, EachSourceCanBeSwitchedOffAndOneViewAddsNothing) {
   r = densify::Run(in, o);
   EXPECT_GT(r.texture_points, 0);
   EXPECT_EQ(r.outline.points, 0);
+  o.sweep.enabled = false;
+  r = densify::Run(in, o);
+  EXPECT_EQ(r.sweep.points + r.sweep.candidates, 0);
   // Only the reference view: sfm's points come back unchanged, with a warning.
   in.cameras.views.resize(1);
   in.photos.resize(1);
   in.distortion.resize(1);
   r = densify::Run(in, DensifyOptions());
   EXPECT_EQ(r.points.vertices.size(), 150u);
-  EXPECT_EQ(r.texture_points + r.outline.points, 0);
+  EXPECT_EQ(r.texture_points + r.outline.points + r.sweep.points, 0);
   EXPECT_FALSE(r.warnings.empty());
 }
 
