@@ -319,8 +319,9 @@ FoldedScene MakeFoldedScene() {
   return s;
 }
 
-TEST(Densify, TheFarSideOfAFoldGetsPointsThroughTheSurfaceOfTheFirst) {
-  const FoldedScene scene = MakeFoldedScene();
+// The folded page's photos, its outline in the reference, and 150 sfm
+// points on its top half.
+DensifyInputs FoldedInputs(const FoldedScene& scene) {
   DensifyInputs in = PhotoInputs(scene.cameras, scene.photos);
   const PinholeCamera& ref = scene.cameras.views[0];
   const double r = scene.texture.cols - 0.5, b = scene.texture.rows - 0.5;
@@ -335,6 +336,12 @@ TEST(Densify, TheFarSideOfAFoldGetsPointsThroughTheSurfaceOfTheFirst) {
   std::uniform_real_distribution<double> u(20, 280), v(20, 190);
   for (int i = 0; i < 150; ++i) in.points.vertices.push_back(scene.Point(u(rng), v(rng)));
   in.points.colors.assign(in.points.vertices.size(), {128, 128, 128});
+  return in;
+}
+
+TEST(Densify, TheFarSideOfAFoldGetsPointsThroughTheSurfaceOfTheFirst) {
+  const FoldedScene scene = MakeFoldedScene();
+  const DensifyInputs in = FoldedInputs(scene);
 
   DensifyOptions o;
   o.outline.enabled = false;
@@ -385,20 +392,7 @@ TEST(Densify, TheFarSideOfAFoldGetsPointsThroughTheSurfaceOfTheFirst) {
 // reaches the far side of the fold round by round, on the page.
 TEST(Densify, SweptPointsReachTheFarSideOfAFoldOnThePage) {
   const FoldedScene scene = MakeFoldedScene();
-  DensifyInputs in = PhotoInputs(scene.cameras, scene.photos);
-  const PinholeCamera& ref = scene.cameras.views[0];
-  const double r = scene.texture.cols - 0.5, b = scene.texture.rows - 0.5;
-  for (const Eigen::Vector3d& X :
-       {scene.Point(-0.5, -0.5), scene.Point(r, -0.5), scene.Point(r, scene.fold),
-        scene.Point(r, b), scene.Point(-0.5, b), scene.Point(-0.5, scene.fold)})
-    in.boundary.contour.push_back(ref.Project(X));
-  in.boundary.width = ref.width;
-  in.boundary.height = ref.height;
-  in.region = ContourRegion(in.boundary, 0);
-  std::mt19937 rng(3);
-  std::uniform_real_distribution<double> u(20, 280), v(20, 190);
-  for (int i = 0; i < 150; ++i) in.points.vertices.push_back(scene.Point(u(rng), v(rng)));
-  in.points.colors.assign(in.points.vertices.size(), {128, 128, 128});
+  const DensifyInputs in = FoldedInputs(scene);
 
   DensifyOptions o;
   o.texture.enabled = o.outline.enabled = o.steps.enabled = false;
