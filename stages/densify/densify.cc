@@ -325,6 +325,13 @@ DensifyResult Run(const DensifyInputs& in, const DensifyOptions& o) {
   timer.Mark("sfm points");
 
   const WorkingCopies w = MakeWorkingCopies(in, o, ref_camera, full_region, &r);
+  // The page's sfm points and every point made so far: the surface the later
+  // passes work around.
+  const auto points_so_far = [&] {
+    std::vector<Eigen::Vector3d> known = sfm.page_points;
+    known.insert(known.end(), r.points.vertices.begin() + first_new_point, r.points.vertices.end());
+    return known;
+  };
   r.seconds_reading = timer.Mark("working copies");
   const bool matching = !w.others.empty();
   if (!matching) r.warnings.push_back("only one view: nothing to match, no points added");
@@ -364,10 +371,8 @@ DensifyResult Run(const DensifyInputs& in, const DensifyOptions& o) {
   }
 
   if (o.texture.enabled && o.texture.surface_prewarp && matching) {
-    std::vector<Eigen::Vector3d> known = sfm.page_points;
-    known.insert(known.end(), r.points.vertices.begin() + first_new_point, r.points.vertices.end());
-    detail::AddSurfaceTexturePoints(w.ref, w.others, w.region, known, in.reference, o.texture,
-                                    &tracks, &r);
+    detail::AddSurfaceTexturePoints(w.ref, w.others, w.region, points_so_far(), in.reference,
+                                    o.texture, &tracks, &r);
   }
   r.seconds_surface = timer.Mark("texture, second pass");
   if (o.texture.surface_prewarp)
@@ -376,9 +381,8 @@ DensifyResult Run(const DensifyInputs& in, const DensifyOptions& o) {
         "points' surface, " +
         Fixed(r.seconds_surface, 2) + " s");
   if (o.sweep.enabled && matching) {
-    std::vector<Eigen::Vector3d> known = sfm.page_points;
-    known.insert(known.end(), r.points.vertices.begin() + first_new_point, r.points.vertices.end());
-    detail::AddSweptPoints(w.ref, w.others, w.region, w.page, known, in.reference, o.sweep, &r);
+    detail::AddSweptPoints(w.ref, w.others, w.region, w.page, points_so_far(), in.reference,
+                           o.sweep, &r);
     r.seconds_sweep = timer.Mark("sweep");
     Log(std::to_string(r.sweep.points) + " swept points from " +
         std::to_string(r.sweep.candidates) + " candidates, " + Fixed(r.seconds_sweep, 2) + " s");
