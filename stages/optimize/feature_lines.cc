@@ -177,8 +177,6 @@ Grouping GroupSegments(const MeshPair& meshes, const MarkerSet& markers,
   for (size_t s = 0; s < segments.size(); ++s) {
     if (int(points[s].size()) < o.min_markers) continue;
     if (segments[s].kind == "boundary") {
-      if (double(points[s].size()) < o.min_side_fraction * double(segments[s].pixels.size()))
-        continue;
       g.line_of_segment[s] = int(g.line_kind.size());
       g.line_kind.push_back("boundary");
       g.line_side.push_back(segments[s].side);

@@ -54,11 +54,6 @@ struct GroupingOptions {
   double straightness = 0.1;       // h/w of the merged line's oriented box
   double axis_tolerance_deg = 12;  // keep lines this close to horizontal/vertical
   int min_markers = 3;             // fewer: the segment is not used
-  // A real side of which fewer than this fraction of the samples meet M is
-  // not a line: M stops short of it, and the few samples that meet M's
-  // border where it comes near would hold that stretch of border on the
-  // side's rays.
-  double min_side_fraction = 0.5;
 };
 
 // Lines found in M': for every segment its line (or -1 when dropped), and

@@ -32,9 +32,6 @@ void DeclareOptions(OptionTable& table, OptimizeOptions* o) {
   table.Value("side-end-outliers", &o->side_end_outliers, 0.0, 1000.0,
               "in the last tenth at either end of a real side, take samples off it only when "
               "this many times farther from its line than a sample inside may be (0 = keep all)");
-  table.Value("side-min-on-mesh", &o->grouping.min_side_fraction, 0.0, 1.0,
-              "a real page side of which fewer than this fraction of the samples meet M is no "
-              "line (M stops short of it; 0 = every side)");
   table.Switch("feature-lines", &o->features,
                "text lines, rules and real page sides straightened in M' (off: an ablation)");
   table.Switch("mask-hull", &o->mask_hull,

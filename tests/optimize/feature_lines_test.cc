@@ -54,31 +54,6 @@ TEST(CastMarkers, SamplesOnTheMeshBecomeMarkersOthersAreDropped) {
   EXPECT_TRUE(off.markers.empty());
 }
 
-// A real side of which M meets only a stretch (M stops short of the page's
-// edge) makes no line: its few markers would hold that stretch of M's border
-// on the side's rays. One M meets mostly does.
-TEST(GroupSegments, ASideMostlyPastTheMeshIsNoLine) {
-  const Scene scene;
-  auto side = [](double top, double bottom) {
-    Segment s;
-    s.kind = "boundary";
-    s.side = 3;
-    s.pixels = SamplePolyline({{298, top}, {298, bottom}}, 4);
-    return s;
-  };
-  // The sheet spans rows 250..550: 150 of 600 px on it, then 300 of 360.
-  const std::vector<Segment> sides = {side(400, 1000), side(200, 560)};
-  const MarkerSet markers = CastMarkers(scene.meshes, scene.camera, sides);
-  EXPECT_NEAR(double(markers.markers_of_segment[0]) / sides[0].pixels.size(), 0.25, 0.02);
-  EXPECT_NEAR(double(markers.markers_of_segment[1]) / sides[1].pixels.size(), 0.83, 0.02);
-  const Grouping grouping = GroupSegments(scene.meshes, markers, sides, GroupingOptions{});
-  EXPECT_EQ(grouping.line_of_segment[0], -1);
-  EXPECT_EQ(grouping.line_of_segment[1], 0);
-  GroupingOptions every_side;
-  every_side.min_side_fraction = 0;
-  EXPECT_EQ(GroupSegments(scene.meshes, markers, sides, every_side).line_of_segment[0], 0);
-}
-
 // A real left side 5 px inside the sheet's border, with `bumps`: runs of
 // samples pushed `bump_px` into the page (a fold's notch in the outline).
 MarkerSet SideWithBumps(const Scene& scene, const std::vector<std::pair<int, int>>& bumps,
