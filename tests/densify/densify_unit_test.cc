@@ -339,35 +339,39 @@ DensifyInputs FoldedInputs(const FoldedScene& scene) {
   return in;
 }
 
+// The points of `source` in `result`: their distances to the folded page
+// appended to `errors`; returns how many lie 20 mm or more past the fold.
+int PastTheFold(const FoldedScene& scene, const DensifyResult& result, PointSource source,
+                std::vector<double>* errors) {
+  const auto& sources = result.points.FindProperty("source")->values;
+  const Eigen::Vector3d hinge = scene.Point(0, scene.fold);
+  int n = 0;
+  for (size_t i = 0; i < result.points.vertices.size(); ++i) {
+    if (sources[i] != double(source)) continue;
+    const Eigen::Vector3d& X = result.points.vertices[i];
+    errors->push_back(scene.Distance(X));
+    if ((X - hinge).dot(scene.down2.normalized()) > 0.02) ++n;
+  }
+  return n;
+}
+
 TEST(Densify, TheFarSideOfAFoldGetsPointsThroughTheSurfaceOfTheFirst) {
   const FoldedScene scene = MakeFoldedScene();
   const DensifyInputs in = FoldedInputs(scene);
 
   DensifyOptions o;
   o.outline.enabled = false;
-  auto far_side = [&](const DensifyResult& result, std::vector<double>* errors) {
-    const auto& source = result.points.FindProperty("source")->values;
-    const Eigen::Vector3d hinge = scene.Point(0, scene.fold);
-    int n = 0;
-    for (size_t i = 0; i < result.points.vertices.size(); ++i) {
-      if (source[i] != double(PointSource::kTexture)) continue;
-      const Eigen::Vector3d& X = result.points.vertices[i];
-      errors->push_back(scene.Distance(X));
-      if ((X - hinge).dot(scene.down2.normalized()) > 0.02) ++n;  // 20 mm past the fold
-    }
-    return n;
-  };
   o.texture.surface_prewarp = false;
   std::vector<double> errors_first;  // (filled, not checked)
   const DensifyResult first = densify::Run(in, o);
-  const int far_first = far_side(first, &errors_first);
+  const int far_first = PastTheFold(scene, first, PointSource::kTexture, &errors_first);
   o.texture.surface_prewarp = true;
   // Every sample it left: this page is small (300x400 texels), its far side
   // lies within the default hole gap of the points past the fold.
   o.texture.surface_hole_px = 0;
   std::vector<double> errors;
   const DensifyResult both = densify::Run(in, o);
-  const int far_both = far_side(both, &errors);
+  const int far_both = PastTheFold(scene, both, PointSource::kTexture, &errors);
   std::sort(errors.begin(), errors.end());
   const double diagonal = 0.5;
   std::printf(
@@ -397,16 +401,8 @@ TEST(Densify, SweptPointsReachTheFarSideOfAFoldOnThePage) {
   DensifyOptions o;
   o.texture.enabled = o.outline.enabled = o.steps.enabled = false;
   const DensifyResult result = densify::Run(in, o);
-  const auto& source = result.points.FindProperty("source")->values;
-  const Eigen::Vector3d hinge = scene.Point(0, scene.fold);
   std::vector<double> errors;
-  int far = 0;
-  for (size_t i = 0; i < result.points.vertices.size(); ++i) {
-    if (source[i] != double(PointSource::kSwept)) continue;
-    const Eigen::Vector3d& X = result.points.vertices[i];
-    errors.push_back(scene.Distance(X));
-    if ((X - hinge).dot(scene.down2.normalized()) > 0.02) ++far;  // 20 mm past the fold
-  }
+  const int far = PastTheFold(scene, result, PointSource::kSwept, &errors);
   ASSERT_FALSE(errors.empty());
   std::sort(errors.begin(), errors.end());
   const double diagonal = 0.5;
