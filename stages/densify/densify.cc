@@ -47,6 +47,10 @@ void DeclareOptions(OptionTable& table, DensifyOptions* o) {
               "outline: photos that must agree on a point, the reference included");
   table.Value("outline-agree-px", &o->outline.agree_px, 0.1, 100.0,
               "outline: other photos agree when their edge is within this distance (px)");
+  table.Switch("outline-side-lines", &o->outline.side_lines,
+               "outline: samples of a straight side the matching left get points where their rays "
+               "meet the planes through the other photos' cameras and the side's straight image "
+               "in them (a standing end every photo's rays graze)");
   table.Switch("steps", &o->steps.enabled,
                "shading-step points (steps of blank paper such as a fold's crease, matched "
                "on copies blurred so that print is gone)");
@@ -302,7 +306,12 @@ std::string CountsLine(const EdgeCounts& c, const std::string& what, const std::
   return std::to_string(c.points) + " " + what + " from " + std::to_string(c.samples) + " " +
          samples + " (" + std::to_string(c.unmatched) + " unmatched, " +
          std::to_string(c.ambiguous) + " ambiguous, " + std::to_string(c.off_surface) +
-         " off the surface), " + Fixed(seconds, 2) + " s";
+         " off the surface" +
+         (c.side_line_points + c.side_line_weak > 0
+              ? "; " + std::to_string(c.side_line_points) + " of those from the sides' lines, " +
+                    std::to_string(c.side_line_weak) + " too weakly determined by them"
+              : std::string()) +
+         "), " + Fixed(seconds, 2) + " s";
 }
 
 }  // namespace

@@ -106,6 +106,24 @@ struct OutlineOptions {
   // surface").
   double continuity_radius_px = 24;
   double max_depth_jump = 0.02;
+  // Samples of a straight side left without a point get one from the side's
+  // lines in the other photos (AddSideLinePoints, edge_points.cc): the side
+  // straight within side_line_max_rms_px in each (working-copy pixels),
+  // with side_line_min_samples of them; steps looked for this far either
+  // side of a sample's epipolar segment; a photo's plane at least
+  // side_line_min_angle_deg off the reference's.
+  // A photo's line is the one at least side_line_min_share of the steps
+  // lie within a pixel of. A point is kept only where a bias of
+  // side_line_bias_px in every line would move it at most
+  // side_line_max_depth_error of its depth along its ray.
+  bool side_lines = true;
+  double side_line_max_rms_px = 1.0;
+  int side_line_min_samples = 20;
+  double side_line_reach_px = 3;
+  double side_line_min_angle_deg = 2;
+  double side_line_min_share = 0.3;
+  double side_line_bias_px = 0.5;
+  double side_line_max_depth_error = 0.003;
 };
 
 // Points on shading steps of blank paper: where a fold crosses paper without
@@ -244,6 +262,12 @@ struct EdgeCounts {
   int ambiguous = 0;    // another depth is as well supported
   int off_surface = 0;  // off the surface of the known points
   int points = 0;       // triangulated and kept
+  // Of `points`, those from the sides' lines (outline only): samples the
+  // epipolar matching left (unmatched, ambiguous or off the surface).
+  int side_line_points = 0;
+  // Samples on a side's lines left out: the lines' planes too near each
+  // other there (side_line_max_depth_error).
+  int side_line_weak = 0;
 };
 
 struct DensifyResult {

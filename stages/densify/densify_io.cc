@@ -129,6 +129,8 @@ Json PointsJson(const DensifyInputs& in, const DensifyResult& r, const Json& opt
                    {"total", r.points.vertices.size()}};
   doc["texture"] = {{"samples", r.texture_samples}};
   doc["outline"] = CountsJson(r.outline);
+  doc["outline"]["side_line_points"] = r.outline.side_line_points;
+  doc["outline"]["side_line_weak"] = r.outline.side_line_weak;
   doc["steps"] = CountsJson(r.steps);
   doc["sweep"] = {{"candidates", r.sweep.candidates}};
   doc["views"] = Json::array();
