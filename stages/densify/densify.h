@@ -107,7 +107,7 @@ struct OutlineOptions {
   double continuity_radius_px = 24;
   double max_depth_jump = 0.02;
   // Samples of a straight side left without a point get one from the side's
-  // lines in the other photos (AddSideLinePoints, edge_points.cc): the side
+  // lines in the other photos (AddSideLinePoints, side_line_points.cc): the side
   // straight within side_line_max_rms_px in each (working-copy pixels),
   // with side_line_min_samples of them; steps looked for this far either
   // side of a sample's epipolar segment; a photo's plane at least

@@ -1,11 +1,13 @@
 // What the parts of densify share: the working copies of the photos, the
 // triangulation helpers, and the steps Run takes (texture points in
 // texture_points.cc; outline and shading-step points, which share the
-// epipolar matcher, in edge_points.cc).
+// epipolar matcher, in edge_points.cc; outline points from the sides' lines
+// in side_line_points.cc).
 #pragma once
 
 #include <Eigen/Core>
 #include <array>
+#include <functional>
 #include <memory>
 #include <opencv2/core.hpp>
 #include <vector>
@@ -118,6 +120,42 @@ void AddSweptPoints(const View& ref, const std::vector<View>& others, const cv::
 
 // --- outline and shading-step points (edge_points.cc) ------------------------
 
+// Strongest step of sign `sign` (grey rising along +n) within +-reach of c
+// along the unit normal n; returns its offset (sub-pixel) and strength.
+bool FindStep(const View& view, const Eigen::Vector2d& c, const Eigen::Vector2d& n, double reach,
+              int sign, double* offset, double* strength);
+
+// The depth along the reference ray through `pixel` at which its projection
+// crosses the edge found in each other view (obs[1...], edge normals
+// `normals`), by Gauss-Newton from *depth: residuals across the edge only
+// (along it a match is no evidence), so a view whose edge nearly follows its
+// epipolar line weighs little. False when the fit fails; else the largest
+// and mean absolute residual (pixels).
+bool DepthAcrossEdges(const PinholeCamera& ref, const Eigen::Vector2d& pixel,
+                      const std::vector<Observation>& obs,
+                      const std::vector<Eigen::Vector2d>& normals, double* depth, double* worst,
+                      double* mean);
+
+// A crossing of an edge found in another view: where, and the edge's unit
+// normal there (from that image's gradient).
+struct EdgeMatch {
+  Eigen::Vector2d pixel;
+  Eigen::Vector2d normal;
+};
+
+struct EdgeSample {
+  Eigen::Vector2d pixel;   // on the edge, reference working copy
+  Eigen::Vector2d normal;  // unit, pointing out of the page
+  int sign = 1;            // grey rises (+1) or falls (-1) going out
+  int side = -1;           // the boundary side it is on (outline samples)
+  bool matched = false;    // MatchEdgeSamples made a point of it
+  double near_depth = 0, far_depth = 0;
+  std::vector<std::vector<EdgeMatch>> candidates;  // per view index
+};
+
+// Whether a triangulated edge sample at `depth` (reference camera) may be kept.
+using EdgeCheck = std::function<bool(const EdgeSample&, double depth)>;
+
 // Pixels and depths in `camera` of `page_points` and of the points made so far
 // (`points` from `first_new` on): what the edge matching searches around.
 void KnownPoints(const PinholeCamera& camera, const std::vector<Eigen::Vector3d>& page_points,
@@ -131,6 +169,15 @@ void AddOutlinePoints(const View& ref, const std::vector<View>& others, int num_
                       const std::vector<Eigen::Vector2d>& known_pixels,
                       const std::vector<double>& known_depths, const OutlineOptions& o,
                       DensifyResult* result);
+
+// --- outline points from the sides' lines (side_line_points.cc) -------------
+
+// Outline points of straight real sides whose `samples` the epipolar
+// matching left (not `matched`), from the sides' straight images in
+// `others`; marks the samples it places and counts them in `counts`.
+void AddSideLinePoints(const View& ref, const std::vector<View>& others,
+                       std::vector<EdgeSample>* samples, const OutlineOptions& o,
+                       const EdgeCheck& check, EdgeCounts* counts, PlyData* points);
 
 // Points on the shading steps of blank paper inside `page`, matched like the
 // outline (whose matching options `outline` gives) on blurred copies.

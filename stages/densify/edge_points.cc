@@ -1,7 +1,6 @@
 // Outline and shading-step points: edges of the reference view (the page's
 // real sides; steps of blank paper on blurred copies) matched along their
 // epipolar segments in the other photos and triangulated.
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <functional>
@@ -14,12 +13,7 @@
 #include "stages/densify/densify_internal.h"
 
 namespace docunfold::densify::detail {
-namespace {
 
-// --- edges and their matching ----------------------------------------------
-
-// Strongest step of sign `sign` (grey rising along +n) within +-reach of c
-// along the unit normal n; returns its offset (sub-pixel) and strength.
 bool FindStep(const View& view, const Eigen::Vector2d& c, const Eigen::Vector2d& n, double reach,
               int sign, double* offset, double* strength) {
   const int count = int(2 * reach / 0.5) + 1;
@@ -37,6 +31,49 @@ bool FindStep(const View& view, const Eigen::Vector2d& c, const Eigen::Vector2d&
   return true;
 }
 
+bool DepthAcrossEdges(const PinholeCamera& ref, const Eigen::Vector2d& pixel,
+                      const std::vector<Observation>& obs,
+                      const std::vector<Eigen::Vector2d>& normals, double* depth, double* worst,
+                      double* mean) {
+  auto residuals = [&](double d, std::vector<double>* r) {
+    r->clear();
+    const Eigen::Vector3d X = ref.LiftAtDepth(pixel, d);
+    for (size_t k = 1; k < obs.size(); ++k) {
+      const Eigen::Vector3d xc = obs[k].camera->CamFromWorld(X);
+      if (!(xc.z() > 0)) return false;
+      r->push_back(normals[k - 1].dot(obs[k].camera->ProjectCam(xc) - obs[k].pixel));
+    }
+    return true;
+  };
+  std::vector<double> r0, r1;
+  if (!(*depth > 0)) return false;
+  for (int iteration = 0; iteration < 8; ++iteration) {
+    const double step = 1e-6 * *depth;
+    if (!residuals(*depth, &r0) || !residuals(*depth + step, &r1)) return false;
+    double jtj = 0, jtr = 0;
+    for (size_t k = 0; k < r0.size(); ++k) {
+      const double j = (r1[k] - r0[k]) / step;
+      jtj += j * j;
+      jtr += j * r0[k];
+    }
+    if (!(jtj > 0)) return false;
+    const double delta = -jtr / jtj;
+    *depth += delta;
+    if (!(*depth > 0) || std::abs(delta) < 1e-9 * *depth) break;
+  }
+  if (!(*depth > 0) || !residuals(*depth, &r0)) return false;
+  *worst = *mean = 0;
+  for (const double r : r0) {
+    *worst = std::max(*worst, std::abs(r));
+    *mean += std::abs(r) / double(r0.size());
+  }
+  return true;
+}
+
+namespace {
+
+// --- edges and their matching ----------------------------------------------
+
 // Whether the step at c (grey rising along the unit `normal`) continues
 // straight along the edge: a step of the same sign of at least
 // `min_strength` within 1.5 px of the line through c, half and all of
@@ -53,23 +90,6 @@ bool StepContinues(const View& view, const Eigen::Vector2d& c, const Eigen::Vect
   }
   return true;
 }
-
-// A crossing of an edge found in another view: where, and the edge's unit
-// normal there (from that image's gradient).
-struct EdgeMatch {
-  Eigen::Vector2d pixel;
-  Eigen::Vector2d normal;
-};
-
-struct EdgeSample {
-  Eigen::Vector2d pixel;   // on the edge, reference working copy
-  Eigen::Vector2d normal;  // unit, pointing out of the page
-  int sign = 1;            // grey rises (+1) or falls (-1) going out
-  int side = -1;           // the boundary side it is on (outline samples)
-  bool matched = false;    // MatchEdgeSamples made a point of it
-  double near_depth = 0, far_depth = 0;
-  std::vector<std::vector<EdgeMatch>> candidates;  // per view index
-};
 
 std::vector<EdgeSample> EdgeSamples(const View& ref, const Boundary& boundary,
                                     const cv::Mat1b& page, double scale, const OutlineOptions& o) {
@@ -112,51 +132,6 @@ std::vector<EdgeSample> EdgeSamples(const View& ref, const Boundary& boundary,
     }
   }
   return samples;
-}
-
-// The depth along the reference ray through `pixel` at which its projection
-// crosses the edge found in each other view (obs[1...], edge normals
-// `normals`), by Gauss-Newton from *depth: residuals across the edge only
-// (along it a match is no evidence), so a view whose edge nearly follows its
-// epipolar line weighs little. False when the fit fails; else the largest
-// and mean absolute residual (pixels).
-bool DepthAcrossEdges(const PinholeCamera& ref, const Eigen::Vector2d& pixel,
-                      const std::vector<Observation>& obs,
-                      const std::vector<Eigen::Vector2d>& normals, double* depth, double* worst,
-                      double* mean) {
-  auto residuals = [&](double d, std::vector<double>* r) {
-    r->clear();
-    const Eigen::Vector3d X = ref.LiftAtDepth(pixel, d);
-    for (size_t k = 1; k < obs.size(); ++k) {
-      const Eigen::Vector3d xc = obs[k].camera->CamFromWorld(X);
-      if (!(xc.z() > 0)) return false;
-      r->push_back(normals[k - 1].dot(obs[k].camera->ProjectCam(xc) - obs[k].pixel));
-    }
-    return true;
-  };
-  std::vector<double> r0, r1;
-  if (!(*depth > 0)) return false;
-  for (int iteration = 0; iteration < 8; ++iteration) {
-    const double step = 1e-6 * *depth;
-    if (!residuals(*depth, &r0) || !residuals(*depth + step, &r1)) return false;
-    double jtj = 0, jtr = 0;
-    for (size_t k = 0; k < r0.size(); ++k) {
-      const double j = (r1[k] - r0[k]) / step;
-      jtj += j * j;
-      jtr += j * r0[k];
-    }
-    if (!(jtj > 0)) return false;
-    const double delta = -jtr / jtj;
-    *depth += delta;
-    if (!(*depth > 0) || std::abs(delta) < 1e-9 * *depth) break;
-  }
-  if (!(*depth > 0) || !residuals(*depth, &r0)) return false;
-  *worst = *mean = 0;
-  for (const double r : r0) {
-    *worst = std::max(*worst, std::abs(r));
-    *mean += std::abs(r) / double(r0.size());
-  }
-  return true;
 }
 
 // Affine fit of 1/depth to the known points within `radius` of `pixel` that
@@ -495,214 +470,6 @@ bool SideSurface(const PinholeCamera& camera, const Eigen::Vector2d& pixel,
   const Eigen::Vector3d ray = camera.CamRay(pixel);
   *cos_ray = std::abs(plane.normalized().dot(ray.normalized()));
   return true;
-}
-
-// The total-least-squares line through `pixels` (a, b, c with a x + b y + c
-// = 0, (a, b) unit) and the RMS of their distances to it.
-Eigen::Vector3d FitLine(const std::vector<Eigen::Vector2d>& pixels, double* rms) {
-  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
-  for (const auto& p : pixels) mean += p;
-  mean /= double(pixels.size());
-  Eigen::Matrix2d scatter = Eigen::Matrix2d::Zero();
-  for (const auto& p : pixels) scatter += (p - mean) * (p - mean).transpose();
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(scatter);
-  const Eigen::Vector2d normal = eigen.eigenvectors().col(0);
-  *rms = std::sqrt(std::max(0.0, eigen.eigenvalues()(0)) / double(pixels.size()));
-  return {normal.x(), normal.y(), -normal.dot(mean)};
-}
-
-// The line most of `pixels` lie within `tolerance` of (a deterministic
-// RANSAC over evenly spread pairs, then refitted to its inliers); false
-// when fewer than `min_share` of them do.
-bool RobustLine(const std::vector<Eigen::Vector2d>& pixels, double tolerance, double min_share,
-                Eigen::Vector3d* line, double* rms, std::vector<Eigen::Vector2d>* inliers) {
-  const int n = int(pixels.size());
-  if (n < 10) return false;
-  int best = 0;
-  Eigen::Vector3d best_line = Eigen::Vector3d::Zero();
-  const int stride = std::max(1, n / 40);
-  for (int i = 0; i < n; i += stride)
-    for (int j = i + n / 4; j < n; j += stride) {
-      const Eigen::Vector2d d = pixels[j] - pixels[i];
-      if (d.norm() < 1e-9) continue;
-      const Eigen::Vector2d normal = Eigen::Vector2d(-d.y(), d.x()).normalized();
-      const Eigen::Vector3d l(normal.x(), normal.y(), -normal.dot(pixels[i]));
-      int count = 0;
-      for (const auto& p : pixels) count += std::abs(l.head<2>().dot(p) + l(2)) <= tolerance;
-      if (count > best) {
-        best = count;
-        best_line = l;
-      }
-    }
-  if (best < min_share * n) return false;
-  inliers->clear();
-  for (const auto& p : pixels)
-    if (std::abs(best_line.head<2>().dot(p) + best_line(2)) <= tolerance) inliers->push_back(p);
-  *line = FitLine(*inliers, rms);
-  return true;
-}
-
-// The world plane through `camera`'s centre that projects onto image line
-// `line`: its unit normal.
-Eigen::Vector3d PlaneNormal(const PinholeCamera& camera, const Eigen::Vector3d& line) {
-  return (camera.R.transpose() * (camera.K.transpose() * line)).normalized();
-}
-
-// Outline points of a straight real side whose samples the epipolar
-// matching left without a point, where each photo's epipolar segments run
-// along the side's image (a panel standing up at the end of a page lying
-// flat, seen from above: every photo's rays graze it). No sample then has a
-// crossing to match, but the side's image in each photo is still a straight
-// step: it is found next to the samples' epipolar segments, fitted with a
-// line, and each sample's depth is where its ray meets the planes through
-// the cameras and those lines (residuals across the lines only, as for a
-// matched sample). A photo's plane must meet the reference's at
-// side_line_min_angle_deg at least, or it says nothing about depth.
-void AddSideLinePoints(const View& ref, const std::vector<View>& others,
-                       std::vector<EdgeSample>* samples, const OutlineOptions& o,
-                       const EdgeCheck& check, EdgeCounts* counts, PlyData* points) {
-  for (int side = 0; side < 4; ++side) {
-    std::vector<EdgeSample*> all, left;
-    for (EdgeSample& e : *samples)
-      if (e.side == side) {
-        all.push_back(&e);
-        if (!e.matched) left.push_back(&e);
-      }
-    if (int(left.size()) < o.side_line_min_samples) continue;
-    std::vector<Eigen::Vector2d> reference_pixels;
-    for (const EdgeSample* e : all) reference_pixels.push_back(e->pixel);
-    double rms = 0;
-    const Eigen::Vector3d reference_line = FitLine(reference_pixels, &rms);
-    if (rms > o.side_line_max_rms_px) continue;
-    const Eigen::Vector3d reference_normal = PlaneNormal(ref.camera, reference_line);
-    // Each photo's image of the side: steps of the sample's sign next to
-    // its epipolar segment, across the side's direction there.
-    std::vector<Observation> lines;  // a point on each photo's line
-    std::vector<Eigen::Vector2d> line_normals;
-    for (const View& view : others) {
-      std::vector<Eigen::Vector2d> steps;
-      for (const EdgeSample* e : left) {
-        const Eigen::Vector3d A =
-            view.camera.CamFromWorld(ref.camera.LiftAtDepth(e->pixel, e->near_depth));
-        const Eigen::Vector3d B =
-            view.camera.CamFromWorld(ref.camera.LiftAtDepth(e->pixel, e->far_depth));
-        if (!(A.z() > 0) || !(B.z() > 0)) continue;
-        const Eigen::Vector2d a = view.camera.ProjectCam(A), b = view.camera.ProjectCam(B);
-        const double mid = 0.5 * (e->near_depth + e->far_depth);
-        const Eigen::Vector2d at = view.camera.Project(ref.camera.LiftAtDepth(e->pixel, mid));
-        const Eigen::Vector2d nj =
-            (view.camera.Project(ref.camera.LiftAtDepth(e->pixel + e->normal, mid)) - at)
-                .normalized();
-        if (!nj.allFinite()) continue;
-        const double length = (b - a).norm();
-        for (double s = 0; s <= length; s += 2) {
-          const Eigen::Vector2d p = a + (length > 0 ? s / length : 0.0) * (b - a);
-          double offset = 0, strength = 0;
-          if (view.Inside(p) &&
-              FindStep(view, p, nj, o.side_line_reach_px, e->sign, &offset, &strength) &&
-              strength >= o.min_contrast)
-            steps.push_back(p + offset * nj);
-        }
-      }
-      Eigen::Vector3d line;
-      std::vector<Eigen::Vector2d> inliers;
-      if (!RobustLine(steps, 1.0, o.side_line_min_share, &line, &rms, &inliers) ||
-          int(inliers.size()) < o.side_line_min_samples || rms > o.side_line_max_rms_px)
-        continue;
-      const double angle =
-          std::acos(std::min(1.0, std::abs(PlaneNormal(view.camera, line).dot(reference_normal)))) *
-          180 / M_PI;
-      if (angle < o.side_line_min_angle_deg) continue;
-      lines.push_back({&view.camera, -line(2) * line.head<2>()});
-      line_normals.push_back(line.head<2>());
-    }
-    if (int(lines.size()) + 1 < o.min_views) continue;
-    // A sample's depth from the lines of the photos `use`, and its
-    // residual across each of them (pixels).
-    // How many pixels across the lines of `use` a change of the depth by
-    // its own size moves the sample (root sum of squares).
-    auto sensitivity = [&](const EdgeSample& e, const std::vector<int>& use, double depth) {
-      double sum = 0;
-      for (int k : use) {
-        const double h = 1e-6 * depth;
-        const Eigen::Vector2d p0 = lines[k].camera->Project(ref.camera.LiftAtDepth(e.pixel, depth));
-        const Eigen::Vector2d p1 =
-            lines[k].camera->Project(ref.camera.LiftAtDepth(e.pixel, depth + h));
-        sum += std::pow(line_normals[k].dot(p1 - p0) / h * depth, 2);
-      }
-      return std::sqrt(sum);
-    };
-    auto solve = [&](const EdgeSample& e, const std::vector<int>& use, double* depth,
-                     std::vector<double>* residuals) {
-      std::vector<Observation> obs{{&ref.camera, e.pixel}};
-      std::vector<Eigen::Vector2d> normals;
-      for (int k : use) {
-        obs.push_back(lines[k]);
-        normals.push_back(line_normals[k]);
-      }
-      *depth = 0.5 * (e.near_depth + e.far_depth);
-      double worst = 0, mean = 0;
-      if (!DepthAcrossEdges(ref.camera, e.pixel, obs, normals, depth, &worst, &mean)) return false;
-      residuals->clear();
-      const Eigen::Vector3d X = ref.camera.LiftAtDepth(e.pixel, *depth);
-      for (int k : use)
-        residuals->push_back(
-            std::abs(line_normals[k].dot(lines[k].camera->Project(X) - lines[k].pixel)));
-      return true;
-    };
-    // The largest set of photos (of at least min_views - 1) whose lines
-    // agree, by the largest of their median residuals over the samples; a
-    // photo that disagrees saw another edge there (a fold's, where it sees
-    // the page's back). Ties go to the set that agrees best. Past 8 photos
-    // only all of them are tried.
-    std::vector<int> use;
-    double use_spread = HUGE_VAL;
-    const int n = int(lines.size());
-    const int all_photos = (1 << std::min(n, 30)) - 1;
-    for (int subset = n <= 8 ? 1 : all_photos; subset <= all_photos; ++subset) {
-      std::vector<int> pick;
-      for (int k = 0; k < n; ++k)
-        if (k >= 30 || subset & (1 << k)) pick.push_back(k);
-      if (int(pick.size()) + 1 < o.min_views || pick.size() < use.size()) continue;
-      std::vector<std::vector<double>> per_view(pick.size());
-      for (const EdgeSample* e : left) {
-        double depth = 0;
-        std::vector<double> residuals;
-        if (!solve(*e, pick, &depth, &residuals)) continue;
-        for (size_t k = 0; k < pick.size(); ++k) per_view[k].push_back(residuals[k]);
-      }
-      double spread = 0;
-      for (const auto& r : per_view) spread = std::max(spread, r.empty() ? HUGE_VAL : Median(r));
-      if (spread > o.max_reprojection_px) continue;
-      if (pick.size() > use.size() || spread < use_spread) {
-        use = pick;
-        use_spread = spread;
-      }
-    }
-    if (int(use.size()) + 1 < o.min_views) continue;
-    for (EdgeSample* e : left) {
-      double depth = 0;
-      std::vector<double> residuals;
-      if (!solve(*e, use, &depth, &residuals) ||
-          *std::max_element(residuals.begin(), residuals.end()) > o.max_reprojection_px ||
-          !check(*e, depth))
-        continue;
-      // Planes a few degrees apart put a sub-pixel bias of the lines (an
-      // edge's blur or shadow, the same in every sample) far along the ray:
-      // were every line side_line_bias_px off, the point may move at most
-      // side_line_max_depth_error of its depth.
-      const double s_px = sensitivity(*e, use, depth);
-      if (o.side_line_bias_px / s_px > o.side_line_max_depth_error) {
-        ++counts->side_line_weak;
-        continue;
-      }
-      AppendPoint(ref.camera.LiftAtDepth(e->pixel, depth), {255, 0, 255}, int(use.size() + 1),
-                  Median(residuals), PointSource::kOutline, points);
-      e->matched = true;
-      ++counts->points;
-      ++counts->side_line_points;
-    }
-  }
 }
 
 }  // namespace
