@@ -148,7 +148,7 @@ struct EdgeSample {
   Eigen::Vector2d normal;  // unit, pointing out of the page
   int sign = 1;            // grey rises (+1) or falls (-1) going out
   int side = -1;           // the boundary side it is on (outline samples)
-  bool matched = false;    // MatchEdgeSamples made a point of it
+  bool matched = false;    // a point was made of it (matching or the side lines)
   double near_depth = 0, far_depth = 0;
   std::vector<std::vector<EdgeMatch>> candidates;  // per view index
 };
