@@ -10,6 +10,7 @@
 #include <functional>
 #include <memory>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <vector>
 
 #include "common/camera.h"
@@ -130,11 +131,12 @@ bool FindStep(const View& view, const Eigen::Vector2d& c, const Eigen::Vector2d&
 // `normals`), by Gauss-Newton from *depth: residuals across the edge only
 // (along it a match is no evidence), so a view whose edge nearly follows its
 // epipolar line weighs little. False when the fit fails; else the largest
-// and mean absolute residual (pixels).
+// and mean absolute residual (pixels), and, when `residuals` is given, each
+// view's signed residual.
 bool DepthAcrossEdges(const PinholeCamera& ref, const Eigen::Vector2d& pixel,
                       const std::vector<Observation>& obs,
                       const std::vector<Eigen::Vector2d>& normals, double* depth, double* worst,
-                      double* mean);
+                      double* mean, std::vector<double>* residuals = nullptr);
 
 // A crossing of an edge found in another view: where, and the edge's unit
 // normal there (from that image's gradient).
@@ -152,6 +154,16 @@ struct EdgeSample {
   double near_depth = 0, far_depth = 0;
   std::vector<std::vector<EdgeMatch>> candidates;  // per view index
 };
+
+// A sample's epipolar segment in `view`: its ray between its near and far
+// depth, projected, and the direction across the edge there (its outward
+// normal as `view` sees it at mid depth, unit). nullopt where the segment
+// runs behind the camera or the direction is undefined.
+struct EpipolarSegment {
+  Eigen::Vector2d near, far, across;
+};
+std::optional<EpipolarSegment> EpipolarSegmentIn(const View& ref, const View& view,
+                                                 const EdgeSample& e);
 
 // Whether a triangulated edge sample at `depth` (reference camera) may be kept.
 using EdgeCheck = std::function<bool(const EdgeSample&, double depth)>;

@@ -7,6 +7,7 @@
 #include <limits>
 #include <memory>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 
 #include "common/point_index.h"
 #include "common/statistics.h"
@@ -31,10 +32,23 @@ bool FindStep(const View& view, const Eigen::Vector2d& c, const Eigen::Vector2d&
   return true;
 }
 
+std::optional<EpipolarSegment> EpipolarSegmentIn(const View& ref, const View& view,
+                                                 const EdgeSample& e) {
+  const Eigen::Vector3d A = view.camera.CamFromWorld(ref.camera.LiftAtDepth(e.pixel, e.near_depth));
+  const Eigen::Vector3d B = view.camera.CamFromWorld(ref.camera.LiftAtDepth(e.pixel, e.far_depth));
+  if (!(A.z() > 0) || !(B.z() > 0)) return std::nullopt;
+  const double mid = 0.5 * (e.near_depth + e.far_depth);
+  const Eigen::Vector2d at = view.camera.Project(ref.camera.LiftAtDepth(e.pixel, mid));
+  const Eigen::Vector2d across =
+      (view.camera.Project(ref.camera.LiftAtDepth(e.pixel + e.normal, mid)) - at).normalized();
+  if (!across.allFinite()) return std::nullopt;
+  return EpipolarSegment{view.camera.ProjectCam(A), view.camera.ProjectCam(B), across};
+}
+
 bool DepthAcrossEdges(const PinholeCamera& ref, const Eigen::Vector2d& pixel,
                       const std::vector<Observation>& obs,
                       const std::vector<Eigen::Vector2d>& normals, double* depth, double* worst,
-                      double* mean) {
+                      double* mean, std::vector<double>* residuals_out) {
   auto residuals = [&](double d, std::vector<double>* r) {
     r->clear();
     const Eigen::Vector3d X = ref.LiftAtDepth(pixel, d);
@@ -67,6 +81,7 @@ bool DepthAcrossEdges(const PinholeCamera& ref, const Eigen::Vector2d& pixel,
     *worst = std::max(*worst, std::abs(r));
     *mean += std::abs(r) / double(r0.size());
   }
+  if (residuals_out) *residuals_out = r0;
   return true;
 }
 
@@ -207,23 +222,17 @@ void FindCandidates(const View& ref, const std::vector<View>& others, const Outl
   const double min_cos = std::sin(o.min_epipolar_angle_deg * M_PI / 180);
   for (const View& view : others) {
     for (EdgeSample& e : *samples) {
-      const Eigen::Vector3d A =
-          view.camera.CamFromWorld(ref.camera.LiftAtDepth(e.pixel, e.near_depth));
-      const Eigen::Vector3d B =
-          view.camera.CamFromWorld(ref.camera.LiftAtDepth(e.pixel, e.far_depth));
-      if (!(A.z() > 0) || !(B.z() > 0)) continue;
-      const Eigen::Vector2d a = view.camera.ProjectCam(A), b = view.camera.ProjectCam(B);
+      const auto segment = EpipolarSegmentIn(ref, view, e);
+      if (!segment) continue;
+      const Eigen::Vector2d a = segment->near, b = segment->far;
       const double length = (b - a).norm();
       if (length < 1) continue;
       const Eigen::Vector2d dir = (b - a) / length;
-      // The sample's outward normal as this view sees it (at mid depth; only
-      // for the crossing angle and the gradient's direction).
-      const double mid = 0.5 * (e.near_depth + e.far_depth);
-      const Eigen::Vector2d at = view.camera.Project(ref.camera.LiftAtDepth(e.pixel, mid));
-      const Eigen::Vector2d nj =
-          (view.camera.Project(ref.camera.LiftAtDepth(e.pixel + e.normal, mid)) - at).normalized();
+      // The across direction serves only the crossing angle and the
+      // gradient's direction.
+      const Eigen::Vector2d nj = segment->across;
       const double cos_cross = nj.dot(dir);
-      if (!nj.allFinite() || std::abs(cos_cross) < min_cos) continue;
+      if (std::abs(cos_cross) < min_cos) continue;
       const int sign_along = e.sign * (cos_cross > 0 ? 1 : -1);
       const int count = int(length / 0.5) + 1;
       std::vector<double> g(count, 0);

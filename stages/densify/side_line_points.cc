@@ -1,29 +1,24 @@
 // Outline points from the sides' straight images: where every photo's
 // epipolar lines run along a page side, the side's line in each photo places
 // the samples the epipolar matching (edge_points.cc) could not.
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <optional>
 
+#include "common/line_fit.h"
 #include "common/statistics.h"
 #include "stages/densify/densify_internal.h"
 
 namespace docunfold::densify::detail {
 namespace {
 
-// The total-least-squares line through `pixels` (a, b, c with a x + b y + c
-// = 0, (a, b) unit) and the RMS of their distances to it.
+// The total-least-squares line through `pixels` as (a, b, c) with
+// a x + b y + c = 0, (a, b) unit, and the RMS of their distances to it.
 Eigen::Vector3d FitLine(const std::vector<Eigen::Vector2d>& pixels, double* rms) {
-  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
-  for (const auto& p : pixels) mean += p;
-  mean /= double(pixels.size());
-  Eigen::Matrix2d scatter = Eigen::Matrix2d::Zero();
-  for (const auto& p : pixels) scatter += (p - mean) * (p - mean).transpose();
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(scatter);
-  const Eigen::Vector2d normal = eigen.eigenvectors().col(0);
-  *rms = std::sqrt(std::max(0.0, eigen.eigenvalues()(0)) / double(pixels.size()));
-  return {normal.x(), normal.y(), -normal.dot(mean)};
+  const LineFit2d fit = FitLineTotalLeastSquares(pixels);
+  *rms = fit.rms;
+  return {fit.normal.x(), fit.normal.y(), -fit.normal.dot(fit.point)};
 }
 
 // The line most of `pixels` lie within `tolerance` of (a deterministic
@@ -81,17 +76,9 @@ std::optional<PhotoLine> SideLineInPhoto(const View& ref, const View& view,
                                          const OutlineOptions& o) {
   std::vector<Eigen::Vector2d> steps;
   for (const EdgeSample* e : left) {
-    const Eigen::Vector3d A =
-        view.camera.CamFromWorld(ref.camera.LiftAtDepth(e->pixel, e->near_depth));
-    const Eigen::Vector3d B =
-        view.camera.CamFromWorld(ref.camera.LiftAtDepth(e->pixel, e->far_depth));
-    if (!(A.z() > 0) || !(B.z() > 0)) continue;
-    const Eigen::Vector2d a = view.camera.ProjectCam(A), b = view.camera.ProjectCam(B);
-    const double mid = 0.5 * (e->near_depth + e->far_depth);
-    const Eigen::Vector2d at = view.camera.Project(ref.camera.LiftAtDepth(e->pixel, mid));
-    const Eigen::Vector2d across =
-        (view.camera.Project(ref.camera.LiftAtDepth(e->pixel + e->normal, mid)) - at).normalized();
-    if (!across.allFinite()) continue;
+    const auto segment = EpipolarSegmentIn(ref, view, *e);
+    if (!segment) continue;
+    const Eigen::Vector2d a = segment->near, b = segment->far, across = segment->across;
     const double length = (b - a).norm();
     for (double s = 0; s <= length; s += 2) {
       const Eigen::Vector2d p = a + (length > 0 ? s / length : 0.0) * (b - a);
@@ -126,12 +113,8 @@ bool DepthFromLines(const PinholeCamera& ref, const EdgeSample& e,
   }
   *depth = 0.5 * (e.near_depth + e.far_depth);
   double worst = 0, mean = 0;
-  if (!DepthAcrossEdges(ref, e.pixel, obs, normals, depth, &worst, &mean)) return false;
-  residuals->clear();
-  const Eigen::Vector3d X = ref.LiftAtDepth(e.pixel, *depth);
-  for (int k : use)
-    residuals->push_back(
-        std::abs(lines[k].normal.dot(lines[k].camera->Project(X) - lines[k].point)));
+  if (!DepthAcrossEdges(ref, e.pixel, obs, normals, depth, &worst, &mean, residuals)) return false;
+  for (double& r : *residuals) r = std::abs(r);
   return true;
 }
 
@@ -158,14 +141,21 @@ double LineSensitivity(const PinholeCamera& ref, const EdgeSample& e,
 // back). Past 8 photos only all of them are tried. Empty: none agree.
 std::vector<int> AgreeingLines(const PinholeCamera& ref, const std::vector<PhotoLine>& lines,
                                const std::vector<EdgeSample*>& left, const OutlineOptions& o) {
+  const int n = int(lines.size());
+  std::vector<std::vector<int>> subsets;
+  if (n > 8) {
+    subsets.emplace_back(n);
+    std::iota(subsets.back().begin(), subsets.back().end(), 0);
+  } else {
+    for (int mask = 1; mask < 1 << n; ++mask) {
+      subsets.emplace_back();
+      for (int k = 0; k < n; ++k)
+        if (mask & (1 << k)) subsets.back().push_back(k);
+    }
+  }
   std::vector<int> use;
   double use_spread = HUGE_VAL;
-  const int n = int(lines.size());
-  const int all_lines = (1 << std::min(n, 30)) - 1;
-  for (int subset = n <= 8 ? 1 : all_lines; subset <= all_lines; ++subset) {
-    std::vector<int> pick;
-    for (int k = 0; k < n; ++k)
-      if (k >= 30 || subset & (1 << k)) pick.push_back(k);
+  for (const std::vector<int>& pick : subsets) {
     if (int(pick.size()) + 1 < o.min_views || pick.size() < use.size()) continue;
     std::vector<std::vector<double>> per_line(pick.size());
     for (const EdgeSample* e : left) {

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <limits>
 
+#include "common/line_fit.h"
 #include "common/statistics.h"
 
 namespace docunfold::render {
@@ -44,25 +45,6 @@ int NearestFace(const RasterResult& raster, const Eigen::Vector2d& p, double rad
     }
   }
   return best;
-}
-
-struct Line {
-  Eigen::Vector2d point, direction;
-  double rms = 0;
-};
-
-Line FitTotalLeastSquares(const std::vector<Eigen::Vector2d>& pts) {
-  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
-  for (const auto& p : pts) mean += p;
-  mean /= double(pts.size());
-  Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();
-  for (const auto& p : pts) cov += (p - mean) * (p - mean).transpose();
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(cov);
-  Line line;
-  line.point = mean;
-  line.direction = eig.eigenvectors().col(1).normalized();  // largest eigenvalue
-  line.rms = std::sqrt(std::max(0.0, eig.eigenvalues()[0]) / double(pts.size()));
-  return line;
 }
 
 }  // namespace
@@ -123,7 +105,7 @@ SideFit FitSideLine(int side, bool real, const std::vector<Eigen::Vector2d>& fla
                " samples map onto the mesh";
     return fit;
   }
-  Line line = FitTotalLeastSquares(pts);
+  LineFit2d line = FitLineTotalLeastSquares(pts);
   // Drop samples far from the line (a corner rounding, a stray mesh fold),
   // then refit; twice is enough for the few outliers a side has.
   for (int round = 0; round < 2; ++round) {
@@ -137,7 +119,7 @@ SideFit FitSideLine(int side, bool real, const std::vector<Eigen::Vector2d>& fla
       if (res[i] <= limit) kept.push_back(pts[i]);
     if (kept.size() < 10 || kept.size() == pts.size()) break;
     pts = std::move(kept);
-    line = FitTotalLeastSquares(pts);
+    line = FitLineTotalLeastSquares(pts);
   }
   fit.mapped = int(pts.size());
   fit.point = line.point;
