@@ -130,15 +130,6 @@ struct SolveOptions {
   // the model size (bounding-box diagonal of M); re-decided every outer
   // iteration (progressive filtering). <= 0 keeps every point.
   double outlier_distance = 0.06;
-  // λ3 is multiplied by this (≤ 1) on M within support_radius (fraction of
-  // the model size, along M's grid) of a triangle holding an inlier
-  // footpoint, rising linearly back to 1 at twice that distance; decided at
-  // the start of each solve, then held so that F stays one function. Where
-  // points are, they hold M's shape and a fold stays sharp; where none are
-  // (blank margins, a cut-off band) λ3 keeps M from drifting. 1 = off.
-  double fair3d_near_points = 1;
-  double crease_curvature = 0;  // trial: triplet weight 1/(1+(κ/κ0)²)
-  double support_radius = 0.03;
   IsoNormalization iso_normalization = IsoNormalization::kStrain;
   // Weight of E_iso's edge-length rows against the paper's three diagonal
   // rows per quad (0 = the paper). The diagonals alone leave a quad of M free

@@ -1,13 +1,8 @@
 // What each outer iteration of the solver re-decides before its step:
 // footpoints and outliers, the lines' parameters, the markers' projection.
 #include <Eigen/Eigenvalues>
-#include <algorithm>
 #include <cmath>
-#include <functional>
 #include <limits>
-#include <queue>
-#include <utility>
-#include <vector>
 
 #ifdef _OPENMP
 #include <omp.h>
@@ -54,48 +49,6 @@ void UpdateFootpoints(const State& s, StepData& data, double phi, int threads) {
     ++inliers;
   }
   data.num_inliers = inliers;
-}
-
-void UpdateFairScale(const State& s, StepData& data, double near_points, double radius) {
-  data.fair3d_scale.clear();
-  if (radius <= 0) return;
-  // Distance along M's grid edges from the nearest vertex of a triangle
-  // holding an inlier footpoint (Dijkstra, cut off at twice the radius).
-  const QuadGrid& g = s.grid;
-  const int n = g.NumVertices();
-  std::vector<double> distance(size_t(n), std::numeric_limits<double>::infinity());
-  using Item = std::pair<double, int>;
-  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
-  for (const Footpoint& f : data.footpoints) {
-    if (!f.inlier || f.triangle < 0) continue;
-    for (const int v : TriangleOf(g, f.triangle))
-      if (distance[size_t(v)] > 0) {
-        distance[size_t(v)] = 0;
-        queue.push({0.0, v});
-      }
-  }
-  while (!queue.empty()) {
-    const auto [d, v] = queue.top();
-    queue.pop();
-    if (d > distance[size_t(v)] || d > 2 * radius) continue;
-    const int r = v / g.nx, c = v % g.nx;
-    const int next[4][2] = {{r - 1, c}, {r + 1, c}, {r, c - 1}, {r, c + 1}};
-    for (const auto& rc : next) {
-      if (rc[0] < 0 || rc[1] < 0 || rc[0] >= g.ny || rc[1] >= g.nx) continue;
-      const int u = g.Index(rc[0], rc[1]);
-      const double du = d + (s.v3[size_t(u)] - s.v3[size_t(v)]).norm();
-      if (du < distance[size_t(u)]) {
-        distance[size_t(u)] = du;
-        queue.push({du, u});
-      }
-    }
-  }
-  data.support_distance = distance;
-  if (near_points == 1) return;
-  data.fair3d_scale.resize(size_t(n));
-  for (int v = 0; v < n; ++v)
-    data.fair3d_scale[size_t(v)] =
-        near_points + (1 - near_points) * std::clamp(distance[size_t(v)] / radius - 1, 0.0, 1.0);
 }
 
 Eigen::Vector2d FlatPoint(const State& s, const SurfacePoint& w) {

@@ -44,12 +44,6 @@ struct StepData {
   double beta_point = 1;
   double beta_normal = 0.1;
   int num_inliers = 0;
-  // E_fair(M)'s multiplier per vertex of M (the middle of a triplet), or
-  // empty (1 everywhere): see SolveOptions::fair3d_near_points.
-  std::vector<double> fair3d_scale;
-  std::vector<double> fair3d_factor;  // per triplet, on its rows of M (empty: 1)
-  std::vector<double>
-      support_distance;  // trial: per vertex, along M to the nearest footpoint's triangle
 };
 
 struct Row {
@@ -184,23 +178,18 @@ inline std::array<int, 3> FairTriplet(const QuadGrid& g, int t) {
   return {g.Index(r - 1, c), g.Index(r, c), g.Index(r + 1, c)};
 }
 // dims 0..2 (M) or 3..4 (M'): one row per coordinate.
-inline int FairRows(const State& s, const StepData& data, int t, bool flat, Row* rows) {
+inline int FairRows(const State& s, int t, bool flat, Row* rows) {
   const auto v = FairTriplet(s.grid, t);
   const int first = flat ? 3 : 0, n = flat ? 2 : 3;
-  const bool scaled = !flat && (!data.fair3d_scale.empty() || !data.fair3d_factor.empty());
-  double scale = 1.0;
-  if (!flat && !data.fair3d_scale.empty()) scale *= std::sqrt(data.fair3d_scale[v[1]]);
-  if (!flat && !data.fair3d_factor.empty()) scale *= data.fair3d_factor[size_t(t)];
   for (int k = 0; k < n; ++k) {
     const int dim = first + k;
     Row& r = rows[k];
     r.Reset();
     r.value = flat ? s.v2[v[0]][k] - 2 * s.v2[v[1]][k] + s.v2[v[2]][k]
                    : s.v3[v[0]][k] - 2 * s.v3[v[1]][k] + s.v3[v[2]][k];
-    if (scaled) r.value *= scale;
-    r.Add(v[0])[dim] = scale;
-    r.Add(v[1])[dim] = -2 * scale;
-    r.Add(v[2])[dim] = scale;
+    r.Add(v[0])[dim] = 1;
+    r.Add(v[1])[dim] = -2;
+    r.Add(v[2])[dim] = 1;
   }
   return n;
 }
@@ -273,9 +262,9 @@ void ForEachRow(const State& s, const StepData& data, Sink&& sink) {
   }
   const int triplets = NumFairTriplets(s.grid);
   for (int t = 0; t < triplets; ++t) {
-    int n = FairRows(s, data, t, false, rows);
+    int n = FairRows(s, t, false, rows);
     for (int i = 0; i < n; ++i) sink(kFair3d, rows[i]);
-    n = FairRows(s, data, t, true, rows);
+    n = FairRows(s, t, true, rows);
     for (int i = 0; i < n; ++i) sink(kFair2d, rows[i]);
   }
   for (int m = 0; m < int(data.markers.size()); ++m) {

@@ -10,13 +10,6 @@ void DeclareSolveOptions(OptionTable& table, SolveOptions* o) {
               "λ2, weight of the distance to the points E_dist");
   table.Value("lambda-fair3d", &o->weights.fair3d, 0.0, 1e9, "λ3, weight of the fairness of M");
   table.Value("lambda-fair2d", &o->weights.fair2d, 0.0, 1e9, "λ4, weight of the fairness of M'");
-  table.Value("fair3d-near-points", &o->fair3d_near_points, 0.0, 1.0,
-              "λ3 is multiplied by this near the points (within --support-radius along M), "
-              "back to 1 at twice that distance: folds stay sharp where points show them, "
-              "blank paper stays fair (1 = off)");
-  table.Value("crease-curvature", &o->crease_curvature, 0.0, 1e9, "trial κ0 (0 = off)");
-  table.Value("support-radius", &o->support_radius, 0.0, 1.0,
-              "see --fair3d-near-points: fraction of the model size");
   table.Value("outlier-distance", &o->outlier_distance, 0.0, 10.0,
               "φ: points farther from M than this fraction of the model size are ignored "
               "(re-decided every outer iteration)");

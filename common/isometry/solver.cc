@@ -137,25 +137,6 @@ Result Solve(const Problem& problem, const SolveOptions& o) {
     if (gn) gn->set_threads(threads);
     ir.threads = threads;
     UpdateFootpoints(w.state, w.data, o.outlier_distance, threads);
-    if (it == 0) UpdateFairScale(w.state, w.data, o.fair3d_near_points, o.support_radius);
-    if (o.crease_curvature > 0) {
-      using namespace internal;
-      const int triplets = NumFairTriplets(w.state.grid);
-      w.data.fair3d_factor.assign(size_t(triplets), 1.0);
-      for (int t = 0; t < triplets; ++t) {
-        const auto v = FairTriplet(w.state.grid, t);
-        const Eigen::Vector3d a = w.state.v3[v[1]] - w.state.v3[v[0]],
-                              b = w.state.v3[v[2]] - w.state.v3[v[1]];
-        const double la = a.norm(), lb = b.norm();
-        if (!(la > 0 && lb > 0)) continue;
-        if (!w.data.support_distance.empty() &&
-            w.data.support_distance[size_t(v[1])] > o.support_radius)
-          continue;
-        const double turn = std::acos(std::clamp(a.dot(b) / (la * lb), -1.0, 1.0));
-        const double x = turn / (0.5 * (la + lb)) / o.crease_curvature;
-        w.data.fair3d_factor[size_t(t)] = std::sqrt(1 / (1 + x * x));
-      }
-    }
     // The callback first: it may regroup markers into new lines, which are
     // then fitted and projected onto like any others.
     if (o.on_outer_iteration) CallOuterIteration(o, it, w);

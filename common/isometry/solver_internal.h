@@ -49,9 +49,6 @@ double NearestAxisTheta(double theta);
 
 // Footpoints of every target point on M, and the outlier decision.
 void UpdateFootpoints(const State& s, StepData& data, double phi, int threads);
-// E_fair(M)'s multiplier per vertex (SolveOptions::fair3d_near_points and
-// support_radius) from the current footpoints; clears it when off.
-void UpdateFairScale(const State& s, StepData& data, double near_points, double radius);
 
 // A surface point's position in M'.
 Eigen::Vector2d FlatPoint(const State& s, const SurfacePoint& w);
