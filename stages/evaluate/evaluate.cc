@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <fstream>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 #include <sstream>
 
 #include "common/atomic_file.h"
@@ -18,6 +19,7 @@
 #include "stages/evaluate/geometry_metrics.h"
 #include "stages/evaluate/image_metrics.h"
 #include "stages/evaluate/ocr.h"
+#include "stages/evaluate/registration.h"
 #include "stages/evaluate/text_metrics.h"
 
 namespace docunfold::evaluate {
@@ -50,6 +52,29 @@ std::string CacheKey(const fs::path& file, const std::string& settings) {
 Json SizeJson(cv::Size s) { return Json::array({s.width, s.height}); }
 
 Json Skipped(const std::string& why) { return Json{{"skipped", why}}; }
+
+// The result registered to the truth by one affine map (registration.h), the
+// map given in fractions of the page (x / width, y / height) so that it reads
+// the same at any size: diagonal = the result's scale of the page along x
+// and y, last column = its shift.
+Json RegistrationJson(const EvaluationPair& pair, const cv::Mat2f& flow, Metrics* m) {
+  const std::optional<AffineRegistration> reg =
+      RegisterAffine(pair.ground_truth, pair.result, flow);
+  if (!reg) return Skipped("too few flow vectors on the page's ink agree on one affine map");
+  m->ms_ssim_registered = reg->ms_ssim;
+  const double w = pair.ground_truth.cols, h = pair.ground_truth.rows;
+  const cv::Matx23d& a = reg->result_from_truth;
+  const Json map = Json::array({Json::array({a(0, 0), a(0, 1) * h / w, a(0, 2) / w}),
+                                Json::array({a(1, 0) * w / h, a(1, 1), a(1, 2) / h})});
+  return {{"method",
+           "affine map fitted (RANSAC 1 px at the flow size, then refined) to the DeepFlow "
+           "field where flat.png has ink; the result resampled through it, MS-SSIM as above"},
+          {"result_from_truth", map},
+          {"units", "fractions of the page's width (x) and height (y)"},
+          {"samples", reg->samples},
+          {"residual_px", reg->residual_px},
+          {"ms_ssim", reg->ms_ssim}};
+}
 
 // OCR of the ground truth, from the cache when it holds this file's text.
 std::string GroundTruthText(Ocr& ocr, const fs::path& flat, const fs::path& work, bool use_cache,
@@ -215,6 +240,10 @@ void DeclareOptions(OptionTable& table, EvaluateOptions* o) {
   table.Value("method", &o->method, "label of this result (row name)");
   table.Switch("ocr", &o->ocr, "CER, ED and WER (Tesseract)");
   table.Switch("flow", &o->flow, "LD and Li-D (DeepFlow)");
+  table.Switch("registered", &o->registered,
+               "also MS-SSIM after registering the result to flat.png by the best single affine "
+               "map (fitted to the DeepFlow field on the page's ink): the loss the crop's sides "
+               "and the page's scale explain, apart from its local shape");
   table.Switch("geometry", &o->geometry, "surface distance and isometry error");
   table.Switch("ocr-cache", &o->ocr_cache,
                "cache the OCR text of flat.png in <work>/70_eval/ocr-cache/ (off: always OCR "
@@ -252,12 +281,16 @@ EvaluateResult Run(const EvaluateInputs& in, const EvaluateOptions& options,
                 "divided by their sum 1.0001 so that identical images give 1"}};
 
   Json flow_json;
-  if (options.flow) {
+  cv::Mat2f flow_field;
+  if (options.flow || options.registered) {
     t = Clock::now();
-    const FlowResult flow = DenseFlowMetrics(pair.ground_truth, pair.result);
+    flow_field = HalfSizeFlow(pair.ground_truth, pair.result);
+    seconds["flow"] = SecondsSince(t);
+  }
+  if (options.flow) {
+    const FlowResult flow = FlowStatistics(flow_field);
     m.ld = flow.ld;
     m.li_d = flow.li_d;
-    seconds["flow"] = SecondsSince(t);
     flow_json = {{"method",
                   "DeepFlow (OpenCV contrib optflow), a stand-in for "
                   "the SIFT flow of the literature"},
@@ -267,6 +300,13 @@ EvaluateResult Run(const EvaluateInputs& in, const EvaluateOptions& options,
                  {"li_d", flow.li_d}};
   } else {
     flow_json = Skipped("--no-flow");
+  }
+
+  Json registration_json = Skipped("no --registered");
+  if (options.registered) {
+    t = Clock::now();
+    registration_json = RegistrationJson(pair, flow_field, &m);
+    seconds["registration"] = SecondsSince(t);
   }
 
   Json ocr_json;
@@ -296,6 +336,7 @@ EvaluateResult Run(const EvaluateInputs& in, const EvaluateOptions& options,
   doc["result_size"] = SizeJson(result.size());
   doc["ground_truth_size"] = SizeJson(flat.size());
   doc["metrics"] = {{"ms_ssim", NumberOrNull(m.ms_ssim)},
+                    {"ms_ssim_registered", NumberOrNull(m.ms_ssim_registered)},
                     {"ld", NumberOrNull(m.ld)},
                     {"li_d", NumberOrNull(m.li_d)},
                     {"cer", NumberOrNull(m.cer)},
@@ -309,6 +350,7 @@ EvaluateResult Run(const EvaluateInputs& in, const EvaluateOptions& options,
                     {"isometry_max", NumberOrNull(m.isometry_max)}};
   doc["ms_ssim"] = ms_json;
   doc["flow"] = flow_json;
+  doc["registration"] = registration_json;
   doc["ocr"] = ocr_json;
   doc["geometry"] = geometry_json;
   doc["seconds"] = seconds;
@@ -321,7 +363,8 @@ std::string Summary(const EvaluateResult& r, const std::string& method) {
   auto figure = [](const char* name, double v, int decimals) {
     return std::isfinite(v) ? std::string(", ") + name + " " + Fixed(v, decimals) : std::string();
   };
-  return method + ": MS-SSIM " + Fixed(m.ms_ssim, 4) + figure("LD", m.ld, 2) +
+  return method + ": MS-SSIM " + Fixed(m.ms_ssim, 4) +
+         figure("registered by one affine map", m.ms_ssim_registered, 4) + figure("LD", m.ld, 2) +
          figure("Li-D", m.li_d, 2) + figure("CER", m.cer, 4) + figure("WER", m.wer, 4) +
          figure("surface mean %", m.surface_mean_pct, 3) + figure("isometry", m.isometry_mean, 4) +
          " (" + Fixed(r.document["seconds"]["total"].get<double>(), 1) + " s)";

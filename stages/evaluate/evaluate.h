@@ -23,7 +23,12 @@ struct EvaluateOptions {
   std::string method = "docunfold";  // label of the row in the benchmark
   bool ocr = true;                   // CER, ED, WER with Tesseract (the slowest part, ~seconds)
   bool flow = true;                  // LD, Li-D with DeepFlow (~seconds)
-  bool geometry = true;              // surface distance and isometry error, when possible
+  // Also MS-SSIM after registering the result to flat.png by the best
+  // single affine map (registration.h): how much of the loss is the crop's
+  // sides and the page's scale, not its local shape. A diagnostic, off by
+  // default (the literature's figures do not register).
+  bool registered = false;
+  bool geometry = true;  // surface distance and isometry error, when possible
   // Meshes to measure; empty = <work>/50_optimize, else <work>/40_init.
   fs::path mesh_dir;
   // Keep the OCR text of flat.png in <work>/70_eval/ocr-cache/, keyed by a
@@ -54,6 +59,7 @@ bool HasGroundTruth(const fs::path& data);
 // Figures are NaN when not computed (the JSON then holds null).
 struct Metrics {
   double ms_ssim = NAN;
+  double ms_ssim_registered = NAN;  // with --registered
   double ld = NAN, li_d = NAN;
   double cer = NAN, wer = NAN;
   double ed = NAN;

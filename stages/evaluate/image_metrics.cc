@@ -139,15 +139,20 @@ FlowResult FlowStatistics(const cv::Mat2f& flow) {
   return out;
 }
 
+cv::Mat1b BlurredHalf(const cv::Mat1b& image) {
+  const cv::Size half((image.cols + 1) / 2, (image.rows + 1) / 2);
+  cv::Mat1b blurred, small;
+  cv::GaussianBlur(image, blurred, cv::Size(7, 7), 1.0, 1.0, cv::BORDER_REPLICATE);
+  cv::resize(blurred, small, half, 0, 0, cv::INTER_AREA);
+  return small;
+}
+
+cv::Mat2f HalfSizeFlow(const cv::Mat1b& ground_truth, const cv::Mat1b& result) {
+  return DeepFlow(BlurredHalf(ground_truth), BlurredHalf(result));
+}
+
 FlowResult DenseFlowMetrics(const cv::Mat1b& ground_truth, const cv::Mat1b& result) {
-  const cv::Size half((ground_truth.cols + 1) / 2, (ground_truth.rows + 1) / 2);
-  auto prepare = [&](const cv::Mat1b& image) {
-    cv::Mat1b blurred, small;
-    cv::GaussianBlur(image, blurred, cv::Size(7, 7), 1.0, 1.0, cv::BORDER_REPLICATE);
-    cv::resize(blurred, small, half, 0, 0, cv::INTER_AREA);
-    return small;
-  };
-  return FlowStatistics(DeepFlow(prepare(ground_truth), prepare(result)));
+  return FlowStatistics(HalfSizeFlow(ground_truth, result));
 }
 
 }  // namespace docunfold::evaluate

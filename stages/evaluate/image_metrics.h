@@ -60,6 +60,11 @@ struct FlowResult {
 // (7x7 Gaussian, sigma 1, replicated borders) and halved before the flow.
 FlowResult DenseFlowMetrics(const cv::Mat1b& ground_truth, const cv::Mat1b& result);
 
+// The steps of DenseFlowMetrics: an evaluation-size image blurred and
+// halved, and DeepFlow from the ground truth's to the result's.
+cv::Mat1b BlurredHalf(const cv::Mat1b& image);
+cv::Mat2f HalfSizeFlow(const cv::Mat1b& ground_truth, const cv::Mat1b& result);
+
 // LD and Li-D of a given flow field (CV_32FC2, (v_x, v_y) per pixel).
 FlowResult FlowStatistics(const cv::Mat2f& flow);
 

@@ -110,6 +110,34 @@ TEST_F(EvaluateCli, ShiftOfSixPixelsIsThreeAtTheFlowResolution) {
   EXPECT_EQ(j["flow"]["size"], Json::array({440, 340}));
 }
 
+TEST_F(EvaluateCli, RegisteredUndoesAShiftAndStretchButNotTheLiteratureFigure) {
+  // The page moved 6 px right and stretched 1 % down: one affine map.
+  cv::Mat page = cv::imread(flat.string());
+  cv::Mat m = (cv::Mat_<double>(2, 3) << 1, 0, 6, 0, 1.01, 0);
+  cv::Mat moved;
+  cv::warpAffine(page, moved, m, page.size(), cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+  cv::imwrite((dir / "moved.png").string(), moved);
+  CommandResult r = RunCommand(Evaluate(Args(dir / "moved.png", "--no-ocr --registered")));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const Json j = ReadJson(out);
+  EXPECT_LT(j["metrics"]["ms_ssim"].get<double>(), 0.9);
+  EXPECT_GT(j["metrics"]["ms_ssim_registered"].get<double>(), 0.97) << j["registration"].dump();
+  const Json& a = j["registration"]["result_from_truth"];  // in fractions of the page
+  EXPECT_NEAR(a[0][0].get<double>(), 1.0, 2e-3);
+  EXPECT_NEAR(a[1][1].get<double>(), 1.01, 2e-3);
+  EXPECT_NEAR(a[0][2].get<double>(), 6.0 / 880, 1e-3);
+  EXPECT_NE(r.output.find("registered by one affine map"), std::string::npos) << r.output;
+  CommandResult v = RunCommand(Quote((SourceDir() / "scripts" / "validate-json").string()) + " " +
+                               Quote(out.string()));
+  EXPECT_EQ(v.exit_code, 0) << v.output;
+
+  // Without the flag the figure is null and the block says why.
+  r = RunCommand(Evaluate(Args(dir / "moved.png", "--no-ocr")));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(ReadJson(out)["metrics"]["ms_ssim_registered"].is_null());
+  EXPECT_EQ(ReadJson(out)["registration"]["skipped"], "no --registered");
+}
+
 TEST_F(EvaluateCli, OcrAtTruthSizeResizesTheResultFirst) {
   // The page rendered at twice the size: OCRed at flat.png's size it reads
   // as the ground truth does.

@@ -1,0 +1,72 @@
+#include "stages/evaluate/registration.h"
+
+#include <cmath>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+#include <vector>
+
+#include "stages/evaluate/image_metrics.h"
+
+namespace docunfold::evaluate {
+namespace {
+
+// Flow vectors are taken on a grid this many half-size pixels apart, where the
+// blurred truth's gradient is at least kMinGradient grey levels per pixel.
+constexpr int kStride = 2;
+constexpr double kMinGradient = 12;
+constexpr double kRansacPx = 1.0;  // half-size pixels
+constexpr int kMinSamples = 50;
+
+}  // namespace
+
+std::optional<AffineRegistration> RegisterAffine(const cv::Mat1b& ground_truth,
+                                                 const cv::Mat1b& result, const cv::Mat2f& flow) {
+  const cv::Mat1b half = BlurredHalf(ground_truth);
+  if (half.size() != flow.size()) return std::nullopt;
+  cv::Mat1f gx, gy;
+  cv::Sobel(half, gx, CV_32F, 1, 0, 3, 1.0 / 8);
+  cv::Sobel(half, gy, CV_32F, 0, 1, 3, 1.0 / 8);
+  std::vector<cv::Point2f> from, to;
+  for (int r = 0; r < half.rows; r += kStride)
+    for (int c = 0; c < half.cols; c += kStride) {
+      if (std::hypot(gx(r, c), gy(r, c)) < kMinGradient) continue;
+      const cv::Vec2f f = flow(r, c);
+      if (!std::isfinite(f[0]) || !std::isfinite(f[1])) continue;
+      from.emplace_back(float(c), float(r));
+      to.emplace_back(float(c) + f[0], float(r) + f[1]);
+    }
+  if (int(from.size()) < kMinSamples) return std::nullopt;
+  std::vector<uchar> inlier;
+  const cv::Mat half_map = cv::estimateAffine2D(from, to, inlier, cv::RANSAC, kRansacPx);
+  if (half_map.empty()) return std::nullopt;
+  AffineRegistration out;
+  double squares = 0;
+  const cv::Matx23d a(half_map);
+  for (size_t i = 0; i < from.size(); ++i) {
+    if (!inlier[i]) continue;
+    const cv::Point2d p = from[i];
+    const cv::Point2d q(a(0, 0) * p.x + a(0, 1) * p.y + a(0, 2),
+                        a(1, 0) * p.x + a(1, 1) * p.y + a(1, 2));
+    const cv::Point2d e = q - cv::Point2d(to[i]);
+    squares += e.dot(e);
+    ++out.samples;
+  }
+  if (out.samples < kMinSamples) return std::nullopt;
+  // Half-size pixels to evaluation-size pixels, per axis, pixel centres
+  // matched as INTER_AREA matches them: full = s * half + (s - 1) / 2.
+  // A_full = H A_half H^-1.
+  const double sx = double(ground_truth.cols) / half.cols;
+  const double sy = double(ground_truth.rows) / half.rows;
+  const cv::Matx33d h(sx, 0, 0.5 * (sx - 1), 0, sy, 0.5 * (sy - 1), 0, 0, 1);
+  const cv::Matx33d a3(a(0, 0), a(0, 1), a(0, 2), a(1, 0), a(1, 1), a(1, 2), 0, 0, 1);
+  const cv::Matx33d full = h * a3 * h.inv();
+  out.residual_px = std::sqrt(squares / out.samples) * 0.5 * (sx + sy);
+  out.result_from_truth = full.get_minor<2, 3>(0, 0);
+  cv::Mat1b registered;
+  cv::warpAffine(result, registered, cv::Mat(out.result_from_truth), ground_truth.size(),
+                 cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_REPLICATE);
+  out.ms_ssim = MsSsim(ground_truth, registered).value;
+  return out;
+}
+
+}  // namespace docunfold::evaluate
