@@ -63,6 +63,9 @@ case $ocr_size in
   native) ;;
   *) echo "bench: BENCH_OCR_SIZE=$ocr_size: expected truth or native" >&2; exit 2 ;;
 esac
+# Every row also scored after one affine map (evaluate --registered): the
+# share of its loss that is the crop's sides and the page's scale.
+eval_flags+=(--registered)
 timer=$root/scripts/stage-timer
 
 case $frontend in pipeline|truth) ;; *)

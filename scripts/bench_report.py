@@ -28,7 +28,8 @@ STAGE_ORDER = ["truth-frontend", "sfm", "segment-boundary", "densify", "detect-f
 FIGURES = [("ms_ssim", "MS-SSIM ↑", "%.4f"), ("ld", "LD ↓", "%.2f"), ("li_d", "Li-D ↓", "%.2f"),
            ("cer", "CER ↓", "%.4f"), ("wer", "WER ↓", "%.4f"),
            ("surface_mean_pct", "surface mean % ↓", "%.3f"),
-           ("isometry_mean", "isometry ↓", "%.4f")]
+           ("isometry_mean", "isometry ↓", "%.4f"),
+           ("ms_ssim_registered", "MS-SSIM one affine map away ↑", "%.4f")]
 ROW_ORDER = ["homography", "oracle", "oracle-seen", "oracle-multiview", "docunfold",
              "docunfold-reference", "docunfold-init", "docunfold-nofeatures",
              "docunfold-boundary", "docunfold-from-truth", "oracle-deshaded",
@@ -320,7 +321,10 @@ def markdown(result):
               "from DeepFlow (a stand-in for SIFT flow), in pixels at half that size; CER and WER "
               "of Tesseract (eng) on the result%s against Tesseract on flat.png; surface mean "
               "distance of M to the true surface in %% of the page diagonal; isometry = mean "
-              "relative edge-length error between M and M'. "
+              "relative edge-length error between M and M'; MS-SSIM one affine map away = "
+              "MS-SSIM after registering the result to flat.png by the best single affine map "
+              "(evaluate `--registered`): what is left when the crop's sides and the page's scale "
+              "are forgiven. "
               "Rows: `homography` = reference photo warped by the 4 page corners (scanner app), turned the way render turned docunfold's page; "
               "`oracle` = reference photo textured through the true surface and camera (ceiling "
               "for one-view texturing); `oracle-seen` = the oracle cropped to the part of the page "
