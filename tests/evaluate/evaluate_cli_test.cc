@@ -55,6 +55,16 @@ class EvaluateCli : public ::testing::Test {
     return "--data " + Quote(data.string()) + " --work " + Quote((dir / "work").string()) +
            " --result " + Quote(result.string()) + " --out " + Quote(out.string()) + " " + extra;
   }
+  // flat.png moved by the affine map `result_from_truth` (pixels), written as `name`.
+  fs::path WriteMovedPage(const cv::Matx23d& result_from_truth, const std::string& name) const {
+    const cv::Mat page = cv::imread(flat.string());
+    cv::Mat moved;
+    cv::warpAffine(page, moved, cv::Mat(result_from_truth), page.size(), cv::INTER_LINEAR,
+                   cv::BORDER_REPLICATE);
+    const fs::path path = dir / name;
+    cv::imwrite(path.string(), moved);
+    return path;
+  }
 };
 
 TEST_F(EvaluateCli, IdenticalImageScoresPerfectlyAndValidates) {
@@ -93,12 +103,8 @@ TEST_F(EvaluateCli, IdenticalImageScoresPerfectlyAndValidates) {
 }
 
 TEST_F(EvaluateCli, ShiftOfSixPixelsIsThreeAtTheFlowResolution) {
-  cv::Mat page = cv::imread(flat.string());
-  cv::Mat m = (cv::Mat_<double>(2, 3) << 1, 0, 6, 0, 1, 0);
-  cv::Mat shifted;
-  cv::warpAffine(page, shifted, m, page.size(), cv::INTER_LINEAR, cv::BORDER_REPLICATE);
-  cv::imwrite((dir / "shifted.png").string(), shifted);
-  CommandResult r = RunCommand(Evaluate(Args(dir / "shifted.png", "--no-ocr")));
+  const fs::path shifted = WriteMovedPage(cv::Matx23d(1, 0, 6, 0, 1, 0), "shifted.png");
+  CommandResult r = RunCommand(Evaluate(Args(shifted, "--no-ocr")));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const Json j = ReadJson(out);
   EXPECT_NEAR(j["metrics"]["ld"].get<double>(), 3.0, 0.3);
@@ -112,12 +118,8 @@ TEST_F(EvaluateCli, ShiftOfSixPixelsIsThreeAtTheFlowResolution) {
 
 TEST_F(EvaluateCli, RegisteredUndoesAShiftAndStretchButNotTheLiteratureFigure) {
   // The page moved 6 px right and stretched 1 % down: one affine map.
-  cv::Mat page = cv::imread(flat.string());
-  cv::Mat m = (cv::Mat_<double>(2, 3) << 1, 0, 6, 0, 1.01, 0);
-  cv::Mat moved;
-  cv::warpAffine(page, moved, m, page.size(), cv::INTER_LINEAR, cv::BORDER_REPLICATE);
-  cv::imwrite((dir / "moved.png").string(), moved);
-  CommandResult r = RunCommand(Evaluate(Args(dir / "moved.png", "--no-ocr --registered")));
+  const fs::path moved = WriteMovedPage(cv::Matx23d(1, 0, 6, 0, 1.01, 0), "moved.png");
+  CommandResult r = RunCommand(Evaluate(Args(moved, "--no-ocr --registered")));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const Json j = ReadJson(out);
   EXPECT_LT(j["metrics"]["ms_ssim"].get<double>(), 0.9);
@@ -132,7 +134,7 @@ TEST_F(EvaluateCli, RegisteredUndoesAShiftAndStretchButNotTheLiteratureFigure) {
   EXPECT_EQ(v.exit_code, 0) << v.output;
 
   // Without the flag the figure is null and the block says why.
-  r = RunCommand(Evaluate(Args(dir / "moved.png", "--no-ocr")));
+  r = RunCommand(Evaluate(Args(moved, "--no-ocr")));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_TRUE(ReadJson(out)["metrics"]["ms_ssim_registered"].is_null());
   EXPECT_EQ(ReadJson(out)["registration"]["skipped"], "no --registered");
