@@ -120,11 +120,11 @@ double GaussNewton::Assemble(const State& s, const StepData& data, const Weights
         for (int k = colour; k < per_line; k += 3) {
           const int t = (phase == 0 ? 0 : along_rows) + l * per_line + k;
           if (w.fair3d > 0) {
-            const int m = FairRows(s, t, false, rows);
+            const int m = FairRows(s, data, t, false, rows);
             for (int i = 0; i < m; ++i) sum += add(w.fair3d, rows[i]);
           }
           if (w.fair2d > 0) {
-            const int m = FairRows(s, t, true, rows);
+            const int m = FairRows(s, data, t, true, rows);
             for (int i = 0; i < m; ++i) sum += add(w.fair2d, rows[i]);
           }
         }

@@ -101,6 +101,10 @@ struct Problem {
   std::vector<Eigen::Vector3d> points;  // target points (SfM), world frame
   std::vector<Marker> markers;          // may be empty (then E_line = E_ray = 0)
   std::vector<FeatureLine> lines;       // initial line parameters
+  // λ3's multiplier per fair triplet (NumFairTriplets of the grid, in
+  // FairTriplet's order), or empty (1 everywhere): lets E_fair(M) spare
+  // where the caller knows the page is creased.
+  std::vector<double> fair3d_weights;
 };
 
 enum class IsoNormalization { kStrain, kRaw };
@@ -240,6 +244,10 @@ struct Result {
 // its stopping rule) into `table`, bound to `options`' fields: the same flags
 // in init-mesh and optimize, each with that stage's default.
 void DeclareSolveOptions(OptionTable& table, SolveOptions* options);
+
+// E_fair's triplets of vertices (three in a row along a grid row, then
+// along a column), in the order of Problem::fair3d_weights.
+std::vector<std::array<int, 3>> FairTriplets(const QuadGrid& grid);
 
 // Minimises F from problem's initial values. Throws std::invalid_argument on
 // an inconsistent problem (sizes, non-finite values, bad marker triangles).

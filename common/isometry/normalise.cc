@@ -29,6 +29,11 @@ Frame FrameOf(const MeshPair& m) {
 
 void Validate(const Problem& p) {
   const QuadGrid& g = p.meshes.grid;
+  if (!p.fair3d_weights.empty() && int(p.fair3d_weights.size()) != NumFairTriplets(g))
+    throw std::invalid_argument("isometry: fair3d_weights does not match the grid's triplets");
+  for (const double w : p.fair3d_weights)
+    if (!(w >= 0 && std::isfinite(w)))
+      throw std::invalid_argument("isometry: a fair3d weight is negative or not finite");
   if (g.nx < 2 || g.ny < 2) throw std::invalid_argument("isometry: grid smaller than 2x2");
   if (int(p.meshes.mesh3d.size()) != g.NumVertices() ||
       int(p.meshes.mesh2d.size()) != g.NumVertices())
@@ -74,6 +79,7 @@ Work Normalise(const Problem& p, const SolveOptions& o) {
   }
   w.data.beta_point = o.beta_point;
   w.data.beta_normal = o.beta_normal;
+  for (const double weight : p.fair3d_weights) w.data.fair3d_factor.push_back(std::sqrt(weight));
   if (o.iso_normalization == IsoNormalization::kStrain) {
     // c_iso divided by ℓ², the mean squared diagonal length of the quads of
     // M' at the start (of M when M' is degenerate): rows are strains of an
@@ -130,3 +136,14 @@ Marker NormaliseMarker(Marker m, const Frame& f) {
 }
 
 }  // namespace docunfold::isometry::internal
+
+namespace docunfold::isometry {
+
+std::vector<std::array<int, 3>> FairTriplets(const QuadGrid& grid) {
+  std::vector<std::array<int, 3>> triplets;
+  for (int t = 0; t < internal::NumFairTriplets(grid); ++t)
+    triplets.push_back(internal::FairTriplet(grid, t));
+  return triplets;
+}
+
+}  // namespace docunfold::isometry

@@ -44,6 +44,8 @@ struct StepData {
   double beta_point = 1;
   double beta_normal = 0.1;
   int num_inliers = 0;
+  // Per fair triplet, the square root of Problem::fair3d_weights (empty: 1).
+  std::vector<double> fair3d_factor;
 };
 
 struct Row {
@@ -178,18 +180,19 @@ inline std::array<int, 3> FairTriplet(const QuadGrid& g, int t) {
   return {g.Index(r - 1, c), g.Index(r, c), g.Index(r + 1, c)};
 }
 // dims 0..2 (M) or 3..4 (M'): one row per coordinate.
-inline int FairRows(const State& s, int t, bool flat, Row* rows) {
+inline int FairRows(const State& s, const StepData& data, int t, bool flat, Row* rows) {
   const auto v = FairTriplet(s.grid, t);
   const int first = flat ? 3 : 0, n = flat ? 2 : 3;
+  const double f = flat || data.fair3d_factor.empty() ? 1.0 : data.fair3d_factor[size_t(t)];
   for (int k = 0; k < n; ++k) {
     const int dim = first + k;
     Row& r = rows[k];
     r.Reset();
-    r.value = flat ? s.v2[v[0]][k] - 2 * s.v2[v[1]][k] + s.v2[v[2]][k]
-                   : s.v3[v[0]][k] - 2 * s.v3[v[1]][k] + s.v3[v[2]][k];
-    r.Add(v[0])[dim] = 1;
-    r.Add(v[1])[dim] = -2;
-    r.Add(v[2])[dim] = 1;
+    r.value = f * (flat ? s.v2[v[0]][k] - 2 * s.v2[v[1]][k] + s.v2[v[2]][k]
+                        : s.v3[v[0]][k] - 2 * s.v3[v[1]][k] + s.v3[v[2]][k]);
+    r.Add(v[0])[dim] = f;
+    r.Add(v[1])[dim] = -2 * f;
+    r.Add(v[2])[dim] = f;
   }
   return n;
 }
@@ -262,9 +265,9 @@ void ForEachRow(const State& s, const StepData& data, Sink&& sink) {
   }
   const int triplets = NumFairTriplets(s.grid);
   for (int t = 0; t < triplets; ++t) {
-    int n = FairRows(s, t, false, rows);
+    int n = FairRows(s, data, t, false, rows);
     for (int i = 0; i < n; ++i) sink(kFair3d, rows[i]);
-    n = FairRows(s, t, true, rows);
+    n = FairRows(s, data, t, true, rows);
     for (int i = 0; i < n; ++i) sink(kFair2d, rows[i]);
   }
   for (int m = 0; m < int(data.markers.size()); ++m) {

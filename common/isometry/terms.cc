@@ -58,8 +58,8 @@ TermValues EvaluateTerms(const State& s, const StepData& data, int threads) {
     AddSquares(rows, DistRows(s, data, p, rows), &acc[0]);
   })[0];
   const auto fair = OrderedSums<2>(triplets, threads, [&](int t, Row* rows, auto& acc) {
-    AddSquares(rows, FairRows(s, t, false, rows), &acc[0]);
-    AddSquares(rows, FairRows(s, t, true, rows), &acc[1]);
+    AddSquares(rows, FairRows(s, data, t, false, rows), &acc[0]);
+    AddSquares(rows, FairRows(s, data, t, true, rows), &acc[1]);
   });
   const auto feature = OrderedSums<2>(markers, threads, [&](int m, Row* rows, auto& acc) {
     AddSquares(rows, LineRows(s, data, m, rows), &acc[0]);
