@@ -132,11 +132,14 @@ std::vector<bool> SolveRound(const OptimizeInputs& in, const OptimizeOptions& o,
                              const std::vector<Segment>& segments,
                              const std::vector<Eigen::Vector3d>& region_points,
                              const std::vector<HullView>& hull_views,
-                             const cv::Mat1b& page_interior, isometry::SolveOptions so,
-                             RoundResult* round) {
+                             const cv::Mat1b& page_interior, const CreaseMap& crease_evidence,
+                             isometry::SolveOptions so, RoundResult* round) {
   isometry::Problem problem;
   problem.meshes = round->meshes;
   problem.points = region_points;
+  if (!crease_evidence.step.empty())
+    problem.fair3d_weights = CreaseFairWeights(round->meshes, in.reference, crease_evidence,
+                                               o.crease, &round->crease_triplets);
 
   // Every outer iteration: the samples' rays meet the current M, their
   // points in M' are grouped into lines, and only markers on a line stay.
@@ -198,10 +201,11 @@ void LogRound(const RoundResult& round) {
   char buf[256];
   std::snprintf(buf, sizeof buf,
                 "round %d: %dx%d grid, %zu iterations (%s), F %.4g, %d lines, %d markers "
-                "(%d side markers off their side, %d hull), %d/%d points inside, %.1f s",
+                "(%d side markers off their side, %d hull), %d creased triplets, %d/%d points "
+                "inside, %.1f s",
                 round.round, meshes.grid.nx, meshes.grid.ny, report.iterations.size(),
                 report.stop_reason.c_str(), last.F, last.lines, last.markers,
-                round.side_markers_dropped, round.hull_markers, last.inliers,
+                round.side_markers_dropped, round.hull_markers, round.crease_triplets, last.inliers,
                 last.inliers + last.outliers, report.seconds);
   Log(buf);
 }
@@ -249,6 +253,13 @@ OptimizeResult Run(const OptimizeInputs& in, const OptimizeOptions& o) {
     result.hull_views = MarkMaskDoubts(region_points, o.hull, &hull_views);
     LogHullViews(result.hull_views);
   }
+  CreaseMap crease_evidence;
+  if (o.crease.step > 0 && in.reference_image.empty()) {
+    Log("warning: no reference photo (reference.png beside cameras.json): E_fair(M) spares no "
+        "crease");
+  } else if (o.crease.step > 0) {
+    crease_evidence = CreaseEvidence(in.reference_image, ContourRegion(in.boundary, 0), o.crease);
+  }
   isometry::Weights weights = o.solve.weights;
   if (segments.empty()) weights.line = weights.ray = 0;
   for (int r = 0; r < o.rounds; ++r) {
@@ -263,7 +274,7 @@ OptimizeResult Run(const OptimizeInputs& in, const OptimizeOptions& o) {
     round.start_seconds = SecondsSince(start);
     round.meshes = meshes;
     result.inliers = SolveRound(in, o, segments, region_points, hull_views, page_interior,
-                                RoundSolveOptions(o, r, weights), &round);
+                                crease_evidence, RoundSolveOptions(o, r, weights), &round);
     meshes = round.meshes;
     LogRound(round);
     result.rounds.push_back(std::move(round));

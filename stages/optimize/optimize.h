@@ -15,6 +15,7 @@
 #include "common/isometry/isometry.h"
 #include "common/option_table_fwd.h"
 #include "common/page_files.h"
+#include "stages/optimize/crease_evidence.h"
 #include "stages/optimize/feature_lines.h"
 #include "stages/optimize/mask_hull.h"
 
@@ -60,6 +61,7 @@ struct OptimizeOptions {
   // iteration makes F jump. See docs/decisions/optimize.md, "A sample at a
   // side's end".
   double side_end_outliers = 4;
+  CreaseOptions crease;
   bool features = true;        // false: no feature lines at all (--no-feature-lines)
   bool boundary_only = false;  // only the real boundary sides (--boundary-only)
   // Which lines run exactly along the axes of the upright M' (kNone: only
@@ -107,6 +109,7 @@ struct OptimizeInputs {
   Boundary boundary;
   FeatureFile features;
   std::vector<ViewPage> other_views;  // 20_boundary/views/*/mask.png
+  cv::Mat reference_image;            // <sfm>/reference.png (empty: not read)
 };
 
 // A feature line at the end of a round, for lines.json.
@@ -129,6 +132,7 @@ struct RoundResult {
   // last outer iteration.
   int side_markers_dropped = 0;
   int hull_markers = 0;      // in the round's last outer iteration
+  int crease_triplets = 0;   // E_fair(M) triplets spared across a shading step
   double start_seconds = 0;  // since optimize started
 };
 

@@ -19,6 +19,15 @@ Json Points(const std::vector<Eigen::Vector2d>& points) {
   return a;
 }
 
+// "<before>WxH<after>, but the reference view is WxH": a file made for
+// another image than the reference photo.
+InputError SizeMismatch(const std::string& before, int width, int height, const std::string& after,
+                        const PinholeCamera& reference) {
+  return InputError(before + std::to_string(width) + "x" + std::to_string(height) + after +
+                    ", but the reference view is " + std::to_string(reference.width) + "x" +
+                    std::to_string(reference.height));
+}
+
 Json WeightsJson(const isometry::Weights& w) {
   return {{"iso", w.iso},       {"dist", w.dist}, {"fair3d", w.fair3d},
           {"fair2d", w.fair2d}, {"line", w.line}, {"ray", w.ray}};
@@ -46,18 +55,22 @@ OptimizeInputs ReadInputs(const InputPaths& paths, bool view_masks) {
       fs::is_directory(paths.boundary) ? paths.boundary / "boundary.json" : paths.boundary;
   in.boundary = ReadBoundary(boundary_file);
   if (in.boundary.width != ref->width || in.boundary.height != ref->height)
-    throw InputError(boundary_file.string() + ": found in a " + std::to_string(in.boundary.width) +
-                     "x" + std::to_string(in.boundary.height) +
-                     " image, but the reference view is " + std::to_string(ref->width) + "x" +
-                     std::to_string(ref->height));
+    throw SizeMismatch(boundary_file.string() + ": found in a ", in.boundary.width,
+                       in.boundary.height, " image", *ref);
   in.features = ReadFeatures(paths.features);
   if (in.features.width > 0 &&
       (in.features.width != ref->width || in.features.height != ref->height))
-    throw InputError(paths.features.string() + ": segments of a " +
-                     std::to_string(in.features.width) + "x" + std::to_string(in.features.height) +
-                     " image, but the reference view is " + std::to_string(ref->width) + "x" +
-                     std::to_string(ref->height));
+    throw SizeMismatch(paths.features.string() + ": segments of a ", in.features.width,
+                       in.features.height, " image", *ref);
   in.init = ReadMeshPair(paths.init);
+  // Without it optimize spares no crease; scene.glb still needs it.
+  const fs::path reference_image = paths.sfm / "reference.png";
+  std::error_code ec;
+  if (fs::exists(reference_image, ec)) in.reference_image = ReadImage(reference_image);
+  if (!in.reference_image.empty() &&
+      (in.reference_image.cols != ref->width || in.reference_image.rows != ref->height))
+    throw SizeMismatch(reference_image.string() + ": ", in.reference_image.cols,
+                       in.reference_image.rows, " pixels", *ref);
   if (view_masks && fs::is_directory(paths.boundary))
     in.other_views = ReadOtherViewPages(cameras, paths.sfm / "cameras.json", paths.boundary);
   return in;
@@ -117,6 +130,7 @@ Json LogJson(const OptimizeResult& result, const Json& options_record) {
                              {"lines", r.lines.size()},
                              {"side_markers_dropped", r.side_markers_dropped},
                              {"hull_markers", r.hull_markers},
+                             {"crease_triplets", r.crease_triplets},
                              {"iterations", iterations}});
   }
   return doc;
@@ -153,7 +167,7 @@ void WriteOutputs(const fs::path& out, const InputPaths& paths, const OptimizeIn
 
   // scene.glb: M textured from the reference image, M' beside it with the
   // same texture (the rectified page), and the SfM points M was fitted to.
-  cv::Mat texture = ReadImage(reference_image);
+  cv::Mat texture = in.reference_image.empty() ? ReadImage(reference_image) : in.reference_image;
   const double shrink = std::min(1.0, double(output_options.texture_width) / texture.cols);
   if (shrink < 1) cv::resize(texture, texture, cv::Size(), shrink, shrink, cv::INTER_AREA);
   GltfMesh m3, m2;

@@ -34,6 +34,13 @@ void DeclareOptions(OptionTable& table, OptimizeOptions* o) {
               "this many times farther from its line than a sample inside may be (0 = keep all)");
   table.Switch("feature-lines", &o->features,
                "text lines, rules and real page sides straightened in M' (off: an ablation)");
+  table.Value("crease-step", &o->crease.step, 0.0, 10.0,
+              "E_fair(M) is halved across a step in the reference photo's shading (a crease) "
+              "of this much log-brightness per pixel, and falls off as its square above (0 = "
+              "off: fair everywhere, as in the paper)");
+  table.Value("crease-ink-px", &o->crease.ink_close_px, 1, 1000,
+              "print narrower than this many pixels (of the reference photo read at most "
+              "1600 px on its longer side) is closed away before the shading steps are read");
   table.Switch("mask-hull", &o->mask_hull,
                "hold page vertices that project outside another photo's page mask to that "
                "mask's outline (the photos' masks as a visual hull)");
