@@ -9,10 +9,11 @@
 #include <string>
 #include <unordered_map>
 
+#include "stages/synth/random.h"
+
 namespace docunfold::synth {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 // Sampling of the self-intersection test (metres): fine enough for the arc of
 // a 3 mm crease turned by 180 degrees (radius 1 mm) to keep its layers apart.
 constexpr double kContactSpacing = 0.0015;

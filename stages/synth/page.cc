@@ -9,6 +9,8 @@
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 
+#include "stages/synth/random.h"
+
 namespace docunfold::synth {
 namespace {
 
@@ -233,10 +235,6 @@ class Typesetter {
   std::mt19937* rng_;
   std::map<std::string, cv::Ptr<cv::freetype::FreeType2>> fonts_;
 };
-
-double Uniform(std::mt19937* rng, double lo, double hi) {
-  return std::uniform_real_distribution<double>(lo, hi)(*rng);
-}
 
 cv::Scalar Ink(std::mt19937* rng) {
   const double k = Uniform(rng, 15, 45);

@@ -4,14 +4,10 @@
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 
+#include "stages/synth/random.h"
+
 namespace docunfold::synth {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-
-double Uniform(std::mt19937* rng, double lo, double hi) {
-  return std::uniform_real_distribution<double>(lo, hi)(*rng);
-}
 
 double Radians(double deg) { return deg * kPi / 180; }
 

@@ -25,7 +25,7 @@ struct Scene {
   std::vector<FusionView> views;
 };
 
-cv::Mat3b MakePage() {
+cv::Mat3b MakePrintedPage() {
   cv::Mat3b page(kPageH, kPageW, cv::Vec3b(222, 230, 236));
   cv::RNG rng(7);
   for (int y = 60; y < kPageH - 40; y += 28)
@@ -77,7 +77,7 @@ cv::Mat3b Photograph(const cv::Mat3b& page, const PinholeCamera& camera, double 
 
 Scene MakeScene() {
   Scene s;
-  s.page = MakePage();
+  s.page = MakePrintedPage();
   cv::Mat grey;
   cv::cvtColor(s.page, grey, cv::COLOR_BGR2GRAY);
   cv::Mat1b print = grey < 200;
