@@ -15,6 +15,7 @@
 #include "common/option_table.h"
 #include "common/ply.h"
 #include "common/program.h"
+#include "stages/synth/random.h"
 
 namespace docunfold::synth {
 namespace {
@@ -48,10 +49,10 @@ PageSurface PlaceOnTable(const FoldedSheet& sheet, double spacing, bool root_fla
   // FoldedSheet leaves the root panel in z = 0 with its print facing -z.
   const Eigen::Matrix3d up =
       root_flat
-          ? Eigen::Matrix3d(Eigen::AngleAxisd(3.14159265358979323846, Eigen::Vector3d::UnitX()))
+          ? Eigen::Matrix3d(Eigen::AngleAxisd(kPi, Eigen::Vector3d::UnitX()))
           : Eigen::Quaterniond::FromTwoVectors(mean_normal.normalized(), Eigen::Vector3d::UnitZ())
                 .toRotationMatrix();
-  const double yaw = std::uniform_real_distribution<double>(0, 2 * 3.14159265358979)(*rng);
+  const double yaw = Uniform(rng, 0, 2 * 3.14159265358979);
   const Eigen::Matrix3d R =
       Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix() * up;
   Eigen::Vector3d lo(1e9, 1e9, 1e9), hi(-1e9, -1e9, -1e9);
@@ -120,8 +121,7 @@ Scene MakeScene(const SynthOptions& o, std::mt19937* rng) {
   size = DefaultPageSize(o.kind);
   // A receipt torn off a roll is as wide as the roll, and as long as the
   // till made it.
-  if (o.roll_mm > 0)
-    size = {o.roll_mm / 1000.0, std::uniform_real_distribution<double>(0.14, 0.24)(*rng)};
+  if (o.roll_mm > 0) size = {o.roll_mm / 1000.0, Uniform(rng, 0.14, 0.24)};
   if (o.page_size_m.width > 0) size.width = o.page_size_m.width;
   if (o.page_size_m.height > 0) size.height = o.page_size_m.height;
 
