@@ -230,6 +230,7 @@ isometry::SolveOptions RoundSolveOptions(const OptimizeOptions& o, int r,
   isometry::SolveOptions so = o.solve;
   so.weights = weights;
   so.converged_iterations = r < o.rises_from_round ? o.converged_iterations : 1;
+  if (r < o.rises_from_round) so.relative_tolerance = o.first_rounds_tolerance;
   so.max_rises = r >= o.rises_from_round ? o.max_rises : 0;
   return so;
 }

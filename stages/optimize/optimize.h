@@ -40,6 +40,13 @@ struct OptimizeOptions {
   // cheap, and a round that stops on one short step hands the next a page it
   // has not finished fitting. From rises_from_round on, 1.
   int converged_iterations = 2;
+  // ε of those first rounds (later rounds: solve.relative_tolerance, the
+  // paper's 0.01). Past 1 % a round is still crawling: footpoints and
+  // markers re-decided each outer iteration let a rounded fold unround by
+  // ~0.5 % of F per iteration, and what the coarse grids leave rounded the
+  // fine rounds do not undo. See docs/decisions/optimize.md, "The first
+  // rounds run to 1e-4".
+  double first_rounds_tolerance = 1e-4;
   // From round rises_from_round on, a round also stops once F rose from one
   // outer iteration to the next this often (0 = off): with markers re-decided
   // every iteration F can oscillate without settling in the fine rounds,

@@ -37,7 +37,9 @@ TEST(OptimizeOptions, RoundsHandTheSolverThePapersSettingsAndTheirStoppingRule) 
     EXPECT_EQ(so.outlier_distance, 0.06);
     EXPECT_EQ(so.iso_edges, 0);
     EXPECT_EQ(so.iso_normalization, isometry::IsoNormalization::kStrain);
-    EXPECT_EQ(so.relative_tolerance, 0.01);
+    // The first two rounds run to 1e-4 (the coarse grids are cheap), the
+    // later ones to the paper's 1 %.
+    EXPECT_EQ(so.relative_tolerance, r < 2 ? 1e-4 : 0.01) << r;
     EXPECT_EQ(so.max_outer_iterations, 100);
     // The first two rounds end at the second short step and never on
     // rises; the later ones at the first, or at the third rise.
