@@ -14,10 +14,11 @@ void DeclareOptions(OptionTable& table, OptimizeOptions* o) {
               "λ6, feature points on their viewing rays (first round)");
   table.Value("feature-growth", &o->feature_weight_growth,
               "λ5 and λ6 are multiplied by this after each subdivision");
-  table.Value("converged-iterations", &o->converged_iterations, 1, 100,
-              "a round stops at the outer iteration where |ΔF/F| is below its tolerance for this "
-              "many times (in a row or not), in the rounds before --rises-from-round (1 = the paper: "
-              "the first short step ends a round)");
+  table.Value(
+      "converged-iterations", &o->converged_iterations, 1, 100,
+      "a round stops at the outer iteration where |ΔF/F| is below its tolerance for this "
+      "many times (in a row or not), in the rounds before --rises-from-round (1 = the paper: "
+      "the first short step ends a round)");
   table.Value("first-rounds-tolerance", &o->first_rounds_tolerance, 0.0, 1.0,
               "in the rounds before --rises-from-round a round stops at |ΔF/F| below this "
               "instead of --tolerance (the coarse grids are cheap, and a fold they leave "
