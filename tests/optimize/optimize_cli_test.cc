@@ -112,11 +112,12 @@ TEST(OptimizeCli, TextRowsTurnAnOffUprightFlatMesh) {
   ASSERT_TRUE(turned_lines.contains("text_down_flat")) << turned.output;
   EXPECT_GT(std::abs(turned_lines["text_down_flat"][1].get<double>()), 0.99);
   // Without the turn and with the paper's stopping rule the rows stay off
-  // the axes and are dropped. (With the default --converged-iterations 2 the
-  // first rounds can run on until the real sides, held along the axes, have
-  // turned M' upright by themselves: 24 lines in one run on 2026-11-26.)
-  const CommandResult kept = RunCommand(OptimizeCommand(dir.path(), points, dir / "kept") +
-                                        " --no-upright-by-lines --converged-iterations 1");
+  // the axes and are dropped. (With the default first rounds, which run on
+  // to 1e-4 and a second short step, the real sides, held along the axes,
+  // can turn M' upright by themselves: 24 lines in one run on 2026-11-26.)
+  const CommandResult kept =
+      RunCommand(OptimizeCommand(dir.path(), points, dir / "kept") +
+                 " --no-upright-by-lines --converged-iterations 1 --first-rounds-tolerance 0.01");
   ASSERT_EQ(kept.exit_code, 0) << kept.output;
   EXPECT_EQ(ReadJsonFile(dir / "kept/log.json")["line_direction"]["turned_deg"].get<double>(), 0);
   // Lines found: the rows, once M' is upright; none 25 degrees off it.
@@ -185,7 +186,10 @@ TEST(OptimizeCli, APageBuiltFromThePointsOfEveryPhotoStaysWhole) {
       100 * page_to_m.mean / size, 100 * page_to_m.max / size, 100 * page_to_init.mean / size,
       100 * page_to_init.max / size);
   EXPECT_LT(page_to_m.mean, 0.005 * size);
-  EXPECT_LT(page_to_m.max, 0.03 * size);
+  // Whole, not collapsed. Without text lines F's minimum lies a little off
+  // the truth on the edge-on half, and the first rounds, run to 1e-4, get
+  // nearer it: 3.05 % at most (1.49 % stopping at 1 %, as the paper does).
+  EXPECT_LT(page_to_m.max, 0.04 * size);
 }
 
 }  // namespace
