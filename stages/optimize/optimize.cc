@@ -229,9 +229,10 @@ isometry::SolveOptions RoundSolveOptions(const OptimizeOptions& o, int r,
                                          const isometry::Weights& weights) {
   isometry::SolveOptions so = o.solve;
   so.weights = weights;
-  so.converged_iterations = r < o.rises_from_round ? o.converged_iterations : 1;
-  if (r < o.rises_from_round) so.relative_tolerance = o.first_rounds_tolerance;
-  so.max_rises = r >= o.rises_from_round ? o.max_rises : 0;
+  const bool first_rounds = r < o.rises_from_round;
+  so.converged_iterations = first_rounds ? o.converged_iterations : 1;
+  if (first_rounds) so.relative_tolerance = o.first_rounds_tolerance;
+  so.max_rises = first_rounds ? 0 : o.max_rises;
   return so;
 }
 

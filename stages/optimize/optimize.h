@@ -41,10 +41,10 @@ struct OptimizeOptions {
   // has not finished fitting. From rises_from_round on, 1.
   int converged_iterations = 2;
   // ε of those first rounds (later rounds: solve.relative_tolerance, the
-  // paper's 0.01). Past 1 % a round is still crawling: footpoints and
-  // markers re-decided each outer iteration let a rounded fold unround by
-  // ~0.5 % of F per iteration, and what the coarse grids leave rounded the
-  // fine rounds do not undo. See docs/decisions/optimize.md, "The first
+  // paper's 0.01). Past 1 % a round is still crawling: with footpoints and
+  // markers re-decided each outer iteration F keeps falling by 0.1-0.5 % an
+  // iteration as a rounded fold unrounds, and what the coarse grids leave
+  // rounded the fine rounds do not undo. See docs/decisions/optimize.md, "The first
   // rounds run to 1e-4".
   double first_rounds_tolerance = 1e-4;
   // From round rises_from_round on, a round also stops once F rose from one
