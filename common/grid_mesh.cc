@@ -122,15 +122,16 @@ void WriteMeshPair(const fs::path& dir, const MeshPair& m, const MeshPairWriteOp
 }
 
 PixelToSurface::PixelToSurface(const MeshPair& m, const PinholeCamera& camera, double scale)
-    : mesh_(m), camera_(camera), triangles_(m.grid.Triangles()), scale_(scale) {
-  raster_ = RasterizeMesh(camera_, m.mesh3d, triangles_, scale_);
-}
+    : mesh_(m),
+      camera_(camera),
+      triangles_(m.grid.Triangles()),
+      scale_(scale),
+      face_(MeshFaceIndex(camera_, m.mesh3d, triangles_, scale_)) {}
 
 std::optional<SurfacePoint> PixelToSurface::Lookup(const Eigen::Vector2d& pixel) const {
   const int x = int(std::lround((pixel.x() + 0.5) * scale_ - 0.5));
   const int y = int(std::lround((pixel.y() + 0.5) * scale_ - 0.5));
-  if (x < 0 || y < 0 || x >= raster_.face.cols || y >= raster_.face.rows) return std::nullopt;
-  const int f = raster_.face(y, x);
+  const int f = face_(x, y);
   if (f < 0) return std::nullopt;
   return OnTriangle(f, pixel);
 }
@@ -146,10 +147,11 @@ std::optional<SurfacePoint> PixelToSurface::LookupNear(const Eigen::Vector2d& pi
   for (int dy = -r; dy <= r; ++dy)
     for (int dx = -r; dx <= r; ++dx) {
       const int x = cx + dx, y = cy + dy;
-      if (x < 0 || y < 0 || x >= raster_.face.cols || y >= raster_.face.rows) continue;
       const double d2 = dx * dx + dy * dy;
-      if (d2 > double(r) * r || d2 >= best_d2 || raster_.face(y, x) < 0) continue;
-      best = raster_.face(y, x);
+      if (d2 > double(r) * r || d2 >= best_d2) continue;
+      const int f = face_(x, y);
+      if (f < 0) continue;
+      best = f;
       best_d2 = d2;
     }
   if (best < 0) return std::nullopt;

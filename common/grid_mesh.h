@@ -82,11 +82,12 @@ Eigen::Vector3d RayOnTrianglePlane(const PinholeCamera& camera,
                                    const std::array<Eigen::Vector3d, 3>& world,
                                    const Eigen::Vector2d& pixel);
 
-// Which point of M each pixel of the reference camera sees: a face-id raster
-// of M, built once and then queried for any number of pixels.
+// Which point of M each pixel of the reference camera sees: a face index of
+// M in the camera (PixelFaceIndex), built once and then queried for any
+// number of pixels.
 class PixelToSurface {
  public:
-  // `scale` < 1 rasterizes a smaller face-id image (the barycentrics stay
+  // `scale` < 1 indexes a smaller face-id image (the barycentrics stay
   // exact: they come from the ray-plane intersection; only which triangle a
   // pixel near a triangle border belongs to is decided more coarsely).
   PixelToSurface(const MeshPair& m, const PinholeCamera& camera, double scale = 1.0);
@@ -99,7 +100,8 @@ class PixelToSurface {
   // then extrapolate that triangle's plane a little): for samples on the
   // page's outline, half of whose pixel lies off the page.
   std::optional<SurfacePoint> LookupNear(const Eigen::Vector2d& pixel, double radius) const;
-  const RasterResult& raster() const { return raster_; }
+  // The triangle seen at pixel centre (x, y) of the scaled image; -1 off M.
+  int FaceAt(int x, int y) const { return face_(x, y); }
 
  private:
   // Exact barycentrics of the pixel's viewing ray in triangle f's plane.
@@ -109,7 +111,7 @@ class PixelToSurface {
   PinholeCamera camera_;
   std::vector<Triangle> triangles_;
   double scale_ = 1.0;
-  RasterResult raster_;
+  PixelFaceIndex face_;
 };
 
 }  // namespace docunfold

@@ -81,8 +81,13 @@ std::optional<ClosestPoint> TriangleMeshIndex::Closest(const Eigen::Vector3d& p,
   }
   const double bound = std::min(best.distance, max_distance);
   const double radius = bound + max_radius_;
+  auto among_nearest = [&](int t) {
+    return std::any_of(nearest.begin(), nearest.end(), [t](const auto& n) { return n.first == t; });
+  };
   for (const auto& [t, dist2] : tree_->WithinSquaredRadius(p, radius * radius)) {
     if (std::sqrt(dist2) - max_radius_ > std::min(best.distance, max_distance)) break;
+    // Those are in `best` already (a tie keeps the first found).
+    if (among_nearest(t)) continue;
     ClosestPoint c = exact(t);
     if (c.distance < best.distance) best = c;
   }

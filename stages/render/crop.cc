@@ -25,17 +25,15 @@ std::optional<Eigen::Vector2d> RayThroughTrianglePlane(const MeshPair& mesh,
          sol[1] * mesh.mesh2d[t[2]];
 }
 
-// Nearest pixel centre of the raster within `radius` that shows M.
-int NearestFace(const RasterResult& raster, const Eigen::Vector2d& p, double radius) {
+// Nearest pixel centre within `radius` that shows M (the lookup at scale 1).
+int NearestFace(const PixelToSurface& lookup, const Eigen::Vector2d& p, double radius) {
   const int r = int(std::ceil(radius));
   const int cx = int(std::lround(p.x())), cy = int(std::lround(p.y()));
   int best = -1;
   double best_d2 = radius * radius;
   for (int y = cy - r; y <= cy + r; ++y) {
-    if (y < 0 || y >= raster.face.rows) continue;
     for (int x = cx - r; x <= cx + r; ++x) {
-      if (x < 0 || x >= raster.face.cols) continue;
-      const int f = raster.face(y, x);
+      const int f = lookup.FaceAt(x, y);
       if (f < 0) continue;
       const double d2 = (Eigen::Vector2d(x, y) - p).squaredNorm();
       if (d2 <= best_d2) {
@@ -75,7 +73,7 @@ std::vector<Eigen::Vector2d> MapPolylineOntoFlat(const MeshPair& mesh, const Pin
       return;
     }
     if (snap_px <= 0) return;
-    const int f = NearestFace(lookup.raster(), p, snap_px);
+    const int f = NearestFace(lookup, p, snap_px);
     if (f < 0) return;
     if (auto q = RayThroughTrianglePlane(mesh, camera, f, p)) out.push_back(*q);
   };

@@ -309,7 +309,7 @@ RenderResult Run(const RenderOptions& options, const RenderInputs& in) {
   const std::array<std::vector<Eigen::Vector2d>, 4> side_points = FitSides(options, in, lookup, &r);
   const double angle = DeskewAngle(options, in, &r);
   r.rotation_deg = angle * 180 / M_PI;
-  const CropStep crop = CropPage(options, in, lookup, pm, angle, side_points, &r);
+  const CropStep crop = CropPage(options, in, pm, angle, side_points, &r);
   timer.Mark("crop");
 
   const OutputFrame frame = FrameOutput(options, crop.crop, crop.flat, pm, &r);
@@ -324,10 +324,10 @@ RenderResult Run(const RenderOptions& options, const RenderInputs& in) {
   cv::Mat3b image;
   cv::Mat1b state;
   const SampleStats stats =
-      fusion ? FusePixels(options, in, pm, crop.flat, frame.pixel, frame.raster, lookup.raster(),
+      fusion ? FusePixels(options, in, pm, crop.flat, frame.pixel, frame.raster, pm.raster,
                           frame.size.scale, photos, &image, &state, &r)
-             : SamplePixels(options, in, pm, crop.flat, frame.raster, lookup.raster(),
-                            frame.size.scale, &image, &state);
+             : SamplePixels(options, in, pm, crop.flat, frame.raster, pm.raster, frame.size.scale,
+                            &image, &state);
   timer.Mark("sample");
 
   TexturePastMesh(options, in, crop.self_view, frame.size, photos, &image, &state, &r, &timer);

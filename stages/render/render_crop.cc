@@ -215,9 +215,9 @@ void ApplyPageFormat(const RenderOptions& options, const RenderInputs& in, CropR
 
 }  // namespace
 
-CropStep CropPage(const RenderOptions& options, const RenderInputs& in,
-                  const PixelToSurface& lookup, const ProjectedMesh& pm, double angle,
-                  const std::array<std::vector<Eigen::Vector2d>, 4>& side_points, RenderResult* r) {
+CropStep CropPage(const RenderOptions& options, const RenderInputs& in, const ProjectedMesh& pm,
+                  double angle, const std::array<std::vector<Eigen::Vector2d>, 4>& side_points,
+                  RenderResult* r) {
   const fs::path m3 = in.meshes_dir / "mesh3d.ply";
   const Eigen::Rotation2Dd rotation(angle);
   CropStep step;
@@ -226,7 +226,7 @@ CropStep CropPage(const RenderOptions& options, const RenderInputs& in,
   for (auto& q : flat) q = rotation * q;
   for (auto& s : r->sides)
     if (s.used) RotateSide(&s, angle);
-  Eigen::Vector4d visible = VisibleBox(lookup.raster(), pm.triangles, flat);
+  Eigen::Vector4d visible = VisibleBox(pm.raster, pm.triangles, flat);
   if (!(visible[2] > visible[0] && visible[3] > visible[1]))
     throw InputError(m3.string() + ": the mesh covers no pixel of the reference image");
   if (options.extend_cut_sides) ExtendPastCutSides(options, in, flat, &visible, r);

@@ -34,6 +34,7 @@ struct ProjectedMesh {
   std::vector<char> front;  // triangle faces the camera like most of M
   double density = 0;       // reference pixels per unit of M'
   int faces_in_view = 0;
+  RasterResult raster;  // M in the reference image: nearest triangle per pixel
 };
 
 // The page region of the reference image: the boundary's outline filled.
@@ -126,8 +127,8 @@ struct CropStep {
 // too), the page edge past cut sides (r->cut_edges), real sides reached past
 // M's border (r->reached_sides), scattered sides' medians and the page
 // format (r->page_format).
-CropStep CropPage(const RenderOptions& options, const RenderInputs& in,
-                  const PixelToSurface& lookup, const ProjectedMesh& pm, double angle,
-                  const std::array<std::vector<Eigen::Vector2d>, 4>& side_points, RenderResult* r);
+CropStep CropPage(const RenderOptions& options, const RenderInputs& in, const ProjectedMesh& pm,
+                  double angle, const std::array<std::vector<Eigen::Vector2d>, 4>& side_points,
+                  RenderResult* r);
 
 }  // namespace docunfold::render

@@ -71,6 +71,7 @@ ProjectedMesh ProjectMesh(const RenderInputs& in) {
   }
   p.faces_in_view = int(ratios.size());
   p.density = Median(ratios);
+  p.raster = RasterizeMesh(cam, m.mesh3d, p.triangles);
   return p;
 }
 
