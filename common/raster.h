@@ -28,13 +28,14 @@ RasterResult Rasterize(const std::vector<Eigen::Vector3d>& screen_vertices,
                        const std::vector<Triangle>& triangles, int width, int height,
                        double near_depth = 1e-6);
 
+namespace internal {
+struct ScreenTriangle;  // one triangle as Rasterize draws it (raster.cc)
+}
+
 // Which triangle Rasterize would leave at a pixel centre, one pixel at a
 // time: for a few thousand pixels of a large image (markers cast every
 // iteration) it saves filling, and clearing, three full-size buffers. Same
 // coverage test, depth test and order as Rasterize, so the same answer.
-namespace internal {
-struct ScreenTriangle;
-}
 class PixelFaceIndex {
  public:
   PixelFaceIndex(const std::vector<Eigen::Vector3d>& screen_vertices,
