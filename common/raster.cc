@@ -105,22 +105,22 @@ PixelFaceIndex::PixelFaceIndex(const std::vector<Eigen::Vector3d>& v,
       screen_.push_back(t);
       face_.push_back(int(f));
     }
+  // The cells triangle k's pixel box overlaps.
+  auto for_each_cell = [&](size_t k, auto&& visit) {
+    const ScreenTriangle& s = screen_[k];
+    for (int cy = s.y0 / kCell; cy <= s.y1 / kCell; ++cy)
+      for (int cx = s.x0 / kCell; cx <= s.x1 / kCell; ++cx) visit(size_t(cy) * cells_x_ + cx);
+  };
   // Count, then fill: every cell lists its triangles in ascending order,
   // the order Rasterize draws them in.
   cell_start_.assign(size_t(cells_x_) * cells_y_ + 1, 0);
-  for (const ScreenTriangle& s : screen_)
-    for (int cy = s.y0 / kCell; cy <= s.y1 / kCell; ++cy)
-      for (int cx = s.x0 / kCell; cx <= s.x1 / kCell; ++cx)
-        ++cell_start_[size_t(cy) * cells_x_ + cx + 1];
+  for (size_t k = 0; k < screen_.size(); ++k)
+    for_each_cell(k, [&](size_t cell) { ++cell_start_[cell + 1]; });
   for (size_t i = 1; i < cell_start_.size(); ++i) cell_start_[i] += cell_start_[i - 1];
   std::vector<int> next(cell_start_.begin(), cell_start_.end() - 1);
   cell_triangles_.resize(size_t(cell_start_.back()));
-  for (size_t k = 0; k < screen_.size(); ++k) {
-    const ScreenTriangle& s = screen_[k];
-    for (int cy = s.y0 / kCell; cy <= s.y1 / kCell; ++cy)
-      for (int cx = s.x0 / kCell; cx <= s.x1 / kCell; ++cx)
-        cell_triangles_[size_t(next[size_t(cy) * cells_x_ + cx]++)] = int(k);
-  }
+  for (size_t k = 0; k < screen_.size(); ++k)
+    for_each_cell(k, [&](size_t cell) { cell_triangles_[size_t(next[cell]++)] = int(k); });
 }
 
 PixelFaceIndex::~PixelFaceIndex() = default;
@@ -133,12 +133,13 @@ int PixelFaceIndex::operator()(int x, int y) const {
   int best = -1;
   float best_z = std::numeric_limits<float>::infinity();
   for (int k = cell_start_[cell]; k < cell_start_[cell + 1]; ++k) {
-    const ScreenTriangle& t = screen_[size_t(cell_triangles_[size_t(k)])];
+    const size_t i = size_t(cell_triangles_[size_t(k)]);
+    const ScreenTriangle& t = screen_[i];
     if (x < t.x0 || x > t.x1 || y < t.y0 || y > t.y1) continue;
     float z;
     if (!t.Covers(x, y, &z, nullptr, nullptr) || z >= best_z) continue;
     best_z = z;
-    best = face_[size_t(cell_triangles_[size_t(k)])];
+    best = face_[i];
   }
   return best;
 }
