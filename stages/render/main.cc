@@ -36,6 +36,7 @@ int main(int argc, char** argv) {
     const double read_s = timer.Mark("read");
     const render::RenderResult result = render::Run(o, in);
     timer.Mark("render");
+    for (const std::string& warning : result.warnings) Log("warning: " + warning);
     Json report = render::RenderReport(o, in, result, table.Record());
     report["timing_s"]["read"] = read_s;
     render::WriteRenderOutputs(out, result, report);

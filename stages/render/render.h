@@ -179,6 +179,10 @@ struct RenderInputs {
   // Page masks of the other views (20_boundary/views/<name>/mask.png, when
   // segment-boundary was given --views), with their cameras and photos.
   std::vector<ViewMask> views;
+  // The other registered photos in sfm's order as the reference, best first
+  // (cameras.json reference_selection; empty when it has none): what to
+  // suggest when M looks wrong.
+  std::vector<std::string> other_references;
   // Where each input came from, for error messages and the report.
   fs::path cameras_file, reference_file, meshes_dir;
 };
@@ -232,6 +236,8 @@ struct RenderResult {
   std::string size_rule;                 // "reference-density", "width", "height", "dpi", "scale"
   bool capped = false;                   // the default size was reduced to max_pixels
   std::array<SideFit, 4> sides;
+  // What the user should know about the result (render.json "warnings").
+  std::vector<std::string> warnings;
   // The sides whose lines the crop's edges were warped onto (SideWarp), and
   // the largest move of a crop corner (M' units).
   std::array<bool, 4> warped_sides{};

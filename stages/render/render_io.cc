@@ -15,6 +15,26 @@
 
 namespace docunfold::render {
 
+namespace {
+
+// The photos of cameras.json's reference_selection/views other than
+// `reference`, in its order; advice only, so a missing or odd entry is skipped.
+std::vector<std::string> OtherReferences(const Json& cameras, const std::string& reference) {
+  std::vector<std::string> names;
+  const auto selection = cameras.find("reference_selection");
+  if (selection == cameras.end() || !selection->is_object()) return names;
+  const auto views = selection->find("views");
+  if (views == selection->end() || !views->is_array()) return names;
+  for (const Json& v : *views) {
+    const auto image = v.is_object() ? v.find("image") : v.end();
+    if (image == v.end() || !image->is_string()) continue;
+    if (image->get<std::string>() != reference) names.push_back(image->get<std::string>());
+  }
+  return names;
+}
+
+}  // namespace
+
 RenderInputs ReadRenderInputs(const fs::path& sfm_dir, const fs::path& boundary_dir,
                               const fs::path& meshes_dir, const fs::path& images_dir,
                               const fs::path& features_file) {
@@ -29,6 +49,7 @@ RenderInputs ReadRenderInputs(const fs::path& sfm_dir, const fs::path& boundary_
                      "which names the "
                      "reference view");
   in.camera = *cameras.Find(cameras.reference);
+  in.other_references = OtherReferences(ReadJsonFile(in.cameras_file), cameras.reference);
   in.reference = ReadImage(in.reference_file, cv::IMREAD_COLOR);
   in.boundary = ReadBoundary(boundary_dir / "boundary.json");
   // The other views' page masks, where segment-boundary found them, with
@@ -94,9 +115,8 @@ Json RenderReport(const RenderOptions& options, const RenderInputs& in, const Re
                    {"reference", in.reference_file.string()},
                    {"boundary", in.boundary.file.string()},
                    {"grid", {in.meshes.grid.nx, in.meshes.grid.ny}}};
-  Json view_masks = Json::array();
-  for (const ViewMask& v : in.views) view_masks.push_back(v.file.string());
-  doc["inputs"]["view_masks"] = view_masks;
+  doc["inputs"]["view_masks"] = Json::array();
+  for (const ViewMask& v : in.views) doc["inputs"]["view_masks"].push_back(v.file.string());
   doc["width"] = r.rectified.cols;
   doc["height"] = r.rectified.rows;
   doc["pixels_per_unit"] = r.pixels_per_unit;
@@ -105,6 +125,7 @@ Json RenderReport(const RenderOptions& options, const RenderInputs& in, const Re
   doc["capped"] = r.capped;
   doc["rotation_deg"] = r.rotation_deg;
   doc["deskew_source"] = r.deskew_source;
+  doc["warnings"] = r.warnings;
   doc["crop"] = {{"x0", r.crop_x0}, {"y0", r.crop_y0},     {"x1", r.crop_x1},
                  {"y1", r.crop_y1}, {"rule", r.crop_rule}, {"warp_max_shift", r.warp_max_shift}};
   const auto& w = r.warped_sides;

@@ -85,6 +85,7 @@ class Page {
            "table{border-collapse:collapse;margin:0.5em 0}td,th{border:1px solid #ccc;"
            "padding:3px 8px;text-align:right}th{background:#f0f0f0}td.l,th.l{text-align:left}"
            ".ref{outline:4px solid #d62728}.missing{color:#a00;font-style:italic}"
+           ".warning{color:#a00;font-weight:bold}"
            "code{background:#f4f4f4;padding:1px 3px}img{max-width:100%;height:auto}"
            "</style></head><body>\n<h1>" +
            MarkupEscape(title) + "</h1><p>" + summary + "</p><nav>" + toc_ + "</nav>\n" + body_ +
@@ -400,6 +401,11 @@ void ResultSection(const ReportOptions& o, const DataSet& data, const fs::path& 
         "The same with the edges of M' (from " + MarkupEscape(mesh_dir.filename().string()) + ")");
   const cv::Mat labels = TryImage(o.work / "60_render/texture_labels.png");
   const Json render_json = TryJson(o.work / "60_render/render.json");
+  if (render_json.is_object() && render_json.contains("warnings") &&
+      render_json["warnings"].is_array())
+    for (const Json& w : render_json["warnings"])
+      if (w.is_string())
+        page->Add("<p class=\"warning\">render: " + MarkupEscape(w.get<std::string>()) + "</p>");
   if (!labels.empty() && render_json.is_object() && render_json.contains("texture")) {
     std::string legend;
     const Json& views = render_json["texture"].value("views", Json::array());

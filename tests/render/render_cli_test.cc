@@ -76,6 +76,7 @@ TEST_F(RenderCli, WritesTheImagesAndAValidReport) {
   EXPECT_EQ(report["crop"]["rule"], "boundary-lines");
   EXPECT_EQ(report["size_rule"], "reference-density");
   EXPECT_TRUE(report["timing_s"].contains("read"));
+  EXPECT_EQ(report["warnings"], Json::array()) << "a page M fits along every side";
   const CommandResult v = RunCommand(Quote((SourceDir() / "scripts/validate-json").string()) + " " +
                                      Quote((out / "render.json").string()));
   EXPECT_EQ(v.exit_code, 0) << v.output;

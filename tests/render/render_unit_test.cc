@@ -9,6 +9,7 @@
 
 #include "common/atomic_file.h"
 #include "common/errors.h"
+#include "common/json_io.h"
 #include "stages/render/crop.h"
 #include "stages/render/cut_sides.h"
 #include "stages/render/render.h"
@@ -425,9 +426,15 @@ TEST(RenderScene, ScatteredSideBoundsTheCropByItsMedian) {
   }
   s.sides[0].front() = s.camera.Project(o.page_origin + tilt * Eigen::Vector3d(edge, 0, 0));
   s.sides[2].front() = s.camera.Project(o.page_origin + tilt * Eigen::Vector3d(edge, o.page_h, 0));
-  const render::RenderResult r = render::Run({}, InputsOf(s));
+  render::RenderInputs in = InputsOf(s);
+  in.other_references = {"view_02.jpg", "view_00.jpg"};
+  const render::RenderResult r = render::Run({}, in);
   ASSERT_TRUE(r.sides[3].scattered) << r.sides[3].note;
   EXPECT_FALSE(r.sides[3].used);
+  // M is likely wrong there: a warning names the side and sfm's next choice.
+  ASSERT_EQ(r.warnings.size(), 1u);
+  EXPECT_NE(r.warnings[0].find("along its left side"), std::string::npos) << r.warnings[0];
+  EXPECT_NE(r.warnings[0].find("REF=view_02.jpg"), std::string::npos) << r.warnings[0];
   const double px = 1 / r.pixels_per_unit;
   EXPECT_NEAR(r.crop_x0, edge, 2 * px);
   EXPECT_NEAR(r.crop_x1, o.page_w, px);
@@ -435,11 +442,37 @@ TEST(RenderScene, ScatteredSideBoundsTheCropByItsMedian) {
   EXPECT_GT(r.crop_x0, 0.5 * edge);  // not the mesh's border (x = 0)
 }
 
+// sfm's ranking of the photos as the reference, for the warning's advice:
+// the others in its order; entries without a name are skipped, and a
+// cameras.json without the ranking gives none.
+TEST(RenderInputsFile, OtherReferencesFollowSfmsRanking) {
+  TempDir dir;
+  const SyntheticScene s = MakeScene({});
+  WriteScene(s, dir.path());
+  const fs::path sfm = dir / "10_sfm";
+  const render::RenderInputs plain =
+      render::ReadRenderInputs(sfm, dir / "20_boundary", dir / "40_init", "", "");
+  EXPECT_TRUE(plain.other_references.empty());
+  Json cameras = ReadJsonFile(sfm / "cameras.json");
+  cameras["reference_selection"] = {
+      {"method", "auto"},
+      {"views", Json::array({{{"image", "view_09.png"}},
+                             {{"image", s.camera.image}},
+                             {{"score", 0.5}},
+                             {{"image", 7}},
+                             {{"image", "view_01.png"}}})}};
+  WriteJsonAtomic(sfm / "cameras.json", cameras);
+  const render::RenderInputs in =
+      render::ReadRenderInputs(sfm, dir / "20_boundary", dir / "40_init", "", "");
+  EXPECT_EQ(in.other_references, (std::vector<std::string>{"view_09.png", "view_01.png"}));
+}
+
 TEST(RenderScene, TiltedFlatMeshIsTurnedUpright) {
   SyntheticScene s = MakeScene({});
   const double angle = 3 * M_PI / 180;
   for (auto& q : s.meshes.mesh2d) q = Eigen::Rotation2Dd(angle) * q;
   const render::RenderResult r = render::Run({}, InputsOf(s));
+  EXPECT_TRUE(r.warnings.empty()) << r.warnings.front();
   EXPECT_NEAR(r.rotation_deg, -3, 0.05);
   EXPECT_EQ(r.crop_rule, "boundary-lines");
   EXPECT_NEAR(r.crop_x1 - r.crop_x0, s.page_w, 2 / r.pixels_per_unit);
