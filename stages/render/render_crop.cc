@@ -17,7 +17,7 @@ namespace {
 
 // The reference's outline scattering about its line in M' along a side is
 // how a wrong M shows: on the benchmark sets, every run with a scattered
-// side scored 0.73 MS-SSIM or less, most of them for want of a better
+// side scored at most 0.734 MS-SSIM, most of them for want of a better
 // reference photo (docs/decisions/sfm.md, what the choice is worth).
 void WarnOfScatteredSides(const RenderInputs& in, double flat_diagonal, RenderResult* r) {
   std::string sides;
