@@ -156,7 +156,7 @@ OutputFrame FrameOutput(const RenderOptions& options, const CropRect& crop,
 // r->other_view_fraction).
 void TexturePastMesh(const RenderOptions& options, const RenderInputs& in,
                      const std::vector<ViewMask>& self_view, const SizeChoice& size,
-                     const std::vector<cv::Mat>& photos, cv::Mat3b* image_io, cv::Mat1b* state_io,
+                     const TexturePhotos& photos, cv::Mat3b* image_io, cv::Mat1b* state_io,
                      RenderResult* r, StepTimer* timer) {
   cv::Mat3b& image = *image_io;
   cv::Mat1b& state = *state_io;
@@ -169,7 +169,7 @@ void TexturePastMesh(const RenderOptions& options, const RenderInputs& in,
     if (!e.strip.flat.empty()) reached_strips.push_back(&e.strip);
   if (!reached_strips.empty()) {
     const cv::Mat1b textured = TextureStrips(
-        reached_strips, self_view, {in.reference}, r->crop_x0, r->crop_y0, size.scale,
+        reached_strips, self_view, {photos.reference}, r->crop_x0, r->crop_y0, size.scale,
         options.antialias, image.clone(), state == kPage, state == kOutside, &image, nullptr,
         /*own_photo=*/true);
     state.setTo(kPage, textured);
@@ -178,7 +178,7 @@ void TexturePastMesh(const RenderOptions& options, const RenderInputs& in,
   if (!strips.empty() && options.texture_cut_sides) {
     const cv::Mat3b reference_render = image.clone();
     const cv::Mat1b textured = TextureStrips(
-        strips, in.views, photos, r->crop_x0, r->crop_y0, size.scale, options.antialias,
+        strips, in.views, photos.views, r->crop_x0, r->crop_y0, size.scale, options.antialias,
         reference_render, state == kPage, state == kOutside, &image, &r->registrations);
     state.setTo(kOtherView, textured);
     r->other_view_fraction = cv::countNonZero(textured) / (double(size.width) * size.height);
@@ -319,15 +319,15 @@ RenderResult Run(const RenderOptions& options, const RenderInputs& in) {
   const bool past_mesh = options.texture_cut_sides &&
                          std::any_of(r.cut_edges.begin(), r.cut_edges.end(),
                                      [](const CutSideEdge& e) { return !e.strip.flat.empty(); });
-  const std::vector<cv::Mat> photos = ReadViewPhotos(in, fusion || past_mesh);
+  const TexturePhotos photos = ReadTexturePhotos(options, in, fusion || past_mesh);
   timer.Mark("read_photos");
   cv::Mat3b image;
   cv::Mat1b state;
   const SampleStats stats =
       fusion ? FusePixels(options, in, pm, crop.flat, frame.pixel, frame.raster, pm.raster,
                           frame.size.scale, photos, &image, &state, &r)
-             : SamplePixels(options, in, pm, crop.flat, frame.raster, pm.raster, frame.size.scale,
-                            &image, &state);
+             : SamplePixels(options, in, photos.reference, pm, crop.flat, frame.raster, pm.raster,
+                            frame.size.scale, &image, &state);
   timer.Mark("sample");
 
   TexturePastMesh(options, in, crop.self_view, frame.size, photos, &image, &state, &r, &timer);

@@ -24,6 +24,7 @@
 #include "common/shading.h"
 #include "common/texture_fusion.h"
 #include "stages/render/cut_sides.h"
+#include "stages/render/page_edge.h"
 #include "stages/render/print_straightening.h"
 #include "stages/render/view_sides.h"
 
@@ -145,6 +146,9 @@ struct RenderOptions {
   // The printed rows and columns straightened in the finished image
   // (print_straightening.h): the waviness M' left behind.
   StraightenOptions straighten;
+  // Every photo's page colour continued past its outline before it is
+  // sampled (page_edge.h): no rim of table colour along the crop's edges.
+  PageEdgeOptions page_edge;
   // kFusion: every photo that sees a part of the page better than the
   // reference does colours it there (common/texture_fusion.h: levelled,
   // registered, seams where the photos agree); kReference: the reference

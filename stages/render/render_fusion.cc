@@ -6,12 +6,18 @@
 
 namespace docunfold::render {
 
-std::vector<cv::Mat> ReadViewPhotos(const RenderInputs& in, bool needed) {
-  std::vector<cv::Mat> photos(in.views.size());
-  if (!needed) return photos;
+TexturePhotos ReadTexturePhotos(const RenderOptions& options, const RenderInputs& in,
+                                bool views_needed) {
+  TexturePhotos photos;
+  photos.reference =
+      ContinuePageColour(in.reference, ContourRegion(in.boundary, 0), options.page_edge);
+  photos.views.resize(in.views.size());
+  if (!views_needed) return photos;
   for (size_t v = 0; v < in.views.size(); ++v) {
     const ViewMask& view = in.views[v];
-    if (!view.photo.empty()) photos[v] = ReadViewPhoto(view.photo, view.camera, in.cameras_file);
+    if (view.photo.empty()) continue;
+    photos.views[v] = ContinuePageColour(ReadViewPhoto(view.photo, view.camera, in.cameras_file),
+                                         view.mask, options.page_edge);
   }
   return photos;
 }
@@ -20,7 +26,7 @@ SampleStats FusePixels(const RenderOptions& options, const RenderInputs& in,
                        const ProjectedMesh& pm, const std::vector<Eigen::Vector2d>& flat,
                        const std::vector<Eigen::Vector2d>& out_pixel,
                        const RasterResult& out_raster, const RasterResult& ref_raster, double scale,
-                       const std::vector<cv::Mat>& photos, cv::Mat3b* image, cv::Mat1b* state,
+                       const TexturePhotos& photos, cv::Mat3b* image, cv::Mat1b* state,
                        RenderResult* r) {
   const int W = out_raster.face.cols, H = out_raster.face.rows;
   FusionSurface surface;
@@ -31,11 +37,11 @@ SampleStats FusePixels(const RenderOptions& options, const RenderInputs& in,
   surface.height = H;
   // The reference first: reference.png, undistorted; its outline is where
   // M comes from, so it needs no mask.
-  std::vector<FusionView> views = {{in.camera, {}, in.reference, {}, in.camera.image}};
+  std::vector<FusionView> views = {{in.camera, {}, photos.reference, {}, in.camera.image}};
   for (size_t v = 0; v < in.views.size(); ++v)
-    if (!photos[v].empty())
-      views.push_back({in.views[v].camera, in.views[v].distortion, photos[v], in.views[v].mask,
-                       in.views[v].camera.image});
+    if (!photos.views[v].empty())
+      views.push_back({in.views[v].camera, in.views[v].distortion, photos.views[v],
+                       in.views[v].mask, in.views[v].camera.image});
   FusionOptions fusion = options.fusion;
   fusion.antialias = options.antialias;
   FusedTexture fused = FuseTexture(surface, views, fusion);
@@ -52,8 +58,8 @@ SampleStats FusePixels(const RenderOptions& options, const RenderInputs& in,
   if (options.sample_hidden && stats.hidden > 0) {
     cv::Mat3b reference_image;
     cv::Mat1b reference_state;
-    SamplePixels(options, in, pm, flat, out_raster, ref_raster, scale, &reference_image,
-                 &reference_state);
+    SamplePixels(options, in, photos.reference, pm, flat, out_raster, ref_raster, scale,
+                 &reference_image, &reference_state);
     const cv::Mat1b sampled = (*state == kHidden) & (reference_state == kHiddenSampled);
     reference_image.copyTo(*image, sampled);
     state->setTo(kHiddenSampled, sampled);

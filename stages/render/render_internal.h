@@ -68,17 +68,26 @@ struct SampleStats {
   long page = 0, hidden = 0, minified = 0;
 };
 
-// Samples every output pixel of `out_raster` (M' turned as `flat`, `scale`
-// output pixels per unit) from the reference image into *image, and its
-// state (kOutside ... kHiddenSampled) into *state.
-SampleStats SamplePixels(const RenderOptions& options, const RenderInputs& in,
-                         const ProjectedMesh& pm, const std::vector<Eigen::Vector2d>& flat,
-                         const RasterResult& out_raster, const RasterResult& ref_raster,
-                         double scale, cv::Mat3b* image, cv::Mat1b* state);
+// The photos the texture is sampled from, each with the page's colour
+// continued past its outline (options.page_edge).
+struct TexturePhotos {
+  cv::Mat reference;           // in.reference's
+  std::vector<cv::Mat> views;  // in.views' (empty where a view has none)
+};
 
-// The photos of in.views (empty where a view has none, or when `needed`
-// is false), read once for texture fusion and the page past cut sides.
-std::vector<cv::Mat> ReadViewPhotos(const RenderInputs& in, bool needed);
+// TexturePhotos of in.reference and, when `views_needed` (texture fusion,
+// the page past cut sides), of in.views' photos, read once.
+TexturePhotos ReadTexturePhotos(const RenderOptions& options, const RenderInputs& in,
+                                bool views_needed);
+
+// Samples every output pixel of `out_raster` (M' turned as `flat`, `scale`
+// output pixels per unit) from `reference` (in.reference as textured) into
+// *image, and its state (kOutside ... kHiddenSampled) into *state.
+SampleStats SamplePixels(const RenderOptions& options, const RenderInputs& in,
+                         const cv::Mat& reference, const ProjectedMesh& pm,
+                         const std::vector<Eigen::Vector2d>& flat, const RasterResult& out_raster,
+                         const RasterResult& ref_raster, double scale, cv::Mat3b* image,
+                         cv::Mat1b* state);
 
 // The texture from every photo (options.texture == kFusion,
 // common/texture_fusion.h) over the same output pixels as SamplePixels
@@ -91,7 +100,7 @@ SampleStats FusePixels(const RenderOptions& options, const RenderInputs& in,
                        const ProjectedMesh& pm, const std::vector<Eigen::Vector2d>& flat,
                        const std::vector<Eigen::Vector2d>& out_pixel,
                        const RasterResult& out_raster, const RasterResult& ref_raster, double scale,
-                       const std::vector<cv::Mat>& photos, cv::Mat3b* image, cv::Mat1b* state,
+                       const TexturePhotos& photos, cv::Mat3b* image, cv::Mat1b* state,
                        RenderResult* r);
 
 // Per-channel median colour of the page pixels (the paper, on a document).

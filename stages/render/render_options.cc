@@ -90,6 +90,10 @@ void DeclareOptions(OptionTable& table, RenderOptions* o) {
                "remove: divide out the light's shading (folds, curls, shadows) so that the paper "
                "comes out one even colour, as from a scanner (far better OCR); keep: the "
                "reference photo's brightness, as the paper's method renders it");
+  table.Value("page-rim-px", &o->page_edge.mixed_px, 0, 20,
+              "pixels just inside each photo's page outline, mixed with the table by lens blur, "
+              "are replaced by the page's colour continued from further inside before the "
+              "texture is sampled (0: the photos as they are)");
   table.Switch("straighten", &o->straighten.enabled,
                "straighten the printed rows and columns in the finished image where M' left them "
                "a little wavy (off: the image as M' maps it)");

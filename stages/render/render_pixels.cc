@@ -134,9 +134,10 @@ SizeChoice ChooseSize(const RenderOptions& o, double crop_w, double crop_h, doub
 }
 
 SampleStats SamplePixels(const RenderOptions& options, const RenderInputs& in,
-                         const ProjectedMesh& pm, const std::vector<Eigen::Vector2d>& flat,
-                         const RasterResult& out_raster, const RasterResult& ref_raster,
-                         double scale, cv::Mat3b* image, cv::Mat1b* state) {
+                         const cv::Mat& reference, const ProjectedMesh& pm,
+                         const std::vector<Eigen::Vector2d>& flat, const RasterResult& out_raster,
+                         const RasterResult& ref_raster, double scale, cv::Mat3b* image,
+                         cv::Mat1b* state) {
   const PinholeCamera& cam = in.camera;
   const int W = out_raster.face.cols, H = out_raster.face.rows;
   *image = cv::Mat3b(H, W, cv::Vec3b(0, 0, 0));
@@ -157,7 +158,7 @@ SampleStats SamplePixels(const RenderOptions& options, const RenderInputs& in,
   // pixel is in front of it by more than this (relative to the page's size,
   // as every tolerance on the surface).
   const double depth_tolerance = 0.005 * diag;
-  const TextureSampler sampler(in.reference);
+  const TextureSampler sampler(reference);
   const Eigen::Matrix3d& K = cam.K;
   std::vector<SampleStats> rows(H);
   cv::parallel_for_(cv::Range(0, H), [&](const cv::Range& range) {

@@ -170,7 +170,10 @@ cv::Mat3b MakeTexture(int width, int height) {
   for (int y = height * 2 / 3 + 10; y < height - 20; y += line_h)
     cv::line(tex, cv::Point(width / 20, y), cv::Point(width * 19 / 20, y), cv::Scalar(60, 40, 20),
              2);
-  cv::rectangle(tex, cv::Rect(4, 4, width - 8, height - 8), cv::Scalar(90, 60, 30), 3);
+  // The frame is printed where a printer's margin would be, clear of the
+  // few pixels along the page's edge that render does not take from the
+  // photo (page_edge.h).
+  cv::rectangle(tex, cv::Rect(20, 20, width - 40, height - 40), cv::Scalar(90, 60, 30), 3);
   // Fine stripes (period 3 texture pixels) in a corner patch.
   for (int y = height - 120; y < height - 30; ++y)
     for (int x = width * 2 / 3; x < width - 30; ++x)

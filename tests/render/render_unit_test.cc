@@ -91,6 +91,82 @@ TEST(RenderScene, BentPageReproducesItsTexture) {
   EXPECT_LT(changed, 0.5);
 }
 
+// The outermost ring of output pixels, `width` pixels wide.
+cv::Mat1b Rim(cv::Size size, int width) {
+  cv::Mat1b rim(size, uchar(255));
+  rim(cv::Rect(width, width, size.width - 2 * width, size.height - 2 * width)).setTo(0);
+  return rim;
+}
+
+TEST(RenderScene, TheTableDoesNotShowAlongTheCropsEdges) {
+  // A lens's blur mixes the page's outermost pixels with the green table.
+  SceneOptions o;
+  o.radius = 0;
+  o.tilt_deg = 10;
+  SyntheticScene s = MakeScene(o);
+  cv::GaussianBlur(s.photo, s.photo, cv::Size(), 1.0);
+  auto rim_error = [&](int mixed_px) {
+    render::RenderOptions options;
+    options.page_edge.mixed_px = mixed_px;
+    const render::RenderResult r = render::Run(options, InputsOf(s));
+    Keep("rim-" + std::to_string(mixed_px), r.rectified);
+    // Where the page is blank paper at its edge (the text runs off its right side).
+    const cv::Mat expected = ExpectedImage(s, r);
+    cv::Mat1b paper;
+    cv::cvtColor(expected, paper, cv::COLOR_BGR2GRAY);
+    const cv::Mat1b rim = Rim(r.rectified.size(), 1) & (paper > 230);
+    EXPECT_GT(cv::countNonZero(rim), r.rectified.rows);
+    return MeanAbsGreyDifference(expected, r.rectified, rim);
+  };
+  const double continued = rim_error(render::PageEdgeOptions{}.mixed_px);
+  const double as_photographed = rim_error(0);
+  EXPECT_LT(continued, 6);
+  EXPECT_GT(as_photographed, 5 * continued);
+}
+
+TEST(PageEdge, TheRimTakesThePagesColourAndTheRestIsKept) {
+  // Paper with a gradient, on a dark table, blurred: a mixed rim.
+  cv::Mat3b photo(120, 160, cv::Vec3b(30, 40, 50));
+  const cv::Rect page(30, 20, 100, 80);
+  for (int y = page.y; y < page.br().y; ++y)
+    for (int x = page.x; x < page.br().x; ++x)
+      photo(y, x) = cv::Vec3b(uchar(180 + (x - page.x) / 2), 210, 220);
+  cv::Mat3b blurred;
+  cv::GaussianBlur(photo, blurred, cv::Size(), 1.0);
+  cv::Mat1b mask(photo.size(), uchar(0));
+  mask(page).setTo(255);
+  const render::PageEdgeOptions options;
+  const cv::Mat3b out = render::ContinuePageColour(blurred, mask, options);
+  ASSERT_EQ(out.size(), photo.size());
+  // Deep inside and far outside: untouched.
+  for (const cv::Point p :
+       {cv::Point(80, 60), cv::Point(40, 30), cv::Point(5, 5), cv::Point(155, 115)})
+    EXPECT_EQ(out(p), blurred(p)) << p;
+  // On the outline, and up to reach_px past it: the paper's colour nearby.
+  for (const cv::Point p :
+       {cv::Point(30, 60), cv::Point(129, 60), cv::Point(80, 20), cv::Point(80, 99),
+        cv::Point(80, 99 + options.reach_px - 2), cv::Point(30 - options.reach_px + 2, 60)}) {
+    const cv::Point inside(std::clamp(p.x, page.x + 4, page.br().x - 5),
+                           std::clamp(p.y, page.y + 4, page.br().y - 5));
+    for (int c = 0; c < 3; ++c)
+      EXPECT_NEAR(out(p)[c], photo(inside)[c], 6) << p << " channel " << c;
+  }
+  // Off: the photo itself.
+  const cv::Mat off = render::ContinuePageColour(blurred, mask, {.mixed_px = 0});
+  EXPECT_EQ(off.data, blurred.data);
+}
+
+TEST(PageEdge, APageCutOffByTheImageKeepsItsPixelsThere) {
+  cv::Mat3b photo(100, 100, cv::Vec3b(200, 200, 200));
+  cv::Mat1b mask(photo.size(), uchar(0));
+  mask(cv::Rect(0, 0, 60, 100)).setTo(255);  // the page runs off the left, top and bottom
+  for (int y = 0; y < 100; ++y) photo(y, 0) = cv::Vec3b(0, 0, 255);  // print at the cut
+  const cv::Mat3b out = render::ContinuePageColour(photo, mask, render::PageEdgeOptions{});
+  for (int y = 0; y < 100; ++y) EXPECT_EQ(out(y, 0), cv::Vec3b(0, 0, 255)) << y;
+  EXPECT_EQ(out(0, 30), photo(0, 30));
+  EXPECT_EQ(out(99, 30), photo(99, 30));
+}
+
 TEST(RenderScene, DefaultSizeKeepsTheReferenceDensity) {
   // A frontal flat page at depth 1: f pixels per unit everywhere.
   SceneOptions o;
@@ -454,13 +530,12 @@ TEST(RenderInputsFile, OtherReferencesFollowSfmsRanking) {
       render::ReadRenderInputs(sfm, dir / "20_boundary", dir / "40_init", "", "");
   EXPECT_TRUE(plain.other_references.empty());
   Json cameras = ReadJsonFile(sfm / "cameras.json");
-  cameras["reference_selection"] = {
-      {"method", "auto"},
-      {"views", Json::array({{{"image", "view_09.png"}},
-                             {{"image", s.camera.image}},
-                             {{"score", 0.5}},
-                             {{"image", 7}},
-                             {{"image", "view_01.png"}}})}};
+  cameras["reference_selection"] = {{"method", "auto"},
+                                    {"views", Json::array({{{"image", "view_09.png"}},
+                                                           {{"image", s.camera.image}},
+                                                           {{"score", 0.5}},
+                                                           {{"image", 7}},
+                                                           {{"image", "view_01.png"}}})}};
   WriteJsonAtomic(sfm / "cameras.json", cameras);
   const render::RenderInputs in =
       render::ReadRenderInputs(sfm, dir / "20_boundary", dir / "40_init", "", "");
