@@ -78,12 +78,16 @@ class PhonePhotos : public ::testing::Test {
   std::string output_;
 };
 
-TEST_F(PhonePhotos, ExifTaggedPortraitPhotos) {
+// EXIF-tagged portrait photos named as phones and apps name them, in
+// "My Scans/lettre é 1", run from inside its images/ folder with DATA=..
+TEST_F(PhonePhotos, ExifTaggedPortraitPhotosWithSpacedNamesAndDataDotDot) {
   PhoneChanges c;
   c.exif_portrait = {0, 1, 2, 3, 4};
-  const fs::path set = tmp_ / "portrait";
-  EXPECT_GT(Run(c, set, tmp_.path(), set.string(), "portrait"), own_ - kTolerance) << output_;
-  const Json cameras = ReadJsonFile(tmp_ / "work/portrait/10_sfm/cameras.json");
+  c.spaced_names = true;
+  const fs::path set = tmp_ / "My Scans" / "lettre é 1";
+  EXPECT_GT(Run(c, set, set / "images", "..", "lettre_é_1"), own_ - kTolerance) << output_;
+  EXPECT_TRUE(fs::exists(tmp_ / "work/lettre_é_1/60_render/rectified.png"));
+  const Json cameras = ReadJsonFile(tmp_ / "work/lettre_é_1/10_sfm/cameras.json");
   EXPECT_EQ(cameras.at("views").at(0).at("width").get<int>(), 1200) << "upright: portrait";
   EXPECT_GT(cameras.at("colmap").at("cameras").at(0).at("focal_prior_px").get<double>(), 0);
 }
@@ -98,11 +102,20 @@ TEST_F(PhonePhotos, TurnedPhotosAndOneAtHalfSize) {
   EXPECT_EQ(cameras.at("colmap").at("cameras").size(), 2u) << "the turned ones share a camera";
 }
 
-TEST_F(PhonePhotos, OnePhotoFromA48MegapixelPhone) {
+// One photo from a 48-megapixel phone and one damaged by an interrupted
+// copy: the damaged photo is left out, by name, and the pipeline goes on
+// with the other four; run with DATA=. from the set's folder.
+TEST_F(PhonePhotos, OnePhotoFromA48MegapixelPhoneOneTruncatedAndDataDot) {
   PhoneChanges c;
   c.scale[3] = 5;  // 8000 x 6000
-  const fs::path set = tmp_ / "big";
-  EXPECT_GT(Run(c, set, tmp_.path(), set.string(), "big"), own_ - kTolerance) << output_;
+  c.truncated = {0};
+  const fs::path set = tmp_ / "letter1";
+  const double ms_ssim = Run(c, set, set, ".", "letter1");
+  EXPECT_TRUE(Said("left out: view_00.jpg (damaged: the file ends early)")) << output_;
+  EXPECT_GT(ms_ssim, own_ - kTolerance) << output_;
+  const Json cameras = ReadJsonFile(tmp_ / "work/letter1/10_sfm/cameras.json");
+  EXPECT_EQ(cameras.at("views").size(), 4u);
+  EXPECT_EQ(cameras.at("left_out").at(0).at("image"), "view_00.jpg");
 }
 
 TEST_F(PhonePhotos, HeicPhotosAndASidecarFile) {
@@ -112,30 +125,6 @@ TEST_F(PhonePhotos, HeicPhotosAndASidecarFile) {
   const fs::path set = tmp_ / "iphone";
   EXPECT_GT(Run(c, set, tmp_.path(), set.string(), "iphone"), own_ - kTolerance) << output_;
   EXPECT_TRUE(Said("left out: IMG_0001.AAE (not a photo)")) << output_;
-}
-
-// "My Scans/lettre é 1" with names as phones and apps give them, run from
-// inside its images/ folder with DATA=..
-TEST_F(PhonePhotos, SpacesAndAccentsRunFromInsideWithDataDotDot) {
-  PhoneChanges c;
-  c.spaced_names = true;
-  const fs::path set = tmp_ / "My Scans" / "lettre é 1";
-  EXPECT_GT(Run(c, set, set / "images", "..", "lettre_é_1"), own_ - kTolerance) << output_;
-  EXPECT_TRUE(fs::exists(tmp_ / "work/lettre_é_1/60_render/rectified.png"));
-}
-
-// An interrupted copy: the damaged photo is left out, by name, and the
-// pipeline goes on with the other four; run with DATA=. from the set's folder.
-TEST_F(PhonePhotos, TruncatedPhotoIsLeftOutAndDataDot) {
-  PhoneChanges c;
-  c.truncated = {0};
-  const fs::path set = tmp_ / "letter1";
-  const double ms_ssim = Run(c, set, set, ".", "letter1");
-  EXPECT_TRUE(Said("left out: view_00.jpg (damaged: the file ends early)")) << output_;
-  EXPECT_GT(ms_ssim, own_ - kTolerance) << output_;
-  const Json cameras = ReadJsonFile(tmp_ / "work/letter1/10_sfm/cameras.json");
-  EXPECT_EQ(cameras.at("views").size(), 4u);
-  EXPECT_EQ(cameras.at("left_out").at(0).at("image"), "view_00.jpg");
 }
 
 }  // namespace
