@@ -63,17 +63,29 @@ Json RegistrationJson(const EvaluationPair& pair, const cv::Mat2f& flow, Metrics
   if (!reg) return Skipped("too few flow vectors on the page's ink agree on one affine map");
   m->ms_ssim_registered = reg->ms_ssim;
   const double w = pair.ground_truth.cols, h = pair.ground_truth.rows;
-  const cv::Matx23d& a = reg->result_from_truth;
-  const Json map = Json::array({Json::array({a(0, 0), a(0, 1) * h / w, a(0, 2) / w}),
-                                Json::array({a(1, 0) * w / h, a(1, 1), a(1, 2) / h})});
+  auto page_map = [&](const cv::Matx23d& a) {
+    return Json::array({Json::array({a(0, 0), a(0, 1) * h / w, a(0, 2) / w}),
+                        Json::array({a(1, 0) * w / h, a(1, 1), a(1, 2) / h})});
+  };
+  Json candidates = Json::array();
+  for (const AffineCandidate& c : reg->candidates)
+    candidates.push_back({{"fit", c.fit},
+                          {"result_from_truth", page_map(c.result_from_truth)},
+                          {"samples", c.samples},
+                          {"residual_px", c.residual_px},
+                          {"ms_ssim", c.ms_ssim}});
   return {{"method",
-           "affine map fitted (RANSAC 1 px at the flow size, then refined) to the DeepFlow "
-           "field where flat.png has ink; the result resampled through it, MS-SSIM as above"},
-          {"result_from_truth", map},
+           "the best affine map by MS-SSIM of those fitted to the DeepFlow field where "
+           "flat.png has ink (RANSAC at 1 px of the flow size, then refined on its inliers; "
+           "least squares over every such vector; RANSAC over the vectors the first left "
+           "out) and the identity; the result resampled through it, MS-SSIM as above"},
+          {"fit", reg->fit},
+          {"result_from_truth", page_map(reg->result_from_truth)},
           {"units", "fractions of the page's width (x) and height (y)"},
           {"samples", reg->samples},
           {"residual_px", reg->residual_px},
-          {"ms_ssim", reg->ms_ssim}};
+          {"ms_ssim", reg->ms_ssim},
+          {"candidates", candidates}};
 }
 
 // OCR of the ground truth, from the cache when it holds this file's text.

@@ -66,6 +66,7 @@ TEST(RegisterAffine, ACropShortAtTheBottomIsOneAffineMapAway) {
   EXPECT_LT(reg->residual_px, 0.5);
   EXPECT_LT(plain, 0.9);
   EXPECT_GT(reg->ms_ssim, 0.97);
+  EXPECT_NE(reg->fit, "identity");
 }
 
 TEST(RegisterAffine, LeavesALocalWaveInTheLoss) {
@@ -85,6 +86,33 @@ TEST(RegisterAffine, LeavesALocalWaveInTheLoss) {
   ASSERT_TRUE(reg.has_value());
   EXPECT_LT(reg->ms_ssim, plain + 0.05);
   EXPECT_LT(reg->ms_ssim, 0.9);
+}
+
+TEST(RegisterAffine, NeverScoresBelowTheResultAsItIs) {
+  // A page shown as two halves moved apart, as across a fold M got wrong:
+  // the top 55 % in place, the rest 9 px lower and stretched. No single map
+  // fits both; whichever is chosen, the registered score is the best of the
+  // maps tried and not below the plain one.
+  const cv::Mat1b page = TextPage({480, 680}, 7);
+  cv::Mat1f map_x(page.size()), map_y(page.size());
+  const float split = 0.55f * float(page.rows);
+  for (int r = 0; r < page.rows; ++r)
+    for (int c = 0; c < page.cols; ++c) {
+      map_x(r, c) = float(c);
+      map_y(r, c) = r < split ? float(r) : split + (float(r) - split - 9) / 1.04f;
+    }
+  cv::Mat1b result;
+  cv::remap(page, result, map_x, map_y, cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+  const double plain = MsSsim(page, result).value;
+  const auto reg = RegisterAffine(page, result, HalfSizeFlow(page, result));
+  ASSERT_TRUE(reg.has_value());
+  ASSERT_GE(reg->candidates.size(), 3u);
+  EXPECT_EQ(reg->candidates.front().fit, "ransac");
+  EXPECT_EQ(reg->candidates[1].fit, "least-squares");
+  EXPECT_EQ(reg->candidates.back().fit, "identity");
+  EXPECT_NEAR(reg->candidates.back().ms_ssim, plain, 1e-9);
+  for (const AffineCandidate& c : reg->candidates) EXPECT_GE(reg->ms_ssim, c.ms_ssim);
+  EXPECT_GE(reg->ms_ssim, plain);
 }
 
 TEST(RegisterAffine, ABlankPageHasNothingToRegister) {

@@ -58,9 +58,11 @@ class PhonePhotos : public ::testing::Test {
     std::vector<std::string> roots;
     for (const auto& e : fs::directory_iterator(work_root)) roots.push_back(e.path().filename());
     EXPECT_EQ(roots, std::vector<std::string>{name}) << output_;
-    for (const auto& [path, what] : Listing(tmp_.path()))
-      if (path.rfind("work", 0) != 0)
+    for (const auto& [path, what] : Listing(tmp_.path())) {
+      if (path.rfind("work", 0) != 0) {
         EXPECT_TRUE(top_before.count(path)) << path << " written outside the work directory";
+      }
+    }
     const fs::path metrics = work_root / name / "70_eval/metrics.json";
     if (!fs::exists(metrics)) {
       ADD_FAILURE() << "no result:\n" << output_;
