@@ -25,10 +25,7 @@ State Moved(const State& s, const Eigen::VectorXd& delta) {
 
 GaussNewton::GaussNewton(const QuadGrid& grid, const SolveOptions& o)
     : o_(o), H_(grid), threads_(std::max(1, o.num_threads)) {
-  const bool direct =
-      o.linear_solver == LinearSolver::kDirect ||
-      (o.linear_solver == LinearSolver::kAuto && grid.NumVertices() <= o.direct_max_vertices);
-  direct_ = direct;
+  direct_ = o.linear_solver == LinearSolver::kDirect;
   mu_ = o.initial_damping;
 }
 
