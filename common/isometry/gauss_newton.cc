@@ -25,7 +25,10 @@ State Moved(const State& s, const Eigen::VectorXd& delta) {
 
 GaussNewton::GaussNewton(const QuadGrid& grid, const SolveOptions& o)
     : o_(o), H_(grid), threads_(std::max(1, o.num_threads)) {
-  direct_ = o.linear_solver == LinearSolver::kDirect;
+  const bool direct =
+      o.linear_solver == LinearSolver::kDirect ||
+      (o.linear_solver == LinearSolver::kAuto && grid.NumVertices() <= o.direct_max_vertices);
+  direct_ = direct;
   mu_ = o.initial_damping;
 }
 

@@ -110,9 +110,9 @@ struct Problem {
 enum class IsoNormalization { kStrain, kRaw };
 enum class Method { kGaussNewton, kLbfgs };
 // How a Gauss-Newton step's normal equations are solved: sparse Cholesky
-// (CHOLMOD supernodal, symbolic analysis reused) or block-Jacobi conjugate
-// gradients.
-enum class LinearSolver { kDirect, kConjugateGradient };
+// (CHOLMOD supernodal, symbolic analysis reused), block-Jacobi conjugate
+// gradients, or direct up to `direct_max_vertices` and CG above.
+enum class LinearSolver { kAuto, kDirect, kConjugateGradient };
 
 // Called at the start of every outer iteration, after footpoints and
 // outliers were updated and before the lines are fitted (refit_lines), the
@@ -141,11 +141,14 @@ struct SolveOptions {
   double iso_edges = 0;
 
   Method method = Method::kGaussNewton;
-  // Block-Jacobi CG on every grid: an inexact Gauss-Newton step (a few CG
-  // iterations to a loose tolerance) fits as well as an exact one at a
-  // fraction of its cost, the coarse 21x31 grid included. See
-  // docs/decisions/optimize.md, "Conjugate gradients on every grid".
-  LinearSolver linear_solver = LinearSolver::kConjugateGradient;
+  // Direct CHOLMOD factorisation up to direct_max_vertices (the 21x31 first
+  // round), block-Jacobi CG above: an inexact Gauss-Newton step (a few CG
+  // iterations to a loose tolerance) is enough once the coarser rounds have
+  // settled the smooth part, and it fits as well as exact steps at a
+  // fraction of the cost of factorising the fine grids. See
+  // docs/decisions/optimize.md, "Conjugate gradients on the fine grids".
+  LinearSolver linear_solver = LinearSolver::kAuto;
+  int direct_max_vertices = 1000;
   int cg_max_iterations = 40;     // per Gauss-Newton step
   double cg_tolerance = 3e-2;     // relative residual of the normal equations
   double initial_damping = 1e-4;  // Levenberg-Marquardt μ (× diag(JᵀJ))

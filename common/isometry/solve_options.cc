@@ -24,9 +24,11 @@ void DeclareSolveOptions(OptionTable& table, SolveOptions* o) {
                "gn: Gauss-Newton/Levenberg-Marquardt with sparse Cholesky; lbfgs: L-BFGS (the "
                "paper's)");
   table.Choice("linear-solver", &o->linear_solver,
-               {{"cg", LinearSolver::kConjugateGradient}, {"direct", LinearSolver::kDirect}},
-               "Gauss-Newton's normal equations: cg (block-Jacobi conjugate gradients to a "
-               "loose tolerance) or direct (sparse Cholesky, exact steps)");
+               {{"auto", LinearSolver::kAuto},
+                {"direct", LinearSolver::kDirect},
+                {"cg", LinearSolver::kConjugateGradient}},
+               "Gauss-Newton's normal equations: auto (Cholesky on small grids, conjugate "
+               "gradients on large), direct or cg");
   table.Value("max-iterations", &o->max_outer_iterations, 0, 100000,
               "outer iterations at most (per round), Q");
   table.Value("tolerance", &o->relative_tolerance, 0.0, 1.0,

@@ -2,7 +2,7 @@
 // grid 20x30 quads, 4 rounds separated by 3 Catmull-Clark subdivisions, on a
 // data set's truth (points from WriteSfmFromTruth, initial M = the truth on a
 // coarse grid, flattened halfway). Not a test: prints a table.
-//   isometry_bench <data set> [--method gn|lbfgs] [--solver direct|cg]
+//   isometry_bench <data set> [--method gn|lbfgs] [--solver auto|direct|cg]
 //                  [--rounds 4] [--points 6000] [--flatten 0.5]
 #include <chrono>
 #include <cstring>
@@ -33,7 +33,8 @@ int main(int argc, char** argv) {
       o.method = v == "lbfgs" ? isometry::Method::kLbfgs : isometry::Method::kGaussNewton;
     if (k == "--solver")
       o.linear_solver = v == "direct" ? isometry::LinearSolver::kDirect
-                                      : isometry::LinearSolver::kConjugateGradient;
+                        : v == "cg"   ? isometry::LinearSolver::kConjugateGradient
+                                      : isometry::LinearSolver::kAuto;
     if (k == "--rounds") rounds = std::stoi(v);
     if (k == "--points") points = std::stoi(v);
     if (k == "--flatten") flatten = std::stod(v);
@@ -46,6 +47,7 @@ int main(int argc, char** argv) {
     if (k == "--cg-tol") o.cg_tolerance = std::stod(v);
     if (k == "--fair2d") o.weights.fair2d = std::stod(v);
     if (k == "--threads") o.num_threads = std::stoi(v);
+    if (k == "--direct-max") o.direct_max_vertices = std::stoi(v);
   }
   auto gt = testing::LoadGroundTruth(argv[1]);
   if (!gt) return 1;

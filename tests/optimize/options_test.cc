@@ -46,7 +46,7 @@ TEST(OptimizeOptions, RoundsHandTheSolverThePapersSettingsAndTheirStoppingRule) 
     EXPECT_EQ(so.converged_iterations, r < 2 ? 2 : 1) << r;
     EXPECT_EQ(so.max_rises, r < 2 ? 0 : 3) << r;
     EXPECT_EQ(so.method, isometry::Method::kGaussNewton);
-    EXPECT_EQ(so.linear_solver, isometry::LinearSolver::kConjugateGradient);
+    EXPECT_EQ(so.linear_solver, isometry::LinearSolver::kAuto);
     EXPECT_TRUE(so.project_markers);
     EXPECT_EQ(so.num_threads, 2);
     EXPECT_EQ(so.converged_max_damping, defaults.converged_max_damping);
