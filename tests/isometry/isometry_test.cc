@@ -288,7 +288,7 @@ TEST(Isometry, SolveFitsNoisyPointsAndFlagsOutliers) {
   const auto& report = result.report;
   ASSERT_GE(report.iterations.size(), 2u);
   EXPECT_LT(report.iterations.back().F, report.iterations.front().F);
-  EXPECT_EQ(report.method, "gauss-newton/cholmod");
+  EXPECT_EQ(report.method, "gauss-newton/cg");
   EXPECT_EQ(report.iterations.back().inliers + report.iterations.back().outliers,
             int(sample.points.size()));
   const Json j = isometry::ToJson(report);
@@ -657,6 +657,9 @@ TEST(Isometry, AMarkerOfWeightKCountsAsKCopies) {
   SolveOptions o;
   o.weights.dist = 0;
   o.max_outer_iterations = 5;
+  // Exact steps: CG stops at a tolerance, and the two sums of rows are the
+  // same only up to rounding, which its iteration counts would magnify.
+  o.linear_solver = isometry::LinearSolver::kDirect;
   const auto a = isometry::Solve(weighted, o), b = isometry::Solve(copies, o);
   double worst = 0;
   for (size_t v = 0; v < a.meshes.mesh3d.size(); ++v)
