@@ -24,11 +24,16 @@ State Moved(const State& s, const Eigen::VectorXd& delta) {
 }  // namespace
 
 GaussNewton::GaussNewton(const QuadGrid& grid, const SolveOptions& o)
-    : o_(o), H_(grid), threads_(std::max(1, o.num_threads)) {
-  const bool direct =
-      o.linear_solver == LinearSolver::kDirect ||
-      (o.linear_solver == LinearSolver::kAuto && grid.NumVertices() <= o.direct_max_vertices);
-  direct_ = direct;
+    : o_(o),
+      H_(grid),
+      threads_(std::max(1, o.num_threads)),
+      cg_tolerance_(o.cg_tolerance),
+      cg_max_iterations_(o.cg_max_iterations) {
+  direct_ = o.linear_solver == LinearSolver::kDirect;
+  if (o.linear_solver == LinearSolver::kAuto && grid.NumVertices() <= o.coarse_max_vertices) {
+    cg_tolerance_ = o.coarse_cg_tolerance;
+    cg_max_iterations_ = o.coarse_cg_max_iterations;
+  }
   mu_ = o.initial_damping;
 }
 
@@ -202,7 +207,7 @@ bool GaussNewton::SolveCg(const Eigen::VectorXd& shift, const Eigen::VectorXd& g
   apply_precond(r, z);
   p = z;
   double rz = r.dot(z);
-  for (int it = 0; it < o_.cg_max_iterations; ++it) {
+  for (int it = 0; it < cg_max_iterations_; ++it) {
     apply_a(p, ap);
     const double pap = p.dot(ap);
     if (!(pap > 0)) break;
@@ -210,7 +215,7 @@ bool GaussNewton::SolveCg(const Eigen::VectorXd& shift, const Eigen::VectorXd& g
     delta += alpha * p;
     r -= alpha * ap;
     ++*iterations;
-    if (r.norm() <= o_.cg_tolerance * b_norm) break;
+    if (r.norm() <= cg_tolerance_ * b_norm) break;
     apply_precond(r, z);
     const double rz_new = r.dot(z);
     p = z + (rz_new / rz) * p;

@@ -38,7 +38,9 @@ class GaussNewton {
   const SolveOptions& o_;
   GridBlockMatrix H_;
   int threads_ = 1;
-  bool direct_ = true;
+  bool direct_ = false;
+  double cg_tolerance_;
+  int cg_max_iterations_;
   double mu_ = 1e-4;
   double nu_ = 2;
   Eigen::SparseMatrix<double> sparse_;

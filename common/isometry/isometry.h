@@ -111,7 +111,8 @@ enum class IsoNormalization { kStrain, kRaw };
 enum class Method { kGaussNewton, kLbfgs };
 // How a Gauss-Newton step's normal equations are solved: sparse Cholesky
 // (CHOLMOD supernodal, symbolic analysis reused), block-Jacobi conjugate
-// gradients, or direct up to `direct_max_vertices` and CG above.
+// gradients, or auto: CG everywhere, to the tighter coarse_cg_tolerance on
+// grids of up to coarse_max_vertices.
 enum class LinearSolver { kAuto, kDirect, kConjugateGradient };
 
 // Called at the start of every outer iteration, after footpoints and
@@ -141,14 +142,17 @@ struct SolveOptions {
   double iso_edges = 0;
 
   Method method = Method::kGaussNewton;
-  // Direct CHOLMOD factorisation up to direct_max_vertices (the 21x31 first
-  // round), block-Jacobi CG above: an inexact Gauss-Newton step (a few CG
-  // iterations to a loose tolerance) is enough once the coarser rounds have
-  // settled the smooth part, and it fits as well as exact steps at a
-  // fraction of the cost of factorising the fine grids. See
-  // docs/decisions/optimize.md, "Conjugate gradients on the fine grids".
+  // Block-Jacobi CG: an inexact Gauss-Newton step (a few CG iterations to a
+  // loose tolerance) is enough once the coarser rounds have settled the
+  // smooth part, at a fraction of the cost of factorising the fine grids.
+  // The coarse grids (the 21x31 first round) settle the blank paper and
+  // need steps solved to 1e-3, which CG reaches in a fraction of CHOLMOD's
+  // time there. See docs/decisions/optimize.md, "Conjugate gradients on the
+  // fine grids" and "Conjugate gradients on the coarse grid, to 1e-3".
   LinearSolver linear_solver = LinearSolver::kAuto;
-  int direct_max_vertices = 1000;
+  int coarse_max_vertices = 1000;
+  double coarse_cg_tolerance = 1e-3;  // relative residual, on coarse grids
+  int coarse_cg_max_iterations = 3000;
   int cg_max_iterations = 40;     // per Gauss-Newton step
   double cg_tolerance = 3e-2;     // relative residual of the normal equations
   double initial_damping = 1e-4;  // Levenberg-Marquardt μ (× diag(JᵀJ))

@@ -27,8 +27,9 @@ void DeclareSolveOptions(OptionTable& table, SolveOptions* o) {
                {{"auto", LinearSolver::kAuto},
                 {"direct", LinearSolver::kDirect},
                 {"cg", LinearSolver::kConjugateGradient}},
-               "Gauss-Newton's normal equations: auto (Cholesky on small grids, conjugate "
-               "gradients on large), direct or cg");
+               "Gauss-Newton's normal equations: auto (conjugate gradients, solved tighter on "
+               "coarse grids), direct (sparse Cholesky, exact steps) or cg (conjugate gradients "
+               "to one loose tolerance on every grid)");
   table.Value("max-iterations", &o->max_outer_iterations, 0, 100000,
               "outer iterations at most (per round), Q");
   table.Value("tolerance", &o->relative_tolerance, 0.0, 1.0,

@@ -91,13 +91,16 @@ struct Options {
   //    their planes (optimize keeps the paper's diagonals);
   //  - |ΔF/F| below the tolerance does not stop the refinement while the
   //    Levenberg-Marquardt damping is above 0.01 (its steps are then short,
-  //    not converged).
+  //    not converged);
+  //  - exact steps (CHOLMOD): its grid is coarse, and inexact ones left the
+  //    receipts' blank paper unsettled.
   // See docs/decisions/init-mesh.md, "The refinement's defaults".
   isometry::SolveOptions refine = [] {
     isometry::SolveOptions o;
     o.weights.fair2d = 0.01;
     o.iso_edges = 0.5;
     o.converged_max_damping = 0.01;
+    o.linear_solver = isometry::LinearSolver::kDirect;
     return o;
   }();
   bool upright = true;

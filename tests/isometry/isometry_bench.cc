@@ -47,7 +47,7 @@ int main(int argc, char** argv) {
     if (k == "--cg-tol") o.cg_tolerance = std::stod(v);
     if (k == "--fair2d") o.weights.fair2d = std::stod(v);
     if (k == "--threads") o.num_threads = std::stoi(v);
-    if (k == "--direct-max") o.direct_max_vertices = std::stoi(v);
+    if (k == "--coarse-max") o.coarse_max_vertices = std::stoi(v);
   }
   auto gt = testing::LoadGroundTruth(argv[1]);
   if (!gt) return 1;

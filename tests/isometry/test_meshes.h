@@ -109,6 +109,7 @@ inline MeshPair Resample(const MeshPair& m, int nx, int ny) {
 struct DistanceStats {
   double mean = 0;
   double max = 0;
+  double p99 = 0;  // 99th percentile: all but the farthest 1 % of the samples
 };
 inline DistanceStats SurfaceDistance(const MeshPair& from, const MeshPair& to) {
   isometry::TriangleMeshIndex index(to.mesh3d, to.grid.Triangles());
@@ -119,11 +120,17 @@ inline DistanceStats SurfaceDistance(const MeshPair& from, const MeshPair& to) {
         (from.mesh3d[c[0]] + from.mesh3d[c[1]] + from.mesh3d[c[2]] + from.mesh3d[c[3]]) / 4);
   }
   DistanceStats s;
+  std::vector<double> distances;
   for (const auto& p : samples) {
     const double d = index.Closest(p)->distance;
+    distances.push_back(d);
     s.mean += d / samples.size();
     s.max = std::max(s.max, d);
   }
+  if (distances.empty()) return s;
+  const auto at = distances.begin() + (distances.size() * 99) / 100;
+  std::nth_element(distances.begin(), at, distances.end());
+  s.p99 = *at;
   return s;
 }
 

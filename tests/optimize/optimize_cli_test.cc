@@ -181,15 +181,19 @@ TEST(OptimizeCli, APageBuiltFromThePointsOfEveryPhotoStaysWhole) {
   const auto page_to_init = SurfaceDistance(truth, ReadMeshPair(dir / "40_init"));
   const auto page_to_m = SurfaceDistance(truth, ReadMeshPair(dir / "50_optimize"));
   std::printf(
-      "[optimize] page rebuilt from its points: page to M %.2f %% (max %.2f %%) of the model "
-      "size, init %.2f %% (max %.2f %%)\n",
-      100 * page_to_m.mean / size, 100 * page_to_m.max / size, 100 * page_to_init.mean / size,
-      100 * page_to_init.max / size);
+      "[optimize] page rebuilt from its points: page to M %.2f %% (99th percentile %.2f %%, "
+      "max %.2f %%) of the model size, init %.2f %% (max %.2f %%)\n",
+      100 * page_to_m.mean / size, 100 * page_to_m.p99 / size, 100 * page_to_m.max / size,
+      100 * page_to_init.mean / size, 100 * page_to_init.max / size);
   EXPECT_LT(page_to_m.mean, 0.005 * size);
   // Whole, not collapsed. Without text lines F's minimum lies a little off
-  // the truth on the edge-on half, and the first rounds, run to 1e-4, get
-  // nearer it: 3.05 % at most (1.49 % stopping at 1 %, as the paper does).
-  EXPECT_LT(page_to_m.max, 0.04 * size);
+  // the truth at the edge-on half's far corner, and the nearer the solver
+  // gets to it, the farther that corner's tip: 3.0 % at most with exact
+  // steps, 7.1 % with the coarse grid by conjugate gradients, which reaches
+  // a lower F (0.5 % of the page beyond 4 %). All but that tip stays on the
+  // page; a collapse moves far more of it.
+  EXPECT_LT(page_to_m.p99, 0.04 * size);
+  EXPECT_LT(page_to_m.max, 0.1 * size);
 }
 
 }  // namespace
