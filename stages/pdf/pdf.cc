@@ -21,6 +21,13 @@
 namespace docunfold::pdf {
 namespace {
 
+// A word whose box fits in a square a quarter of an em across is no glyph
+// (a hyphen is a third of an em wide, a letter half an em tall); painted
+// out with this much paper around it, in at most this many passes.
+constexpr double kSpeckSideEm = 0.25;
+constexpr double kSpeckMarginEm = 0.1;
+constexpr int kSpeckPasses = 2;
+
 // A folder inside `out` for what Tesseract and qpdf write before it is
 // renamed into place; removed however Run ends.
 class Staging {
@@ -140,6 +147,55 @@ void ScaleToPage(double scale, PageReader::Page* page) {
   }
 }
 
+cv::Rect Grown(const cv::Rect& r, int margin) {
+  return cv::Rect(r.x - margin, r.y - margin, r.width + 2 * margin, r.height + 2 * margin);
+}
+
+// `image` with each box (grown by `margin` pixels) filled with the median
+// colour of a ring as wide around it: the paper a speck lies on.
+cv::Mat WithoutSpecks(const cv::Mat& image, const std::vector<cv::Rect>& specks, int margin) {
+  cv::Mat out = image.clone();
+  const cv::Rect whole(0, 0, image.cols, image.rows);
+  const int channels = image.channels();
+  for (const cv::Rect& speck : specks) {
+    const cv::Rect inner = Grown(speck, margin) & whole;
+    const cv::Rect outer = Grown(inner, margin) & whole;
+    std::vector<std::vector<uchar>> ring(channels);
+    for (int y = outer.y; y < outer.br().y; ++y)
+      for (int x = outer.x; x < outer.br().x; ++x)
+        if (!inner.contains({x, y}))
+          for (int c = 0; c < channels; ++c)
+            ring[c].push_back(image.ptr<uchar>(y)[x * channels + c]);
+    if (inner.empty() || ring[0].empty()) continue;
+    cv::Scalar paper;
+    for (int c = 0; c < channels; ++c) {
+      std::nth_element(ring[c].begin(), ring[c].begin() + ring[c].size() / 2, ring[c].end());
+      paper[c] = ring[c][ring[c].size() / 2];
+    }
+    out(inner).setTo(paper);
+  }
+  return out;
+}
+
+// Reads `image` and measures its text. Tesseract's renderers write every
+// word it read, specks on bare paper or i's dots read as '-' or 'g' too:
+// those are painted out and the page read again (18 of 4,399 words on the
+// 15 bench pages were such specks).
+PageReader::Page ReadWithoutSpecks(PageReader& reader, cv::Mat image, TextSize* size,
+                                   size_t* erased) {
+  PageReader::Page read = reader.Read(image);
+  *size = EstimateTextSize(read.words, read.lines);
+  for (int pass = 0; pass < kSpeckPasses; ++pass) {
+    const std::vector<cv::Rect> specks = SpeckBoxes(read.words, kSpeckSideEm * size->em_px);
+    if (specks.empty()) break;
+    image = WithoutSpecks(image, specks, std::max(2, int(std::ceil(kSpeckMarginEm * size->em_px))));
+    *erased += specks.size();
+    read = reader.Read(image);
+    *size = EstimateTextSize(read.words, read.lines);
+  }
+  return read;
+}
+
 Json WordsJson(const std::vector<Word>& words) {
   Json list = Json::array();
   for (const Word& w : words)
@@ -217,10 +273,9 @@ PdfResult Run(const PdfOptions& o, const PdfInputs& in, const fs::path& out,
                cv::Size(int(std::lround(in.page.cols * ocr_scale)),
                         int(std::lround(in.page.rows * ocr_scale))),
                0, 0, cv::INTER_CUBIC);
-  PageReader::Page read = reader.Read(ocr_page);
-  // Measured on the enlarged copy, where word boxes are not rounded to a
-  // few pixels.
-  r.text_size = EstimateTextSize(read.words, read.lines);
+  // Text size measured on the enlarged copy, where word boxes are not
+  // rounded to a few pixels.
+  PageReader::Page read = ReadWithoutSpecks(reader, ocr_page, &r.text_size, &r.specks_erased);
   r.text_size.em_px /= ocr_scale;
   r.text_size.word_height_px /= ocr_scale;
   r.text_size.line_pitch_px /= ocr_scale;
@@ -291,6 +346,7 @@ PdfResult Run(const PdfOptions& o, const PdfInputs& in, const fs::path& out,
                {"read_scale", ocr_scale},
                {"words", r.words.size()},
                {"mean_confidence", r.mean_confidence},
+               {"specks_erased", r.specks_erased},
                {"size",
                 {{"cue", r.text_size.cue},
                  {"em_px", r.text_size.em_px},

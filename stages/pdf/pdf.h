@@ -56,6 +56,7 @@ struct PdfResult {
   std::vector<Word> words;
   TextSize text_size;
   double mean_confidence = 0;
+  size_t specks_erased = 0;  // words too small to be glyphs, painted out before the last read
   size_t pdf_bytes = 0;
   fs::path pdf_file;
   Json report;  // pdf.json

@@ -68,4 +68,11 @@ TextSize EstimateTextSize(const std::vector<Word>& words, const std::vector<Text
   return size;
 }
 
+std::vector<cv::Rect> SpeckBoxes(const std::vector<Word>& words, double side_px) {
+  std::vector<cv::Rect> specks;
+  for (const Word& w : words)
+    if (w.box.width < side_px && w.box.height < side_px) specks.push_back(w.box);
+  return specks;
+}
+
 }  // namespace docunfold::pdf

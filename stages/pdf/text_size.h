@@ -48,4 +48,9 @@ struct TextSize {
 TextSize EstimateTextSize(const std::vector<Word>& words, const std::vector<TextLine>& lines,
                           const TextSizeOptions& options = {});
 
+// The boxes of the words that fit in a square `side_px` across: specks of
+// dirt or noise Tesseract read as a character ('-', 'g' a pixel or two
+// across on bare paper), not glyphs. None when `side_px` is 0.
+std::vector<cv::Rect> SpeckBoxes(const std::vector<Word>& words, double side_px);
+
 }  // namespace docunfold::pdf

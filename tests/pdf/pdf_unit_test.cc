@@ -146,6 +146,21 @@ TEST(TextSize, LinesOfDifferentBlocksOrColumnsAreNotNeighbours) {
   EXPECT_EQ(EstimateTextSize(BodyWords(30, 10), lines).line_pitch_px, 0);
 }
 
+TEST(TextSize, SpecksAreWordsSmallerThanAQuarterEmEveryWay) {
+  // At 12 px to the em: specks Tesseract read on bare paper go; a hyphen
+  // (4 x 1 px), a short word and an upright bar stay.
+  const std::vector<Word> words = {{cv::Rect(5, 5, 1, 1), 0.85, "-"},
+                                   {cv::Rect(9, 9, 2, 2), 0.6, "g"},
+                                   {cv::Rect(20, 5, 4, 1), 0.9, "-"},
+                                   {cv::Rect(30, 5, 15, 7), 0.95, "an"},
+                                   {cv::Rect(50, 2, 1, 9), 0.7, "|"}};
+  const std::vector<cv::Rect> specks = SpeckBoxes(words, 0.25 * 12);
+  ASSERT_EQ(specks.size(), 2u);
+  EXPECT_EQ(specks[0], cv::Rect(5, 5, 1, 1));
+  EXPECT_EQ(specks[1], cv::Rect(9, 9, 2, 2));
+  EXPECT_TRUE(SpeckBoxes(words, 0).empty());
+}
+
 TEST(MarkupScale, AltoPositionsAndSizes) {
   const std::string alto =
       R"(<Page WIDTH="2000" HEIGHT="3000" PHYSICAL_IMG_NR="0" ID="page_0">)"
