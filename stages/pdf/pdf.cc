@@ -178,9 +178,9 @@ cv::Mat WithoutSpecks(const cv::Mat& image, const std::vector<cv::Rect>& specks,
 }
 
 // Reads `image` and measures its text. Tesseract's renderers write every
-// word it read, specks on bare paper or i's dots read as '-' or 'g' too:
-// those are painted out and the page read again (18 of 4,399 words on the
-// 15 bench pages were such specks).
+// word it read, a speck on bare paper or an i's dot on a line of its own
+// read as '-', 'g' or ':' too: those are painted out and the page read
+// again (18 of 4,399 words on the 15 bench pages were such specks).
 PageReader::Page ReadWithoutSpecks(PageReader& reader, cv::Mat image, TextSize* size,
                                    size_t* erased) {
   PageReader::Page read = reader.Read(image);
