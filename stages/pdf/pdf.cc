@@ -15,6 +15,7 @@
 #include "common/option_table.h"
 #include "common/program.h"
 #include "common/shading.h"
+#include "common/statistics.h"
 #include "stages/pdf/markup_scale.h"
 #include "stages/pdf/pdf_file.h"
 
@@ -159,19 +160,17 @@ cv::Mat WithoutSpecks(const cv::Mat& image, const std::vector<cv::Rect>& specks,
   const int channels = image.channels();
   for (const cv::Rect& speck : specks) {
     const cv::Rect inner = Grown(speck, margin) & whole;
+    if (inner.empty()) continue;
     const cv::Rect outer = Grown(inner, margin) & whole;
-    std::vector<std::vector<uchar>> ring(channels);
+    std::vector<std::vector<double>> ring(channels);
     for (int y = outer.y; y < outer.br().y; ++y)
       for (int x = outer.x; x < outer.br().x; ++x)
         if (!inner.contains({x, y}))
           for (int c = 0; c < channels; ++c)
             ring[c].push_back(image.ptr<uchar>(y)[x * channels + c]);
-    if (inner.empty() || ring[0].empty()) continue;
+    if (ring[0].empty()) continue;
     cv::Scalar paper;
-    for (int c = 0; c < channels; ++c) {
-      std::nth_element(ring[c].begin(), ring[c].begin() + ring[c].size() / 2, ring[c].end());
-      paper[c] = ring[c][ring[c].size() / 2];
-    }
+    for (int c = 0; c < channels; ++c) paper[c] = Median(std::move(ring[c]));
     out(inner).setTo(paper);
   }
   return out;

@@ -3,14 +3,10 @@
 #include <algorithm>
 #include <cctype>
 
+#include "common/statistics.h"
+
 namespace docunfold::pdf {
 namespace {
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
-}
 
 double BaselineYAt(const TextLine& line, double x) {
   const cv::Point2d& a = line.baseline_start;
