@@ -110,7 +110,7 @@ void DeclareOptions(OptionTable& table, RenderOptions* o) {
               "reached edge (0 = only sides too short to fit)");
   table.Value("edge-on-cos", &o->edge_on_sides.max_cos, 0.0, 1.0,
               "a real side along which the reference photo's rays meet M at |cos| below this "
-              "(0.25: within 14.5 degrees of the surface) is placed from the other photo that "
+              "(0.5: within 30 degrees of the surface) is placed from the other photo that "
               "sees M there most squarely (0: every side from the reference photo)");
   table.Value("warp-max-slant-deg", &o->warp_max_slant_deg, 0.0, 45.0,
               "warp the page so that the boundary sides' lines in M' within this many degrees of "

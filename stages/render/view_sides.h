@@ -26,9 +26,10 @@ struct SideFit;  // render.h, which holds these options
 struct EdgeOnSideOptions {
   // A real side is edge-on when the median |cos| of the angle between the
   // reference's rays along it and M's normal where they meet M is below
-  // this (0.25: the rays within 14.5° of the surface). 0: every side from
+  // this (0.5: the rays within 30° of the surface, where a depth error of M
+  // moves the side along the page by 1.7 times as much). 0: every side from
   // the reference photo.
-  double max_cos = 0.25;
+  double max_cos = 0.5;
   // Another photo places the side when a depth error of M moves the points
   // its rays meet there (by tan of the angle between ray and normal, at its
   // median |cos|) at most 1 / `gain` as far as the reference's, from at
