@@ -125,9 +125,10 @@ std::array<SidePlacement, 4> PlaceEdgeOnSides(
       std::vector<double> cos;
       for (const auto& s : on_side[i]) cos.push_back(std::abs(s.cos));
       const double median = Median(cos);
-      const bool better = placed[i].view.empty() ? AlongSurface(median) * options.gain <=
-                                                       AlongSurface(*placed[i].reference_cos)
-                                                 : median > placed[i].view_cos;
+      const bool better = placed[i].view.empty()
+                              ? AlongSurface(*placed[i].reference_cos) - AlongSurface(median) >=
+                                    options.min_tan_saving
+                              : median > placed[i].view_cos;
       if (!better) continue;
       placed[i].view = view.camera.image;
       placed[i].view_cos = median;

@@ -30,11 +30,12 @@ struct EdgeOnSideOptions {
   // moves the side along the page by 1.7 times as much). 0: every side from
   // the reference photo.
   double max_cos = 0.5;
-  // Another photo places the side when a depth error of M moves the points
-  // its rays meet there (by tan of the angle between ray and normal, at its
-  // median |cos|) at most 1 / `gain` as far as the reference's, from at
-  // least `min_samples` outline pixels.
-  double gain = 2;
+  // A depth error d of M moves the point a ray meets along the page by d
+  // times tan of the angle between ray and normal (at the median |cos|).
+  // Another photo places the side when its tan is below the reference's by
+  // at least this much, from at least `min_samples` outline pixels: it must
+  // save more than its misregistration with M costs, about one d.
+  double min_tan_saving = 1.0;
   int min_samples = 60;
   // An outline sample belongs to the side whose line in M' lies within this
   // fraction of M's diagonal and every other side's line at least twice as
