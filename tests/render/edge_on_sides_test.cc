@@ -139,6 +139,23 @@ TEST(RenderEdgeOnSides, ASideTheReferenceSeesEdgeOnIsPlacedFromAPhotoThatSeesItS
   EXPECT_TRUE(before.sides[1].placed_by.empty());
   EXPECT_LT(std::abs(r.crop_x1 - kPageW), std::abs(before.crop_x1 - kPageW));
 
+  // A photo beside the reference camera sees the curl as edge-on as it does:
+  // it would save less than one depth error along the page, so the side
+  // stays the reference's.
+  render::ViewMask beside;
+  beside.camera = LookingAt(Eigen::Vector3d(0.03, 0, 0), end);
+  beside.camera.image = "view_02.png";
+  beside.mask = RasterizeMesh(beside.camera, truth.mesh3d, truth.grid.Triangles()).face >= 0;
+  const auto from_beside = render::PlaceEdgeOnSides(in.meshes, in.camera, lookup, in.boundary,
+                                                    sides, {beside}, flat_diagonal, options);
+  EXPECT_TRUE(from_beside[1].view.empty()) << from_beside[1].view_cos;
+  render::EdgeOnSideOptions any_saving = options;  // the photo does see the side
+  any_saving.min_tan_saving = -HUGE_VAL;
+  EXPECT_EQ(render::PlaceEdgeOnSides(in.meshes, in.camera, lookup, in.boundary, sides, {beside},
+                                     flat_diagonal, any_saving)[1]
+                .view,
+            "view_02.png");
+
   // No other photo: every side from the reference.
   in.views.clear();
   const auto alone = render::PlaceEdgeOnSides(in.meshes, in.camera, lookup, in.boundary, sides,
