@@ -1,6 +1,6 @@
 // The Snakemake workflow (workflow/Snakefile) on a real single-node Slurm
-// cluster started for the test: two samples and a data set with a broken
-// photo submitted through the Slurm profile, each data set one Slurm job.
+// cluster started for the test: a sample and a data set with a broken photo
+// submitted through the Slurm profile, each data set one Slurm job.
 #include <gtest/gtest.h>
 
 #include <opencv2/core.hpp>
@@ -33,9 +33,10 @@ TEST(Workflow, SlurmRunsEachDataSetAsAJob) {
   if (RunCommand("command -v snakemake > /dev/null").exit_code != 0)
     GTEST_SKIP() << "snakemake is missing (Debian: snakemake)";
 
-  // The samples' images only (no ground truth: no evaluate, a shorter run),
-  // so their results must equal the e2e run's of the same photos.
-  const std::vector<std::string> samples = {"set03", "set07"};
+  // A sample's images only (no ground truth: no evaluate, a shorter run), so
+  // its result must equal the e2e run's of the same photos. One sample: each
+  // more is another whole pipeline run in CI's half hour.
+  const std::vector<std::string> samples = {"set07"};
   std::string sets;
   for (const std::string& s : samples) {
     fs::create_directories(dir / "sets" / s);
