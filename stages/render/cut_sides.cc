@@ -84,6 +84,9 @@ struct BorderScan {
   std::vector<Eigen::Vector3d> dir3;
   std::vector<Eigen::Vector2d> dir2;
   std::vector<char> view_crossed;  // per view: it saw the edge at least once
+  // Per view: its crossings, and the |cos| between its ray and the
+  // continued surface's normal at each.
+  std::vector<std::vector<double>> view_crossings, view_cos;
 };
 
 // Continues the surface out from every column of `border` (its inner
@@ -105,12 +108,19 @@ BorderScan ScanBorder(const MeshPair& meshes, const std::vector<Eigen::Vector2d>
   dir3.assign(border.vertex.size(), Eigen::Vector3d::Zero());
   dir2.assign(border.vertex.size(), Eigen::Vector2d::Zero());
   view_crossed.assign(views.size(), 0);
+  scan.view_crossings.assign(views.size(), {});
+  scan.view_cos.assign(views.size(), {});
   for (size_t k = 0; k < border.vertex.size(); ++k) {
     const int vb = border.vertex[k], vi = border.inner[k];
     const Eigen::Vector3d d3 = (meshes.mesh3d[vb] - meshes.mesh3d[vi]) / depth;
     const Eigen::Vector2d d2 = (flat[vb] - flat[vi]) / depth;
     const double speed = n.dot(d2);  // outward M' distance per step of t
     if (!(speed > 0)) continue;
+    // The continued surface's normal: across the border and along it.
+    const Eigen::Vector3d along =
+        meshes.mesh3d[border.vertex[std::min(k + 1, border.vertex.size() - 1)]] -
+        meshes.mesh3d[border.vertex[k > 0 ? k - 1 : 0]];
+    const Eigen::Vector3d normal = d3.cross(along).normalized();
     dir3[k] = d3;
     dir2[k] = d2;
     const double dt = extent / (kStepsPerExtent * speed);
@@ -151,6 +161,10 @@ BorderScan ScanBorder(const MeshPair& meshes, const std::vector<Eigen::Vector2d>
           const Eigen::Vector2d q = flat[vb] + (j - 0.5) * dt * d2;
           crossings.push_back(vertical_axis ? q.y() : q.x());
           view_crossed[v] = 1;
+          const Eigen::Vector3d ray =
+              (meshes.mesh3d[vb] + (j - 0.5) * dt * d3 - view.camera.Center()).normalized();
+          scan.view_crossings[v].push_back(crossings.back());
+          scan.view_cos[v].push_back(std::abs(normal.dot(ray)));
           last_page = 0;  // the edge says more than a lower bound
           break;
         }
@@ -201,6 +215,37 @@ void BuildStrip(const MeshPair& meshes, const std::vector<Eigen::Vector2d>& flat
   }
 }
 
+// CutSideOptions::squarest_view: edge->bound from the view whose rays meet
+// the continued surface most squarely where they cross the page edge, or
+// from views[0]'s (the reference's) where that view's bound lies too far
+// from it. False when views[0] has too few crossings.
+bool SquarestViewBound(const BorderScan& scan, const std::vector<ViewMask>& views, double extent,
+                       const CutSideOptions& options, CutSideEdge* edge) {
+  const auto& crossings = scan.view_crossings;
+  if (crossings.empty() || int(crossings[0].size()) < options.min_crossings) return false;
+  auto tan_of = [](double cos) { return std::sqrt(std::max(0.0, 1 - cos * cos)) / cos; };
+  const double reference_bound = Median(crossings[0]);
+  int best = 0;
+  double best_cos = Median(scan.view_cos[0]);
+  for (size_t v = 1; v < crossings.size(); ++v) {
+    // A view that sees the edge along less than half of what the
+    // reference sees of it gives the median of another stretch of the side.
+    if (int(crossings[v].size()) < std::max(options.min_crossings, int(crossings[0].size()) / 2))
+      continue;
+    const double cos = Median(scan.view_cos[v]);
+    if (!(tan_of(cos) < tan_of(best_cos))) continue;
+    if (std::abs(Median(crossings[v]) - reference_bound) > options.max_view_disagreement * extent)
+      continue;
+    best = int(v);
+    best_cos = cos;
+  }
+  edge->bound = Median(crossings[size_t(best)]);
+  edge->edge_seen = true;
+  if (best > 0) edge->placed_by = views[size_t(best)].camera.image;
+  edge->placed_by_cos = best_cos;
+  return true;
+}
+
 }  // namespace
 
 std::array<CutSideEdge, 4> FindCutSideEdges(const MeshPair& meshes,
@@ -234,7 +279,15 @@ std::array<CutSideEdge, 4> FindCutSideEdges(const MeshPair& meshes,
     edge.crossings = int(crossings.size());
     edge.columns_seen = int(seen_page.size());
     edge.views = int(std::count(scan.view_crossed.begin(), scan.view_crossed.end(), 1));
-    if (edge.crossings >= options.min_crossings) {
+    if (options.squarest_view) {
+      if (!SquarestViewBound(scan, views, extent, options, &edge)) {
+        edge.note =
+            "the reference's own outline does not cross the continued surface (" +
+            std::to_string(scan.view_crossings.empty() ? 0 : scan.view_crossings[0].size()) +
+            " crossings; " + std::to_string(options.min_crossings) + " needed)";
+        continue;
+      }
+    } else if (edge.crossings >= options.min_crossings) {
       edge.bound = Median(crossings);
       edge.edge_seen = true;
     } else if (edge.columns_seen >= options.min_crossings) {

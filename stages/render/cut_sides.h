@@ -61,6 +61,16 @@ struct CutSideOptions {
   // Rows of the strip that run back over the mesh, as far as the inner
   // vertex of base_fraction.
   int band_rows = 8;
+  // When set, views[0] is the reference's own outline (a real side M stops
+  // short of) and the bound is the crossings' median in one view: the one
+  // whose rays meet the continued surface most squarely (a depth error d of
+  // the continuation moves a crossing by d times tan of that angle), as long
+  // as it sees the edge along at least half as many border columns as the
+  // reference and its bound lies within max_view_disagreement of the page's
+  // extent of the reference's; farther apart, the straight continuation does not
+  // follow the page (a crease past M's border), and the reference's stands.
+  bool squarest_view = false;
+  double max_view_disagreement = 0.015;
 };
 
 // How another view's texture was moved onto the reference's.
@@ -103,6 +113,11 @@ struct CutSideEdge {
   int crossings = 0;     // border columns (in all views) that saw the edge
   int columns_seen = 0;  // border columns some view sees page past
   int views = 0;         // views with at least one crossing
+  // With CutSideOptions::squarest_view: the photo whose crossings placed
+  // the bound (empty: views[0], the reference), and the median |cos| of its
+  // rays there.
+  std::string placed_by;
+  double placed_by_cos = 0;
   std::string note;      // why it was not measured
   ExtensionStrip strip;  // when measured and extension > 0
 };

@@ -177,8 +177,14 @@ std::vector<ViewMask> ReachRealSides(const RenderOptions& options, const RenderI
                          in.boundary.file,
                          in.reference_file,
                          {}});
+    // The reference's outline first; the other photos' masks may place
+    // the side where they see it more squarely.
+    std::vector<ViewMask> views = self_view;
+    views.insert(views.end(), in.views.begin(), in.views.end());
+    CutSideOptions reach = options.cut_sides;
+    reach.squarest_view = true;
     const std::array<CutSideEdge, 4> reached =
-        FindCutSideEdges(in.meshes, flat, visible, short_side, self_view, options.cut_sides);
+        FindCutSideEdges(in.meshes, flat, visible, short_side, views, reach);
     for (int i = 0; i < 4; ++i) {
       if (!short_side[i]) continue;
       const CutSideEdge& e = reached[i];
@@ -202,7 +208,10 @@ std::vector<ViewMask> ReachRealSides(const RenderOptions& options, const RenderI
       const double axis_extent = i % 2 == 0 ? visible[3] - visible[1] : visible[2] - visible[0];
       Log(std::string(kSideNames[i]) + " side lies past M's border: M continued by " +
           Fixed(100 * e.extension / axis_extent, 1) + " % of the page to reach it (" +
-          std::to_string(e.crossings) + " columns)");
+          (e.placed_by.empty() ? std::string("where the reference's outline crosses it")
+                               : "where " + e.placed_by + "'s page edge crosses it, at |cos| " +
+                                     Fixed(e.placed_by_cos, 2)) +
+          ")");
     }
   }
   return self_view;

@@ -145,9 +145,12 @@ Json RenderReport(const RenderOptions& options, const RenderInputs& in, const Re
     }
     if (!s.note.empty()) j["note"] = s.note;
     if (s.scattered) j["median_bound"] = s.median_bound;
-    if (const CutSideEdge& e = r.reached_sides[i]; e.measured)
+    if (const CutSideEdge& e = r.reached_sides[i]; e.measured) {
       j["reached_past_mesh"] = {
           {"bound", e.bound}, {"extension", e.extension}, {"crossings", e.crossings}};
+      if (!e.placed_by.empty())
+        j["reached_past_mesh"]["placed_by"] = {{"view", e.placed_by}, {"cos", e.placed_by_cos}};
+    }
     if (!s.real && options.extend_cut_sides) {
       const CutSideEdge& e = r.cut_edges[i];
       Json c = {{"measured", e.measured},

@@ -6,6 +6,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <cstdio>
 
 #include "common/raster.h"
 #include "stages/render/crop.h"
@@ -161,6 +162,67 @@ TEST(RenderEdgeOnSides, ASideTheReferenceSeesEdgeOnIsPlacedFromAPhotoThatSeesItS
   const auto alone = render::PlaceEdgeOnSides(in.meshes, in.camera, lookup, in.boundary, sides,
                                               in.views, flat_diagonal, options);
   for (const auto& p : alone) EXPECT_TRUE(p.view.empty());
+}
+
+// M that stops short of the curled end (a blank margin without points):
+// render continues it straight past its border to where the page edge
+// crosses it. The reference's grazing rays cross that continuation far from
+// the true end; a photo that sees the end squarely crosses it near there.
+TEST(RenderEdgeOnSides, AReachedSideIsPlacedWhereTheSquarestPhotoSeesItsEdge) {
+  const double radius = kHalf / (M_PI / 2);
+  const MeshPair truth = CurledPage(radius, 0);
+  SceneOptions o;
+  o.page_w = kPageW;
+  o.page_h = kPageH;
+  o.radius = radius;
+  const SyntheticScene scene = MakeScene(o);
+  ASSERT_TRUE(scene.real[1]);
+  render::RenderInputs in = InputsOf(scene);
+  in.meshes = CurledPage(radius, -0.08 * kPageW);  // M ends 8 % of the page short
+  const Eigen::Vector3d end = truth.mesh3d[truth.grid.Index(28, 60)];
+  render::ViewMask view;
+  view.camera = LookingAt(end + Eigen::Vector3d(-0.7, 0, -0.35), end);
+  view.mask = RasterizeMesh(view.camera, truth.mesh3d, truth.grid.Triangles()).face >= 0;
+
+  const render::RenderResult alone = render::Run({}, in);
+  ASSERT_TRUE(alone.reached_sides[1].measured);
+  EXPECT_TRUE(alone.reached_sides[1].placed_by.empty());
+  const double off_alone = std::abs(alone.crop_x1 - kPageW);
+  EXPECT_GT(off_alone, 0.02 * kPageW);
+
+  // Here the photo's crossings lie 3.5 % of the page from the reference's:
+  // more than the default allows (a straight continuation that no longer
+  // follows the page), so the reference's stand.
+  in.views = {view};
+  const render::RenderResult guarded = render::Run({}, in);
+  EXPECT_TRUE(guarded.reached_sides[1].placed_by.empty());
+  EXPECT_NEAR(guarded.crop_x1, alone.crop_x1, 1 / alone.pixels_per_unit);
+
+  // Allowed that far, the photo places the side near the true end.
+  render::RenderOptions wide;
+  wide.cut_sides.max_view_disagreement = 0.05;
+  const render::RenderResult r = render::Run(wide, in);
+  ASSERT_TRUE(r.reached_sides[1].measured);
+  EXPECT_EQ(r.reached_sides[1].placed_by, "view_01.png");
+  EXPECT_GT(r.reached_sides[1].placed_by_cos, 0.9);
+  const double off = std::abs(r.crop_x1 - kPageW);
+  std::printf(
+      "[render] reached right side: crop %.4f from the reference, %.4f from view_01 (true edge "
+      "%.4f)\n",
+      alone.crop_x1, r.crop_x1, kPageW);
+  EXPECT_LT(off, 0.25 * off_alone);
+
+  // A photo whose page edge lies much farther out on the continuation (its
+  // mask runs a tenth of the page past the edge) is not taken even then.
+  render::ViewMask far_off = view;
+  far_off.mask =
+      RasterizeMesh(view.camera, CurledPage(radius, 0.1 * kPageW).mesh3d, truth.grid.Triangles())
+          .face >= 0;
+  in.views = {far_off};
+  const render::RenderResult kept = render::Run(wide, in);
+  ASSERT_TRUE(kept.reached_sides[1].measured);
+  EXPECT_TRUE(kept.reached_sides[1].placed_by.empty());
+  EXPECT_NEAR(kept.crop_x1, alone.crop_x1, 1 / alone.pixels_per_unit);
 }
 
 }  // namespace
