@@ -106,6 +106,44 @@ Json StraighteningJson(const RenderOptions& options, const RenderResult& r) {
           {"columns", pass(r.straightened_columns)}};
 }
 
+// Side i of render.json's "sides": its line, how it was placed or reached,
+// and the page edge past it where the reference image cuts it.
+Json SideReport(const RenderOptions& options, const RenderResult& r, int i) {
+  const SideFit& s = r.sides[i];
+  Json j = {{"real", s.real}, {"used", s.used}, {"samples", s.samples}, {"mapped", s.mapped}};
+  if (s.used) {
+    j["point"] = Vec2(s.point);
+    j["direction"] = Vec2(s.direction);
+    j["rms"] = s.rms;
+    j["warped"] = r.warped_sides[i];
+    if (s.reference_cos) j["reference_cos"] = *s.reference_cos;
+    if (!s.placed_by.empty()) j["placed_by"] = {{"view", s.placed_by}, {"cos", s.placed_by_cos}};
+  }
+  if (!s.note.empty()) j["note"] = s.note;
+  if (s.scattered) j["median_bound"] = s.median_bound;
+  if (const CutSideEdge& e = r.reached_sides[i]; e.measured) {
+    j["reached_past_mesh"] = {
+        {"bound", e.bound}, {"extension", e.extension}, {"crossings", e.crossings}};
+    if (!e.placed_by.empty())
+      j["reached_past_mesh"]["placed_by"] = {{"view", e.placed_by}, {"cos", e.placed_by_cos}};
+  }
+  if (!s.real && options.extend_cut_sides) {
+    const CutSideEdge& e = r.cut_edges[i];
+    Json c = {{"measured", e.measured},
+              {"edge_seen", e.edge_seen},
+              {"crossings", e.crossings},
+              {"columns_seen", e.columns_seen},
+              {"views", e.views}};
+    if (e.measured) {
+      c["bound"] = e.bound;
+      c["extension"] = e.extension;
+    }
+    if (!e.note.empty()) c["note"] = e.note;
+    j["page_edge_in_other_views"] = c;
+  }
+  return j;
+}
+
 }  // namespace
 
 Json RenderReport(const RenderOptions& options, const RenderInputs& in, const RenderResult& r,
@@ -132,41 +170,7 @@ Json RenderReport(const RenderOptions& options, const RenderInputs& in, const Re
   if (std::find(w.begin(), w.end(), true) != w.end())
     doc["crop"]["warp_box"] = {r.warp_box[0], r.warp_box[1], r.warp_box[2], r.warp_box[3]};
   Json sides = Json::object();
-  for (int i = 0; i < 4; ++i) {
-    const SideFit& s = r.sides[i];
-    Json j = {{"real", s.real}, {"used", s.used}, {"samples", s.samples}, {"mapped", s.mapped}};
-    if (s.used) {
-      j["point"] = Vec2(s.point);
-      j["direction"] = Vec2(s.direction);
-      j["rms"] = s.rms;
-      j["warped"] = r.warped_sides[i];
-      if (s.reference_cos) j["reference_cos"] = *s.reference_cos;
-      if (!s.placed_by.empty()) j["placed_by"] = {{"view", s.placed_by}, {"cos", s.placed_by_cos}};
-    }
-    if (!s.note.empty()) j["note"] = s.note;
-    if (s.scattered) j["median_bound"] = s.median_bound;
-    if (const CutSideEdge& e = r.reached_sides[i]; e.measured) {
-      j["reached_past_mesh"] = {
-          {"bound", e.bound}, {"extension", e.extension}, {"crossings", e.crossings}};
-      if (!e.placed_by.empty())
-        j["reached_past_mesh"]["placed_by"] = {{"view", e.placed_by}, {"cos", e.placed_by_cos}};
-    }
-    if (!s.real && options.extend_cut_sides) {
-      const CutSideEdge& e = r.cut_edges[i];
-      Json c = {{"measured", e.measured},
-                {"edge_seen", e.edge_seen},
-                {"crossings", e.crossings},
-                {"columns_seen", e.columns_seen},
-                {"views", e.views}};
-      if (e.measured) {
-        c["bound"] = e.bound;
-        c["extension"] = e.extension;
-      }
-      if (!e.note.empty()) c["note"] = e.note;
-      j["page_edge_in_other_views"] = c;
-    }
-    sides[kSideNames[i]] = j;
-  }
+  for (int i = 0; i < 4; ++i) sides[kSideNames[i]] = SideReport(options, r, i);
   doc["sides"] = sides;
   if (const PageFormatFit& f = r.page_format;
       options.page_aspect > 0 && (f.axis >= 0 || !f.note.empty())) {
