@@ -73,28 +73,40 @@ render::SideFit ReferenceSide(const MeshPair& mesh, const PinholeCamera& camera,
   return render::FitSideLine(i, true, flat, samples);
 }
 
-TEST(RenderEdgeOnSides, ASideTheReferenceSeesEdgeOnIsPlacedFromAPhotoThatSeesItSquarely) {
-  // The truth: the curl turns through 90° (radius = half the page / (pi/2)).
-  const double radius = kHalf / (M_PI / 2);
-  const MeshPair truth = CurledPage(radius, 0);
+// The curl turns through 90° (radius = half the page / (pi/2)).
+constexpr double kRadius = kHalf / (M_PI / 2);
+
+// MakeScene's photo and outline of the true curled page.
+SyntheticScene CurledScene() {
   SceneOptions o;
   o.page_w = kPageW;
   o.page_h = kPageH;
-  o.radius = radius;
-  const SyntheticScene scene = MakeScene(o);  // its photo and outline: the true page
+  o.radius = kRadius;
+  return MakeScene(o);
+}
+
+// A photo that looks at the curled end, whose print faces the page's left
+// half, from above that half; its mask is where `page` covers its pixels.
+render::ViewMask EndOnView(const MeshPair& page) {
+  const MeshPair truth = CurledPage(kRadius, 0);
+  const Eigen::Vector3d end = truth.mesh3d[truth.grid.Index(28, 60)];
+  render::ViewMask view;
+  view.camera = LookingAt(end + Eigen::Vector3d(-0.7, 0, -0.35), end);
+  view.mask = RasterizeMesh(view.camera, page.mesh3d, page.grid.Triangles()).face >= 0;
+  return view;
+}
+
+TEST(RenderEdgeOnSides, ASideTheReferenceSeesEdgeOnIsPlacedFromAPhotoThatSeesItSquarely) {
+  const MeshPair truth = CurledPage(kRadius, 0);
+  const SyntheticScene scene = CurledScene();
   ASSERT_TRUE(scene.real[1]);
   render::RenderInputs in = InputsOf(scene);
   // M: the curl 2 mm (of a 420 mm page) too far out at the edge, running 5 %
   // of the page past it.
-  in.meshes = CurledPage(radius, 0.05 * kPageW, 0.002);
+  in.meshes = CurledPage(kRadius, 0.05 * kPageW, 0.002);
 
-  // The other photo looks at the curled end, whose print faces the page's
-  // left half, from above that half.
   const Eigen::Vector3d end = truth.mesh3d[truth.grid.Index(28, 60)];
-  render::ViewMask view;
-  view.camera = LookingAt(end + Eigen::Vector3d(-0.7, 0, -0.35), end);
-  const RasterResult raster = RasterizeMesh(view.camera, truth.mesh3d, truth.grid.Triangles());
-  view.mask = raster.face >= 0;
+  const render::ViewMask view = EndOnView(truth);
   ASSERT_GT(cv::countNonZero(view.mask), 10000);
   in.views = {view};
 
@@ -169,20 +181,11 @@ TEST(RenderEdgeOnSides, ASideTheReferenceSeesEdgeOnIsPlacedFromAPhotoThatSeesItS
 // crosses it. The reference's grazing rays cross that continuation far from
 // the true end; a photo that sees the end squarely crosses it near there.
 TEST(RenderEdgeOnSides, AReachedSideIsPlacedWhereTheSquarestPhotoSeesItsEdge) {
-  const double radius = kHalf / (M_PI / 2);
-  const MeshPair truth = CurledPage(radius, 0);
-  SceneOptions o;
-  o.page_w = kPageW;
-  o.page_h = kPageH;
-  o.radius = radius;
-  const SyntheticScene scene = MakeScene(o);
+  const SyntheticScene scene = CurledScene();
   ASSERT_TRUE(scene.real[1]);
   render::RenderInputs in = InputsOf(scene);
-  in.meshes = CurledPage(radius, -0.08 * kPageW);  // M ends 8 % of the page short
-  const Eigen::Vector3d end = truth.mesh3d[truth.grid.Index(28, 60)];
-  render::ViewMask view;
-  view.camera = LookingAt(end + Eigen::Vector3d(-0.7, 0, -0.35), end);
-  view.mask = RasterizeMesh(view.camera, truth.mesh3d, truth.grid.Triangles()).face >= 0;
+  in.meshes = CurledPage(kRadius, -0.08 * kPageW);  // M ends 8 % of the page short
+  const render::ViewMask view = EndOnView(CurledPage(kRadius, 0));
 
   const render::RenderResult alone = render::Run({}, in);
   ASSERT_TRUE(alone.reached_sides[1].measured);
@@ -214,11 +217,7 @@ TEST(RenderEdgeOnSides, AReachedSideIsPlacedWhereTheSquarestPhotoSeesItsEdge) {
 
   // A photo whose page edge lies much farther out on the continuation (its
   // mask runs a tenth of the page past the edge) is not taken even then.
-  render::ViewMask far_off = view;
-  far_off.mask =
-      RasterizeMesh(view.camera, CurledPage(radius, 0.1 * kPageW).mesh3d, truth.grid.Triangles())
-          .face >= 0;
-  in.views = {far_off};
+  in.views = {EndOnView(CurledPage(kRadius, 0.1 * kPageW))};
   const render::RenderResult kept = render::Run(wide, in);
   ASSERT_TRUE(kept.reached_sides[1].measured);
   EXPECT_TRUE(kept.reached_sides[1].placed_by.empty());
