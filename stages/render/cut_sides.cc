@@ -83,7 +83,6 @@ struct BorderScan {
   // Per border column: the continuation's direction (per step of t).
   std::vector<Eigen::Vector3d> dir3;
   std::vector<Eigen::Vector2d> dir2;
-  std::vector<char> view_crossed;  // per view: it saw the edge at least once
   // Per view: its crossings, and the |cos| between its ray and the
   // continued surface's normal at each.
   std::vector<std::vector<double>> view_crossings, view_cos;
@@ -104,10 +103,8 @@ BorderScan ScanBorder(const MeshPair& meshes, const std::vector<Eigen::Vector2d>
   std::vector<double>& seen_page = scan.seen_page;
   std::vector<Eigen::Vector3d>& dir3 = scan.dir3;
   std::vector<Eigen::Vector2d>& dir2 = scan.dir2;
-  std::vector<char>& view_crossed = scan.view_crossed;
   dir3.assign(border.vertex.size(), Eigen::Vector3d::Zero());
   dir2.assign(border.vertex.size(), Eigen::Vector2d::Zero());
-  view_crossed.assign(views.size(), 0);
   scan.view_crossings.assign(views.size(), {});
   scan.view_cos.assign(views.size(), {});
   for (size_t k = 0; k < border.vertex.size(); ++k) {
@@ -160,7 +157,6 @@ BorderScan ScanBorder(const MeshPair& meshes, const std::vector<Eigen::Vector2d>
         if (ahead == 0 && (px_ahead - px).norm() >= options.confirm_px) {
           const Eigen::Vector2d q = flat[vb] + (j - 0.5) * dt * d2;
           crossings.push_back(vertical_axis ? q.y() : q.x());
-          view_crossed[v] = 1;
           const Eigen::Vector3d ray =
               (meshes.mesh3d[vb] + (j - 0.5) * dt * d3 - view.camera.Center()).normalized();
           scan.view_crossings[v].push_back(crossings.back());
@@ -223,7 +219,6 @@ bool SquarestViewBound(const BorderScan& scan, const std::vector<ViewMask>& view
                        const CutSideOptions& options, CutSideEdge* edge) {
   const auto& crossings = scan.view_crossings;
   if (crossings.empty() || int(crossings[0].size()) < options.min_crossings) return false;
-  auto tan_of = [](double cos) { return std::sqrt(std::max(0.0, 1 - cos * cos)) / cos; };
   const double reference_bound = Median(crossings[0]);
   int best = 0;
   double best_cos = Median(scan.view_cos[0]);
@@ -233,7 +228,7 @@ bool SquarestViewBound(const BorderScan& scan, const std::vector<ViewMask>& view
     if (int(crossings[v].size()) < std::max(options.min_crossings, int(crossings[0].size()) / 2))
       continue;
     const double cos = Median(scan.view_cos[v]);
-    if (!(tan_of(cos) < tan_of(best_cos))) continue;
+    if (!(AlongSurface(cos) < AlongSurface(best_cos))) continue;
     if (std::abs(Median(crossings[v]) - reference_bound) > options.max_view_disagreement * extent)
       continue;
     best = int(v);
@@ -247,6 +242,8 @@ bool SquarestViewBound(const BorderScan& scan, const std::vector<ViewMask>& view
 }
 
 }  // namespace
+
+double AlongSurface(double c) { return std::sqrt(std::max(0.0, 1 - c * c)) / std::max(c, 1e-9); }
 
 std::array<CutSideEdge, 4> FindCutSideEdges(const MeshPair& meshes,
                                             const std::vector<Eigen::Vector2d>& flat,
@@ -278,7 +275,8 @@ std::array<CutSideEdge, 4> FindCutSideEdges(const MeshPair& meshes,
     const std::vector<double>& seen_page = scan.seen_page;
     edge.crossings = int(crossings.size());
     edge.columns_seen = int(seen_page.size());
-    edge.views = int(std::count(scan.view_crossed.begin(), scan.view_crossed.end(), 1));
+    edge.views = int(std::count_if(scan.view_crossings.begin(), scan.view_crossings.end(),
+                                   [](const auto& c) { return !c.empty(); }));
     if (options.squarest_view) {
       if (!SquarestViewBound(scan, views, extent, options, &edge)) {
         edge.note =

@@ -122,6 +122,10 @@ struct CutSideEdge {
   ExtensionStrip strip;  // when measured and extension > 0
 };
 
+// How far along the surface a unit error in M's depth moves the point a ray
+// meets, at |cos| `c` between ray and normal: tan of the angle.
+double AlongSurface(double c);
+
 // For each side i (0 top, 1 right, 2 bottom, 3 left of M' turned as
 // `flat`) with cut[i] set: the page edge past that side of the mesh, seen in
 // `views`. `flat` is M' after render's deskew turn, `visible_box` (x0 y0 x1

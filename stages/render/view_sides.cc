@@ -36,10 +36,6 @@ double FacingSign(const MeshPair& mesh, const PinholeCamera& camera) {
   return Median(cos) < 0 ? -1.0 : 1.0;
 }
 
-// How far along the surface a unit error in M's depth moves the point a ray
-// meets, at |cos| `c` between ray and normal: tan of the angle.
-double AlongSurface(double c) { return std::sqrt(std::max(0.0, 1 - c * c)) / std::max(c, 1e-9); }
-
 double DistanceToLine(const SideFit& side, const Eigen::Vector2d& p) {
   const Eigen::Vector2d normal(-side.direction.y(), side.direction.x());
   return std::abs(normal.dot(p - side.point));
