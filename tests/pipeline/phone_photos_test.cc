@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 
@@ -80,36 +81,42 @@ class PhonePhotos : public ::testing::Test {
   std::string output_;
 };
 
-// EXIF-tagged portrait photos named as phones and apps name them, in
+// Straight from a phone: EXIF-tagged portrait photos and HEIC ones beside
+// an iPhone's sidecar file, named as phones and apps name them, in
 // "My Scans/lettre é 1", run from inside its images/ folder with DATA=..
-TEST_F(PhonePhotos, ExifTaggedPortraitPhotosWithSpacedNamesAndDataDotDot) {
+// (Each case is a whole pipeline run, about a minute of CI: the awkward
+// properties share two data sets instead of having one each.)
+TEST_F(PhonePhotos, PortraitAndHeicPhotosWithASidecarSpacedNamesAndDataDotDot) {
   PhoneChanges c;
-  c.exif_portrait = {0, 1, 2, 3, 4};
+  c.exif_portrait = {0, 1, 2};
+  c.heic = {3, 4};
+  c.sidecar = true;
   c.spaced_names = true;
   const fs::path set = tmp_ / "My Scans" / "lettre é 1";
   EXPECT_GT(Run(c, set, set / "images", "..", "lettre_é_1"), own_ - kTolerance) << output_;
+  EXPECT_TRUE(Said("left out: IMG_0001.AAE (not a photo)")) << output_;
   EXPECT_TRUE(fs::exists(tmp_ / "work/lettre_é_1/60_render/rectified.png"));
   const Json cameras = ReadJsonFile(tmp_ / "work/lettre_é_1/10_sfm/cameras.json");
-  EXPECT_EQ(cameras.at("views").at(0).at("width").get<int>(), 1200) << "upright: portrait";
-  EXPECT_GT(cameras.at("colmap").at("cameras").at(0).at("focal_prior_px").get<double>(), 0);
+  std::map<std::string, int> width;
+  for (const Json& view : cameras.at("views")) width[view.at("image")] = view.at("width");
+  EXPECT_EQ(width.size(), 5u) << "every photo read, HEIC too";
+  EXPECT_EQ(width["IMG 0003 (copie).jpg"], 1200) << "upright: portrait";
+  EXPECT_EQ(width["naïve ñ 5.heic"], 1600) << "HEIC, untagged: landscape";
+  double focal_prior = 0;
+  for (const Json& camera : cameras.at("colmap").at("cameras"))
+    focal_prior = std::max(focal_prior, camera.at("focal_prior_px").get<double>());
+  EXPECT_GT(focal_prior, 0) << "the EXIF focal length is COLMAP's prior";
 }
 
-TEST_F(PhonePhotos, TurnedPhotosAndOneAtHalfSize) {
+// Photos turned in their pixels (no tag), one of them from a 48-megapixel
+// phone, one at half size, and one damaged by an interrupted copy: the
+// damaged photo is left out, by name, and the pipeline goes on with the
+// other four; run with DATA=. from the set's folder.
+TEST_F(PhonePhotos, TurnedPhotosOneFromA48MegapixelPhoneOneAtHalfSizeOneTruncated) {
   PhoneChanges c;
   c.turned = {1, 3};
+  c.scale[3] = 5;  // 8000 x 6000, then turned
   c.scale[4] = 0.5;
-  const fs::path set = tmp_ / "mixed";
-  EXPECT_GT(Run(c, set, tmp_.path(), set.string(), "mixed"), own_ - kTolerance) << output_;
-  const Json cameras = ReadJsonFile(tmp_ / "work/mixed/10_sfm/cameras.json");
-  EXPECT_EQ(cameras.at("colmap").at("cameras").size(), 2u) << "the turned ones share a camera";
-}
-
-// One photo from a 48-megapixel phone and one damaged by an interrupted
-// copy: the damaged photo is left out, by name, and the pipeline goes on
-// with the other four; run with DATA=. from the set's folder.
-TEST_F(PhonePhotos, OnePhotoFromA48MegapixelPhoneOneTruncatedAndDataDot) {
-  PhoneChanges c;
-  c.scale[3] = 5;  // 8000 x 6000
   c.truncated = {0};
   const fs::path set = tmp_ / "letter1";
   const double ms_ssim = Run(c, set, set, ".", "letter1");
@@ -118,15 +125,10 @@ TEST_F(PhonePhotos, OnePhotoFromA48MegapixelPhoneOneTruncatedAndDataDot) {
   const Json cameras = ReadJsonFile(tmp_ / "work/letter1/10_sfm/cameras.json");
   EXPECT_EQ(cameras.at("views").size(), 4u);
   EXPECT_EQ(cameras.at("left_out").at(0).at("image"), "view_00.jpg");
-}
-
-TEST_F(PhonePhotos, HeicPhotosAndASidecarFile) {
-  PhoneChanges c;
-  c.heic = {0, 1, 2, 3, 4};
-  c.sidecar = true;
-  const fs::path set = tmp_ / "iphone";
-  EXPECT_GT(Run(c, set, tmp_.path(), set.string(), "iphone"), own_ - kTolerance) << output_;
-  EXPECT_TRUE(Said("left out: IMG_0001.AAE (not a photo)")) << output_;
+  // The turned photos, the large one among them, are copied for COLMAP at
+  // one size and share a camera with the untouched one; the small one has
+  // its own.
+  EXPECT_EQ(cameras.at("colmap").at("cameras").size(), 2u);
 }
 
 }  // namespace
