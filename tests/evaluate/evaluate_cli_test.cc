@@ -40,11 +40,6 @@ std::string Evaluate(const std::string& args) {
   return Quote(StageBinary("evaluate").string()) + " " + args;
 }
 
-Json ReadJson(const fs::path& p) {
-  std::ifstream in(p);
-  return Json::parse(in);
-}
-
 class EvaluateCli : public ::testing::Test {
  protected:
   TempDir dir;
@@ -70,7 +65,7 @@ class EvaluateCli : public ::testing::Test {
 TEST_F(EvaluateCli, IdenticalImageScoresPerfectlyAndValidates) {
   CommandResult r = RunCommand(Evaluate(Args(flat, "--method self")));
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  const Json m = ReadJson(out);
+  const Json m = ReadJsonFile(out);
   EXPECT_EQ(m["format"], "docunfold.metrics");
   EXPECT_EQ(m["method"], "self");
   EXPECT_NEAR(m["metrics"]["ms_ssim"].get<double>(), 1.0, 1e-12);
@@ -96,7 +91,7 @@ TEST_F(EvaluateCli, IdenticalImageScoresPerfectlyAndValidates) {
   // the cache and gets the same figures.
   r = RunCommand(Evaluate(Args(flat, "--no-flow")));
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  const Json again = ReadJson(out);
+  const Json again = ReadJsonFile(out);
   EXPECT_EQ(again["ocr"]["reference_from_cache"], true);
   EXPECT_EQ(again["metrics"]["cer"], m["metrics"]["cer"]);
   EXPECT_EQ(again["ocr"]["reference_chars"], m["ocr"]["reference_chars"]);
@@ -106,7 +101,7 @@ TEST_F(EvaluateCli, ShiftOfSixPixelsIsThreeAtTheFlowResolution) {
   const fs::path shifted = WriteMovedPage(cv::Matx23d(1, 0, 6, 0, 1, 0), "shifted.png");
   CommandResult r = RunCommand(Evaluate(Args(shifted, "--no-ocr")));
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  const Json j = ReadJson(out);
+  const Json j = ReadJsonFile(out);
   EXPECT_NEAR(j["metrics"]["ld"].get<double>(), 3.0, 0.3);
   EXPECT_LT(j["metrics"]["ms_ssim"].get<double>(), 0.9);
   EXPECT_TRUE(j["metrics"]["cer"].is_null());
@@ -121,7 +116,7 @@ TEST_F(EvaluateCli, RegisteredUndoesAShiftAndStretchButNotTheLiteratureFigure) {
   const fs::path moved = WriteMovedPage(cv::Matx23d(1, 0, 6, 0, 1.01, 0), "moved.png");
   CommandResult r = RunCommand(Evaluate(Args(moved, "--no-ocr --registered")));
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  const Json j = ReadJson(out);
+  const Json j = ReadJsonFile(out);
   EXPECT_LT(j["metrics"]["ms_ssim"].get<double>(), 0.9);
   EXPECT_GT(j["metrics"]["ms_ssim_registered"].get<double>(), 0.97) << j["registration"].dump();
   const Json& a = j["registration"]["result_from_truth"];  // in fractions of the page
@@ -136,8 +131,8 @@ TEST_F(EvaluateCli, RegisteredUndoesAShiftAndStretchButNotTheLiteratureFigure) {
   // Without the flag the figure is null and the block says why.
   r = RunCommand(Evaluate(Args(moved, "--no-ocr")));
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_TRUE(ReadJson(out)["metrics"]["ms_ssim_registered"].is_null());
-  EXPECT_EQ(ReadJson(out)["registration"]["skipped"], "no --registered");
+  EXPECT_TRUE(ReadJsonFile(out)["metrics"]["ms_ssim_registered"].is_null());
+  EXPECT_EQ(ReadJsonFile(out)["registration"]["skipped"], "no --registered");
 }
 
 TEST_F(EvaluateCli, OcrAtTruthSizeResizesTheResultFirst) {
@@ -148,7 +143,7 @@ TEST_F(EvaluateCli, OcrAtTruthSizeResizesTheResultFirst) {
   cv::imwrite((dir / "big.png").string(), big);
   CommandResult r = RunCommand(Evaluate(Args(dir / "big.png", "--no-flow --ocr-at-truth-size")));
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  const Json j = ReadJson(out);
+  const Json j = ReadJsonFile(out);
   EXPECT_EQ(j["ocr"]["result_ocr_size"], Json::array({880, 680}));
   EXPECT_EQ(j["producer"]["options"]["ocr_at_truth_size"], true);
   ASSERT_TRUE(j["metrics"]["cer"].is_number()) << j["ocr"].dump();
@@ -157,7 +152,7 @@ TEST_F(EvaluateCli, OcrAtTruthSizeResizesTheResultFirst) {
   // Without the flag the result is read at its own size.
   r = RunCommand(Evaluate(Args(dir / "big.png", "--no-flow")));
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_EQ(ReadJson(out)["ocr"]["result_ocr_size"], Json::array({1760, 1360}));
+  EXPECT_EQ(ReadJsonFile(out)["ocr"]["result_ocr_size"], Json::array({1760, 1360}));
 }
 
 TEST_F(EvaluateCli, MissingResultIsBadInputAndWritesNothing) {

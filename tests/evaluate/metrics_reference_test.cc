@@ -29,16 +29,11 @@ std::vector<std::string> ReferencePairs() {
   return names;
 }
 
-Json ReadJson(const fs::path& p) {
-  std::ifstream in(p);
-  return Json::parse(in);
-}
-
 class MetricsReference : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(MetricsReference, ReproducesMsSsimAndCer) {
   const fs::path pair = SharedDir() / "metrics-reference" / GetParam();
-  const Json expected = ReadJson(pair / "expected.json");
+  const Json expected = ReadJsonFile(pair / "expected.json");
   const fs::path flat = SharedDir() / expected["ground_truth_flat"].get<std::string>();
   ASSERT_EQ(flat.filename(), "flat.png");
   ASSERT_EQ(flat.parent_path().filename(), "ground_truth");
@@ -50,7 +45,7 @@ TEST_P(MetricsReference, ReproducesMsSsimAndCer) {
       Quote((pair / expected["result"].get<std::string>()).string()) + " --out " +
       Quote(out.string()) + " --no-flow --no-geometry --method " + GetParam());
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  const Json m = ReadJson(out)["metrics"];
+  const Json m = ReadJsonFile(out)["metrics"];
   const double ms_ssim = m["ms_ssim"].get<double>(), cer = m["cer"].get<double>();
   std::cout << GetParam() << ": MS-SSIM expected " << expected["ms_ssim"] << " got " << ms_ssim
             << "; CER expected " << expected["cer"] << " got " << cer << "\n";

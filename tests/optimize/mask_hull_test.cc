@@ -13,12 +13,12 @@
 namespace docunfold::optimize {
 namespace {
 
-constexpr int kSize = 800;
+constexpr int kImageSize = 800;
 
 PinholeCamera Camera(const std::string& image, const Eigen::Matrix3d& R) {
   PinholeCamera c;
   c.image = image;
-  c.width = c.height = kSize;
+  c.width = c.height = kImageSize;
   c.K << 800, 0, 400, 0, 800, 400, 0, 0, 1;
   // Looking at the sheet's centre (0, 0, 4) from 4 units away.
   const Eigen::Vector3d centre = Eigen::Vector3d(0, 0, 4) - 4 * R.transpose().col(2);
@@ -37,7 +37,7 @@ cv::Mat1b PageMask(const PinholeCamera& camera, double y_end) {
     const Eigen::Vector2d p = camera.Project(x);
     corners.emplace_back(int(std::lround(p.x())), int(std::lround(p.y())));
   }
-  cv::Mat1b mask = cv::Mat1b::zeros(kSize, kSize);
+  cv::Mat1b mask = cv::Mat1b::zeros(kImageSize, kImageSize);
   cv::fillConvexPoly(mask, corners, 255);
   return mask;
 }
@@ -45,13 +45,13 @@ cv::Mat1b PageMask(const PinholeCamera& camera, double y_end) {
 // A 1 x 1.5 sheet at z = 4 on a 5 x 7 grid (0.25 apart), seen square-on by
 // the reference and from 25 degrees off by view_01, whose mask ends at
 // y = 0.5: the sheet's last row (y = 0.75) is off the page there.
-struct Scene {
+struct TwoViewScene {
   MeshPair meshes;
   PinholeCamera reference = Camera("view_00.jpg", Eigen::Matrix3d::Identity());
   std::vector<ViewPage> others;
-  cv::Mat1b everywhere = cv::Mat1b(kSize, kSize, uchar(255));
+  cv::Mat1b everywhere = cv::Mat1b(kImageSize, kImageSize, uchar(255));
 
-  Scene() {
+  TwoViewScene() {
     meshes = FlatSheetAtDepthFour();
     ViewPage page;
     page.camera = Camera("view_01.jpg",
@@ -62,7 +62,7 @@ struct Scene {
 };
 
 TEST(MaskHull, VerticesOutsideAnotherMaskAreHeldToItsOutline) {
-  const Scene scene;
+  const TwoViewScene scene;
   std::vector<HullView> views = PrepareHullViews(scene.others);
   HullOptions options;
   const std::vector<isometry::Marker> markers =
@@ -87,7 +87,7 @@ TEST(MaskHull, VerticesOutsideAnotherMaskAreHeldToItsOutline) {
   }
   // From the mask at half its size: the same vertices, held to nearly the
   // same planes.
-  const std::vector<HullView> half = PrepareHullViews(scene.others, kSize / 2);
+  const std::vector<HullView> half = PrepareHullViews(scene.others, kImageSize / 2);
   EXPECT_DOUBLE_EQ(half[0].scale, 0.5);
   const std::vector<isometry::Marker> coarse =
       HullMarkers(scene.meshes, scene.reference, scene.everywhere, half, options);
@@ -104,7 +104,7 @@ TEST(MaskHull, VerticesOutsideAnotherMaskAreHeldToItsOutline) {
 }
 
 TEST(MaskHull, PointsOutsideAMaskMakeItDoubtfulThereOrEverywhere) {
-  const Scene scene;
+  const TwoViewScene scene;
   std::vector<HullView> views = PrepareHullViews(scene.others);
   HullOptions options;
   // 2,000 points on the page and one past it at the last row's corner: the

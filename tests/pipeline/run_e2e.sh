@@ -9,7 +9,7 @@
 # PDFs. OCR is left out (the metrics
 # reference test covers it), and so is the benchmark's Gauss-Newton against
 # L-BFGS timing (10 s with one core idle; no test reads it, and
-# bench_report_test covers its table). Exits non-zero only when the run itself fails;
+# the BenchReport tests cover its table). Exits non-zero only when the run itself fails;
 # each set's outcome is for the tests to judge.
 set -uo pipefail
 src=$1 build=$2 out=$3

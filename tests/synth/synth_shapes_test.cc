@@ -22,13 +22,6 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 const char* kTiny = "--views 1 --width 320 --height 240";
 
-std::string Slurp(const fs::path& p) {
-  std::ifstream f(p, std::ios::binary);
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
-
 // Runs synth with `args` into dir/name and loads its ground truth.
 std::optional<GroundTruth> Make(const TempDir& dir, const std::string& name,
                                 const std::string& args) {
@@ -132,7 +125,7 @@ TEST(SynthShapes, RollReceiptPrintsTillRowsAndRecordsTheirBaselines) {
     EXPECT_GE(gt->height_m, 0.14);
     EXPECT_LE(gt->height_m, 0.24);
     const int columns = std::string(roll) == "58" ? 32 : 48;
-    std::istringstream text(Slurp(dir / roll / "ground_truth/text.txt"));
+    std::istringstream text(ReadFileText(dir / roll / "ground_truth/text.txt"));
     std::string line;
     int rows = 0, priced = 0, separators = 0, total = 0;
     const std::regex item(R"(^\S.*\S {2,}-?\d+\.\d\d( [AB])?$)");
@@ -284,8 +277,8 @@ TEST(SynthShapes, SameSeedGivesIdenticalFilesAndBadCombinationsFail) {
   ASSERT_TRUE(Make(dir, "c", args + " --seed 12"));
   for (const char* f : {"images/view_00.jpg", "ground_truth/flat.png", "ground_truth/mesh.ply",
                         "ground_truth/features.json", "ground_truth/text.txt"})
-    EXPECT_EQ(Slurp(dir / "a" / f), Slurp(dir / "b" / f)) << f;
-  EXPECT_NE(Slurp(dir / "a/images/view_00.jpg"), Slurp(dir / "c/images/view_00.jpg"));
+    EXPECT_EQ(ReadFileText(dir / "a" / f), ReadFileText(dir / "b" / f)) << f;
+  EXPECT_NE(ReadFileText(dir / "a/images/view_00.jpg"), ReadFileText(dir / "c/images/view_00.jpg"));
 
   const std::string synth = Quote(StageBinary("synth").string()) + " " + kTiny;
   CommandResult r =

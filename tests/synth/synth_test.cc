@@ -18,13 +18,6 @@ std::string Synth(const std::string& args) {
   return Quote(StageBinary("synth").string()) + " " + args;
 }
 
-std::string Slurp(const fs::path& p) {
-  std::ifstream f(p, std::ios::binary);
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
-
 const char* kSmall = "--views 2 --width 480 --height 360 --creases 2";
 
 TEST(Synth, SameSeedGivesIdenticalFilesAndAnotherSeedDoesNot) {
@@ -41,10 +34,10 @@ TEST(Synth, SameSeedGivesIdenticalFilesAndAnotherSeedDoesNot) {
   for (const char* f : {"images/view_00.jpg", "images/view_01.jpg", "ground_truth/flat.png",
                         "ground_truth/mesh.ply", "ground_truth/cameras.json",
                         "ground_truth/features.json", "ground_truth/text.txt"}) {
-    EXPECT_EQ(Slurp(dir / "a" / f), Slurp(dir / "b" / f)) << f;
+    EXPECT_EQ(ReadFileText(dir / "a" / f), ReadFileText(dir / "b" / f)) << f;
   }
-  EXPECT_NE(Slurp(dir / "a/images/view_00.jpg"), Slurp(dir / "c/images/view_00.jpg"));
-  EXPECT_NE(Slurp(dir / "a/COMMAND").find("--seed 7"), std::string::npos);
+  EXPECT_NE(ReadFileText(dir / "a/images/view_00.jpg"), ReadFileText(dir / "c/images/view_00.jpg"));
+  EXPECT_NE(ReadFileText(dir / "a/COMMAND").find("--seed 7"), std::string::npos);
 }
 
 TEST(Synth, WritesTheGroundTruthLayoutAndItValidates) {
@@ -172,7 +165,7 @@ TEST(Synth, BadRequestsFailWithUsageErrorsAndLeaveNothing) {
   r = RunCommand(Synth(std::string(kSmall) + " --out " + Quote((dir / "taken").string())));
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.output.find("exists (pass --force"), std::string::npos) << r.output;
-  EXPECT_EQ(Slurp(dir / "taken/keep.txt"), "mine");
+  EXPECT_EQ(ReadFileText(dir / "taken/keep.txt"), "mine");
 
   r = RunCommand(Synth("--page-size 21 --out " + Quote((dir / "x").string())));
   EXPECT_EQ(r.exit_code, 2);
