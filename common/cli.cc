@@ -9,9 +9,31 @@
 #include <limits>
 #include <opencv2/core.hpp>
 
+#include "common/option_table.h"
 #include "nlohmann/json.hpp"
 
 namespace docunfold {
+
+CommandLine::CommandLine(const std::string& description)
+    : app_(std::make_unique<CLI::App>(description)), table_(std::make_unique<OptionTable>(*app_)) {}
+
+CommandLine::~CommandLine() = default;
+
+void CommandLine::Path(const std::string& name, std::filesystem::path* field,
+                       const std::string& help) {
+  table_->Path(name, field, help);
+}
+
+void CommandLine::RequiredPath(const std::string& name, std::filesystem::path* field,
+                               const std::string& help) {
+  table_->Path(name, field, help)->required();
+}
+
+void CommandLine::Text(const std::string& name, std::string* field, const std::string& help) {
+  table_->Value(name, field, help);
+}
+
+Json CommandLine::Record() const { return table_->Record(); }
 
 void LimitOpenMpThreads(char** argv) {
   if (std::getenv("OMP_THREAD_LIMIT") != nullptr) return;
@@ -84,14 +106,14 @@ int ParseAndRun(const std::string& program, CLI::App& app, int argc, char** argv
 
 }  // namespace
 
-int RunStage(const std::string& program, OptionTable& options, int argc, char** argv,
+int RunStage(const std::string& program, CommandLine& command, int argc, char** argv,
              const std::function<void()>& body) {
   if (argc == 2 && std::string(argv[1]) == "--help-markdown") {
-    std::cout << options.Markdown();
+    std::cout << command.table().Markdown();
     return kExitOk;
   }
   KeepFreedMemory();
-  return ParseAndRun(program, options.app(), argc, argv, body);
+  return ParseAndRun(program, *command.app_, argc, argv, body);
 }
 
 }  // namespace docunfold

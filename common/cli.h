@@ -2,14 +2,51 @@
 // into an options struct, and exception-to-exit-code mapping.
 #pragma once
 
+#include <filesystem>
 #include <functional>
+#include <memory>
 #include <string>
 
 #include "common/errors.h"
-#include "common/option_table.h"
+#include "common/json_io.h"
+#include "common/option_table_fwd.h"
 #include "common/program.h"
 
+namespace CLI {
+class App;
+}  // namespace CLI
+
 namespace docunfold {
+
+// A stage's command line: its description, the paths its main declares, and
+// the options the stage declares on table(). The mains see no CLI11: its
+// header costs each of them about 6 s to compile.
+class CommandLine {
+ public:
+  explicit CommandLine(const std::string& description);
+  ~CommandLine();
+  CommandLine(const CommandLine&) = delete;
+  CommandLine& operator=(const CommandLine&) = delete;
+
+  OptionTable& table() { return *table_; }
+
+  // --name PATH, an input or output (not recorded); the stage cannot run
+  // without a required one.
+  void Path(const std::string& name, std::filesystem::path* field, const std::string& help);
+  void RequiredPath(const std::string& name, std::filesystem::path* field, const std::string& help);
+  // --name TEXT into *field, recorded.
+  void Text(const std::string& name, std::string* field, const std::string& help);
+
+  // Every recorded option's current value (OptionTable::Record).
+  Json Record() const;
+
+ private:
+  friend int RunStage(const std::string& program, CommandLine& command, int argc, char** argv,
+                      const std::function<void()>& body);
+
+  std::unique_ptr<CLI::App> app_;
+  std::unique_ptr<OptionTable> table_;
+};
 
 // Parses the command line into `options`' fields, runs `body` and maps what
 // it throws to an exit code, printing exactly one line
@@ -17,7 +54,7 @@ namespace docunfold {
 // (or 0 for --help / --version). `--help-markdown` prints the options' table
 // for docs/stages/ instead. Before `body`, malloc is set to keep the memory
 // the stage frees, instead of giving it back to the kernel (cli.cc).
-int RunStage(const std::string& program, OptionTable& options, int argc, char** argv,
+int RunStage(const std::string& program, CommandLine& command, int argc, char** argv,
              const std::function<void()>& body);
 
 // For programs that use Tesseract: its OpenMP parallelism (up to 10 threads

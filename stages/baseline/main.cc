@@ -6,7 +6,7 @@
 using namespace docunfold;
 
 int main(int argc, char** argv) {
-  CLI::App app{
+  CommandLine command{
       "Reference methods for the benchmark. homography: "
       "<work>/10_sfm/reference.png warped by the four page corners of "
       "<work>/20_boundary/boundary.json onto a rectangle of the page's aspect "
@@ -18,16 +18,15 @@ int main(int argc, char** argv) {
       "true cameras by render's texture fusion: the ceiling for texturing from "
       "all the photos. With --crop-to-seen, only the part of the page some photo "
       "sees."};
-  OptionTable table(app);
   baseline::BaselineInputs in;
   baseline::BaselineOptions options;
   fs::path out;
-  table.Path("data", &in.data, "data set folder")->required();
-  table.Path("work", &in.work, "work directory with 10_sfm/ (and 20_boundary/)")->required();
-  table.Path("out", &out, "image to write (.png)")->required();
-  baseline::DeclareOptions(table, &options);
+  command.RequiredPath("data", &in.data, "data set folder");
+  command.RequiredPath("work", &in.work, "work directory with 10_sfm/ (and 20_boundary/)");
+  command.RequiredPath("out", &out, "image to write (.png)");
+  baseline::DeclareOptions(command.table(), &options);
 
-  return RunStage("baseline", table, argc, argv, [&] {
+  return RunStage("baseline", command, argc, argv, [&] {
     const baseline::BaselineResult r = baseline::Run(in, options);
     EnsureDirectory(out.parent_path().empty() ? fs::path(".") : out.parent_path());
     WriteImageAtomic(out, r.image);

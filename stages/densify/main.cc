@@ -6,26 +6,24 @@
 using namespace docunfold;
 
 int main(int argc, char** argv) {
-  CLI::App app{
+  CommandLine command{
       "Adds 3D points of the page to sfm's sparse cloud, cameras held fixed: "
       "text and print followed from the reference view into the other photos by "
       "optical flow, and the page's outline and the shading steps of its blank paper "
       "(a fold's crease) matched along epipolar lines, and print the others missed found "
       "by sweeping depth around the surface of those points. Writes "
       "points.ply (sfm's points first), points.json and overlay.png."};
-  OptionTable table(app);
   densify::DensifyOptions o;
-  table.Path("data", &o.data_dir, "data set folder (its images/ are read)")->required();
-  table.Path("sfm", &o.sfm_dir, "sfm output: cameras.json, points.ply, reference.png")->required();
-  table.Path("boundary", &o.boundary, "segment-boundary output: boundary.json, mask.png")
-      ->required();
-  table.Path("out", &o.out_dir, "output directory (e.g. 25_points)")->required();
-  densify::DeclareOptions(table, &o);
+  command.RequiredPath("data", &o.data_dir, "data set folder (its images/ are read)");
+  command.RequiredPath("sfm", &o.sfm_dir, "sfm output: cameras.json, points.ply, reference.png");
+  command.RequiredPath("boundary", &o.boundary, "segment-boundary output: boundary.json, mask.png");
+  command.RequiredPath("out", &o.out_dir, "output directory (e.g. 25_points)");
+  densify::DeclareOptions(command.table(), &o);
 
-  return RunStage("densify", table, argc, argv, [&] {
+  return RunStage("densify", command, argc, argv, [&] {
     const densify::DensifyInputs in = densify::ReadInputs(o);
     const densify::DensifyResult r = densify::Run(in, o);
-    densify::WriteOutputs(in, r, o, table.Record());
+    densify::WriteOutputs(in, r, o, command.Record());
     for (const std::string& w : r.warnings) Log("warning: " + w);
     Log("wrote " + (o.out_dir / "points.ply").string() + ": " +
         std::to_string(r.sfm_points - int(r.hidden.size())) + " sfm (" +

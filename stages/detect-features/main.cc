@@ -10,19 +10,18 @@
 using namespace docunfold;
 
 int main(int argc, char** argv) {
-  CLI::App app{
+  CommandLine command{
       "Finds short, locally straight feature segments in the document region of "
       "the reference image: text baselines (kind text) and centre lines of printed "
       "rules (kind edge). Writes features.json and overlay.png."};
-  OptionTable table(app);
   fs::path image_path, mask_path, out_dir;
   features::FeaturesOptions opt;
-  table.Path("image", &image_path, "reference image (e.g. 10_sfm/reference.png)")->required();
-  table.Path("mask", &mask_path, "document region, 255 = page (20_boundary/mask.png)")->required();
-  table.Path("out", &out_dir, "output directory (e.g. 30_features)")->required();
-  features::DeclareOptions(table, &opt);
+  command.RequiredPath("image", &image_path, "reference image (e.g. 10_sfm/reference.png)");
+  command.RequiredPath("mask", &mask_path, "document region, 255 = page (20_boundary/mask.png)");
+  command.RequiredPath("out", &out_dir, "output directory (e.g. 30_features)");
+  features::DeclareOptions(command.table(), &opt);
 
-  return RunStage("detect-features", table, argc, argv, [&] {
+  return RunStage("detect-features", command, argc, argv, [&] {
     const auto start = std::chrono::steady_clock::now();
     const cv::Mat image = ReadImage(image_path, cv::IMREAD_COLOR);
     const cv::Mat mask = ReadImage(mask_path, cv::IMREAD_GRAYSCALE);
@@ -37,7 +36,7 @@ int main(int argc, char** argv) {
                      {cv::IMWRITE_PNG_COMPRESSION, 1});
     WriteJsonAtomic(out_dir / "features.json",
                     features::FeaturesToJson(result, image_path.filename().string(), image.cols,
-                                             image.rows, table.Record()));
+                                             image.rows, command.Record()));
     Log(std::to_string(result.text_segments) + " text and " + std::to_string(result.edge_segments) +
         " edge segments (text height " + std::to_string(int(std::lround(result.text_height))) +
         " px), " + Fixed(SecondsSince(start), 2) + " s");

@@ -35,7 +35,7 @@ void FrontEnd(const evaluate::EvaluateInputs& in, const fs::path& out, const Jso
 
 int main(int argc, char** argv) {
   LimitOpenMpThreads(argv);
-  CLI::App app{
+  CommandLine command{
       "Compares a rectified image with <data>/ground_truth/flat.png: MS-SSIM "
       "(DocUNet definition), LD and Li-D (DeepFlow), CER/ED/WER (Tesseract, "
       "eng), and, when the work directory has meshes and the data set a true "
@@ -48,24 +48,23 @@ int main(int argc, char** argv) {
       "<work>/30_features (segment precision and recall against the page's "
       "true lines) in sfm's reference view, as a docunfold.front-end-metrics "
       "file (needs the true surface: ground_truth/mesh.ply, cameras.json)."};
-  OptionTable table(app);
   evaluate::EvaluateInputs in;
   evaluate::EvaluateOptions options;
   fs::path out;
-  table.Path("data", &in.data, "data set folder")->required();
-  table.Path("work", &in.work, "work directory (meshes, 10_sfm/cameras.json, OCR cache)");
-  table.Path("result", &in.result, "rectified image to evaluate (not with --front-end)");
-  table.Path("out", &out, "metrics JSON to write")->required();
-  table.Path("mesh-dir", &options.mesh_dir,
-             "folder with mesh3d.ply (and mesh2d.ply) to measure (default: <work>/50_optimize, "
-             "else <work>/40_init)");
-  evaluate::DeclareOptions(table, &options);
+  command.RequiredPath("data", &in.data, "data set folder");
+  command.Path("work", &in.work, "work directory (meshes, 10_sfm/cameras.json, OCR cache)");
+  command.Path("result", &in.result, "rectified image to evaluate (not with --front-end)");
+  command.RequiredPath("out", &out, "metrics JSON to write");
+  command.Path("mesh-dir", &options.mesh_dir,
+               "folder with mesh3d.ply (and mesh2d.ply) to measure (default: <work>/50_optimize, "
+               "else <work>/40_init)");
+  evaluate::DeclareOptions(command.table(), &options);
 
-  return RunStage("evaluate", table, argc, argv, [&] {
+  return RunStage("evaluate", command, argc, argv, [&] {
     std::error_code ec;
     if (!fs::is_directory(in.data, ec))
       throw InputError(in.data.string() + ": no such data set folder");
-    if (options.front_end) return FrontEnd(in, out, table.Record());
+    if (options.front_end) return FrontEnd(in, out, command.Record());
     if (in.result.empty()) throw UsageError("--result is required (or --front-end)");
     if (!evaluate::HasGroundTruth(in.data)) {
       Log("note: " + in.data.string() +
@@ -74,7 +73,7 @@ int main(int argc, char** argv) {
     }
     if (!fs::is_regular_file(in.result, ec))
       throw InputError(in.result.string() + ": no such file (--result)");
-    const evaluate::EvaluateResult r = evaluate::Run(in, options, table.Record());
+    const evaluate::EvaluateResult r = evaluate::Run(in, options, command.Record());
     WriteDocument(out, r.document);
     Log(evaluate::Summary(r, options.method) + " -> " + out.string());
   });

@@ -8,29 +8,28 @@
 using namespace docunfold;
 
 int main(int argc, char** argv) {
-  CLI::App app{
+  CommandLine command{
       "Initial meshes of the page: a quad grid on the document region of the reference "
       "image (Coons patch of the boundary sides), lifted to 3D by the depths of the SfM "
       "points, unfolded to the plane and refined by the joint isometric optimisation "
       "without feature lines; M' is turned upright by the page border."};
-  OptionTable table(app);
   fs::path sfm_dir, boundary_dir, points_path, out_dir;
   init_mesh::Options options;
-  table.Path("sfm", &sfm_dir, "sfm output: cameras.json, points.ply, reference.png")->required();
-  table.Path("boundary", &boundary_dir, "segment-boundary output: boundary.json, mask.png")
-      ->required();
-  table.Path("points", &points_path,
-             "3D points to fit (default: <sfm>/points.ply; densify writes 25_points/points.ply)");
-  table.Path("out", &out_dir, "output directory (mesh3d.ply, mesh2d.ply, init.json)")->required();
-  init_mesh::DeclareOptions(table, &options);
+  command.RequiredPath("sfm", &sfm_dir, "sfm output: cameras.json, points.ply, reference.png");
+  command.RequiredPath("boundary", &boundary_dir,
+                       "segment-boundary output: boundary.json, mask.png");
+  command.Path("points", &points_path,
+               "3D points to fit (default: <sfm>/points.ply; densify writes 25_points/points.ply)");
+  command.RequiredPath("out", &out_dir, "output directory (mesh3d.ply, mesh2d.ply, init.json)");
+  init_mesh::DeclareOptions(command.table(), &options);
 
-  return RunStage("init-mesh", table, argc, argv, [&] {
+  return RunStage("init-mesh", command, argc, argv, [&] {
     const auto start = std::chrono::steady_clock::now();
     const init_mesh::Inputs inputs = init_mesh::ReadInputs(sfm_dir, boundary_dir, points_path);
     const double read_seconds = SecondsSince(start);
     const init_mesh::Result result = init_mesh::Run(inputs, options);
     init_mesh::LogResult(result, options);
-    init_mesh::WriteOutputs(out_dir, inputs, result, options, table.Record(), read_seconds);
+    init_mesh::WriteOutputs(out_dir, inputs, result, options, command.Record(), read_seconds);
     const auto& its = result.refine.iterations;
     Log(std::to_string(result.meshes.grid.nx - 1) + "x" +
         std::to_string(result.meshes.grid.ny - 1) + " quads (" + result.grid_source + "), " +

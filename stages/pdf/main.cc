@@ -8,27 +8,24 @@ using namespace docunfold;
 
 int main(int argc, char** argv) {
   LimitOpenMpThreads(argv);
-  CLI::App app{
+  CommandLine command{
       "pdf: the rectified page as a searchable PDF at its paper size (ISO A3-A6, Letter, "
       "Legal or a receipt roll when the page's shape matches one, else the image at --dpi), "
       "with an invisible text layer on the words Tesseract reads, and ALTO XML, hOCR and "
       "pdf.json beside it"};
-  OptionTable table(app);
   fs::path render, out;
   std::string name;
   pdf::PdfOptions o;
-  table.Path("render", &render, "render output folder (rectified.png, render.json)")->required();
-  table
-      .Path("out", &out,
-            "output folder: <name>.pdf, <name>.alto.xml, <name>.hocr, the page image "
-            "<name>.jpg (.tif for black-white) and pdf.json")
-      ->required();
-  table.Value("name", &name,
-              "file name of the outputs (default: the work directory's, the folder above "
-              "--render)");
-  pdf::DeclareOptions(table, &o);
+  command.RequiredPath("render", &render, "render output folder (rectified.png, render.json)");
+  command.RequiredPath("out", &out,
+                       "output folder: <name>.pdf, <name>.alto.xml, <name>.hocr, the page image "
+                       "<name>.jpg (.tif for black-white) and pdf.json");
+  command.Text("name", &name,
+               "file name of the outputs (default: the work directory's, the folder above "
+               "--render)");
+  pdf::DeclareOptions(command.table(), &o);
 
-  return RunStage("pdf", table, argc, argv, [&] {
+  return RunStage("pdf", command, argc, argv, [&] {
     StepTimer timer;
     const pdf::PdfInputs in = pdf::ReadPdfInputs(render);
     if (name.empty())
@@ -36,7 +33,7 @@ int main(int argc, char** argv) {
     if (name.empty() || name == "." || name == "..") name = "page";
     if (name.find('/') != std::string::npos)
       throw UsageError("--name " + name + ": a file name, without '/'");
-    const pdf::PdfResult r = pdf::Run(o, in, out, name, table.Record());
+    const pdf::PdfResult r = pdf::Run(o, in, out, name, command.Record());
     Log("wrote " + r.pdf_file.string() + " (" + std::to_string(r.pdf_bytes / 1024) + " KB, " +
         (r.size.format == "none" ? std::string("no standard format") : r.size.format) + " " +
         Fixed(r.size.width_mm, 1) + " x " + Fixed(r.size.height_mm, 1) + " mm at " +

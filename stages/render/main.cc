@@ -8,28 +8,27 @@ using namespace docunfold;
 
 int main(int argc, char** argv) {
   LimitOpenMpThreads(argv);
-  CLI::App app{
+  CommandLine command{
       "render: the flat, cropped page from the meshes M (mesh3d.ply) and M' "
       "(mesh2d.ply) and the reference image"};
-  OptionTable table(app);
   fs::path sfm, boundary, meshes, out, images, features;
   render::RenderOptions o;
-  table.Path("sfm", &sfm, "sfm output folder (cameras.json, reference.png)")->required();
-  table.Path("boundary", &boundary, "segment-boundary output folder (boundary.json)")->required();
-  table.Path("meshes", &meshes, "folder with mesh3d.ply and mesh2d.ply (50_optimize or 40_init)")
-      ->required();
-  table.Path("out", &out, "output folder: rectified.png, rectified_grid.png, render.json")
-      ->required();
-  table.Path("features", &features,
-             "features.json (30_features/): when Tesseract cannot tell which way up the page is "
-             "and the meshes have no lines.json beside them (init-mesh's), the side the text's "
-             "baselines lie on decides");
-  table.Path("images", &images,
-             "the photos (<data>/images): the page found past a cut side is textured from the "
-             "other views that see it (without: the fill colour)");
-  render::DeclareOptions(table, &o);
+  command.RequiredPath("sfm", &sfm, "sfm output folder (cameras.json, reference.png)");
+  command.RequiredPath("boundary", &boundary, "segment-boundary output folder (boundary.json)");
+  command.RequiredPath("meshes", &meshes,
+                       "folder with mesh3d.ply and mesh2d.ply (50_optimize or 40_init)");
+  command.RequiredPath("out", &out,
+                       "output folder: rectified.png, rectified_grid.png, render.json");
+  command.Path("features", &features,
+               "features.json (30_features/): when Tesseract cannot tell which way up the page is "
+               "and the meshes have no lines.json beside them (init-mesh's), the side the text's "
+               "baselines lie on decides");
+  command.Path("images", &images,
+               "the photos (<data>/images): the page found past a cut side is textured from the "
+               "other views that see it (without: the fill colour)");
+  render::DeclareOptions(command.table(), &o);
 
-  return RunStage("render", table, argc, argv, [&] {
+  return RunStage("render", command, argc, argv, [&] {
     StepTimer timer;
     const render::RenderInputs in =
         render::ReadRenderInputs(sfm, boundary, meshes, images, features);
@@ -37,7 +36,7 @@ int main(int argc, char** argv) {
     const render::RenderResult result = render::Run(o, in);
     timer.Mark("render");
     for (const std::string& warning : result.warnings) Log("warning: " + warning);
-    Json report = render::RenderReport(o, in, result, table.Record());
+    Json report = render::RenderReport(o, in, result, command.Record());
     report["timing_s"]["read"] = read_s;
     render::WriteRenderOutputs(out, result, report);
     const double write_s = timer.Mark("write");

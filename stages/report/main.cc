@@ -5,17 +5,16 @@
 
 int main(int argc, char** argv) {
   using namespace docunfold;
-  CLI::App app{
+  CommandLine command{
       "report: one HTML page with every stage's output for a data set (photos, reference "
       "view, boundary, feature segments, point cloud and meshes, convergence, the rectified "
       "page, metrics, stage times and flags). Self-contained: opens from disk, offline."};
-  OptionTable table(app);
   report::ReportOptions o;
-  table.Path("data", &o.data, "data-set folder (images/, optional ground_truth/)")->required();
-  table.Path("work", &o.work, "its work directory")->required();
-  table.Path("out", &o.out, "HTML file to write (default <work>/report.html)");
-  report::DeclareOptions(table, &o);
-  return RunStage("report", table, argc, argv, [&] {
+  command.RequiredPath("data", &o.data, "data-set folder (images/, optional ground_truth/)");
+  command.RequiredPath("work", &o.work, "its work directory");
+  command.Path("out", &o.out, "HTML file to write (default <work>/report.html)");
+  report::DeclareOptions(command.table(), &o);
+  return RunStage("report", command, argc, argv, [&] {
     if (o.out.empty()) o.out = o.work / "report.html";
     report::ReportResult r = report::Run(o);
     WriteTextAtomic(o.out, r.html);

@@ -10,19 +10,18 @@
 using namespace docunfold;
 
 int main(int argc, char** argv) {
-  CLI::App app{
+  CommandLine command{
       "Finds the page in the reference image: its region (mask.png), outline, "
       "corners and sides (boundary.json, real sides vs sides cut by the image "
       "border) and an overlay.png to check them at a glance."};
-  OptionTable table(app);
   fs::path image_path, out_dir;
   boundary::BoundaryOptions opt;
   boundary::OtherViews views;
-  table.Path("image", &image_path, "reference image (e.g. 10_sfm/reference.png)")->required();
-  table.Path("out", &out_dir, "output directory (e.g. 20_boundary)")->required();
-  boundary::DeclareOptions(table, &opt, &views);
+  command.RequiredPath("image", &image_path, "reference image (e.g. 10_sfm/reference.png)");
+  command.RequiredPath("out", &out_dir, "output directory (e.g. 20_boundary)");
+  boundary::DeclareOptions(command.table(), &opt, &views);
 
-  return RunStage("segment-boundary", table, argc, argv, [&] {
+  return RunStage("segment-boundary", command, argc, argv, [&] {
     const auto start = std::chrono::steady_clock::now();
     const cv::Mat image = ReadImage(image_path, cv::IMREAD_COLOR);
     if (opt.verbose)
@@ -38,7 +37,7 @@ int main(int argc, char** argv) {
       Log("page found in " + Fixed(SecondsSince(start), 3) + " s; orientation by " +
           result.orientation.method);
     // The other views, all found before anything is written.
-    const Json record = table.Record();
+    const Json record = command.Record();
     int tried = 0;
     const std::vector<boundary::BoundaryFiles> view_files =
         views.views_dir.empty() ? std::vector<boundary::BoundaryFiles>{}

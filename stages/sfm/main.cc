@@ -7,7 +7,7 @@
 using namespace docunfold;
 
 int main(int argc, char** argv) {
-  CLI::App app{
+  CommandLine command{
       "Recovers the cameras and a sparse point cloud of the page with COLMAP (CPU SIFT, "
       "every pair of views matched exactly and verified, incremental mapper: the same photos "
       "give the same result on every run), picks the reference view (the one that "
@@ -17,17 +17,15 @@ int main(int argc, char** argv) {
       "camera's frame scaled to median depth 1, plus COLMAP's workspace in colmap/. "
       "Exit codes: 0 ok, 1 COLMAP missing or failing, 2 usage, 3 bad input (data set, "
       "image, --ref, too few views registered or points), 4 cannot write."};
-  OptionTable table(app);
   sfm::SfmOptions o;
-  table.Path("data", &o.data_dir, "data set folder (photos in its images/)")->required();
-  table
-      .Path("out", &o.out_dir,
-            "output folder, e.g. work/set01/10_sfm (replaced as a whole when the run succeeds)")
-      ->required();
-  sfm::DeclareOptions(table, &o);
+  command.RequiredPath("data", &o.data_dir, "data set folder (photos in its images/)");
+  command.RequiredPath(
+      "out", &o.out_dir,
+      "output folder, e.g. work/set01/10_sfm (replaced as a whole when the run succeeds)");
+  sfm::DeclareOptions(command.table(), &o);
 
-  return RunStage("sfm", table, argc, argv, [&] {
-    const sfm::SfmResult r = sfm::RunSfm(o, table.Record());
+  return RunStage("sfm", command, argc, argv, [&] {
+    const sfm::SfmResult r = sfm::RunSfm(o, command.Record());
     const size_t left_out = r.photos.left_out.size();
     Log(std::to_string(r.cameras.views.size()) + "/" + std::to_string(r.photos.photos.size()) +
         " views registered" +
