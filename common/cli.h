@@ -48,8 +48,8 @@ class CommandLine {
   std::unique_ptr<OptionTable> table_;
 };
 
-// Parses the command line into `options`' fields, runs `body` and maps what
-// it throws to an exit code, printing exactly one line
+// Parses the command line into the fields `command` declared, runs `body`
+// and maps what it throws to an exit code, printing exactly one line
 // "<program>: <kind>: <message>" to stderr. CLI11 parse errors become exit 2
 // (or 0 for --help / --version). `--help-markdown` prints the options' table
 // for docs/stages/ instead. Before `body`, malloc is set to keep the memory
