@@ -113,7 +113,7 @@ int RunStage(const std::string& program, CommandLine& command, int argc, char** 
     return kExitOk;
   }
   KeepFreedMemory();
-  return ParseAndRun(program, *command.app_, argc, argv, body);
+  return ParseAndRun(program, command.table().app(), argc, argv, body);
 }
 
 }  // namespace docunfold

@@ -41,9 +41,6 @@ class CommandLine {
   Json Record() const;
 
  private:
-  friend int RunStage(const std::string& program, CommandLine& command, int argc, char** argv,
-                      const std::function<void()>& body);
-
   std::unique_ptr<CLI::App> app_;
   std::unique_ptr<OptionTable> table_;
 };
