@@ -4,7 +4,6 @@
 
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
-#include <sstream>
 
 #include "common/json_io.h"
 #include "stages/synth/folds.h"
