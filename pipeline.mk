@@ -91,18 +91,23 @@ deps:
 	@$(ROOT)/scripts/install-deps.sh
 
 $(BUILD)/CMakeCache.txt: | deps
-	cmake -S $(ROOT) -B $(BUILD) -DCMAKE_BUILD_TYPE=Release
+	cmake -S $(ROOT) -B $(BUILD) -G Ninja -DCMAKE_BUILD_TYPE=Release
 
 build: $(BUILD)/CMakeCache.txt deps
 	cmake --build $(BUILD) -j$(JOBS)
 
 # A stage binary is (re)built when its sources changed; stages that depend on
-# it rerun only when the binary actually changes.
+# it rerun only when the binary actually changes. One cmake call checks every
+# program a run uses (CMake's target pipeline-programs): with Ninja it takes
+# 0.1 s when nothing is to be built, where a call per program with Makefiles
+# made every run 4 s longer.
 ifeq ($(NO_BUILD),)
-$(BIN)/%: $(BUILD)/CMakeCache.txt FORCE | deps
-	@cmake --build $(BUILD) --target $* -j$(JOBS) > $(BUILD)/.build-$*.log 2>&1 || \
-	  { cat $(BUILD)/.build-$*.log >&2; echo "pipeline.mk: building $* failed" >&2; exit 1; }
-	@test -x $@
+.PHONY: pipeline-programs
+pipeline-programs: $(BUILD)/CMakeCache.txt | deps
+	@cmake --build $(BUILD) --target pipeline-programs -j$(JOBS) > $(BUILD)/.build-programs.log 2>&1 || \
+	  { cat $(BUILD)/.build-programs.log >&2; echo "pipeline.mk: building the stages' programs failed" >&2; exit 1; }
+$(BIN)/%: pipeline-programs
+	@test -x $@ || { echo "pipeline.mk: $@ is not among the programs CMake's pipeline-programs builds" >&2; exit 1; }
 else
 # Batches build once, up front; the per-data-set makes only check.
 $(BIN)/%:
@@ -125,7 +130,7 @@ FUZZ_BUILD ?= $(ROOT)/build-fuzz
 FUZZ_SECONDS ?= 600
 FUZZ_TARGETS ?=
 fuzz: deps
-	CC=clang CXX=clang++ cmake -S $(ROOT) -B $(FUZZ_BUILD) -DDOCUNFOLD_FUZZ=ON -DBUILD_TESTING=OFF \
+	CC=clang CXX=clang++ cmake -S $(ROOT) -B $(FUZZ_BUILD) $(if $(wildcard $(FUZZ_BUILD)/CMakeCache.txt),,-G Ninja) -DDOCUNFOLD_FUZZ=ON \
 	  -DCMAKE_BUILD_TYPE=RelWithDebInfo > /dev/null
 	cmake --build $(FUZZ_BUILD) -j$(JOBS)
 	$(ROOT)/scripts/fuzz $(FUZZ_BUILD) $(FUZZ_SECONDS) $(JOBS) $(FUZZ_TARGETS)
