@@ -59,7 +59,8 @@ void GridBlockMatrix::Multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y, int
   y.resize(5 * n_);
   // Row by row (upper blocks of row i, transposed upper blocks of the rows
   // above that reach i): no two threads write the same entry.
-#pragma omp parallel for num_threads(threads) schedule(static) if (threads > 1 && n_ > 2000)
+#pragma omp parallel for num_threads(threads) \
+    schedule(static) if (threads > 1 && n_ >= kMinParallelVertices)
   for (int i = 0; i < n_; ++i) {
     Vec5d acc = Block(i, 0) * x.segment<5>(5 * i);
     for (int k = 1; k < kSlots; ++k) {

@@ -77,7 +77,7 @@ double GaussNewton::Assemble(const State& s, const StepData& data, const Weights
                              Eigen::VectorXd& g) {
   H_.SetZero();
   const QuadGrid& grid = s.grid;
-  const bool parallel = threads_ > 1 && grid.NumVertices() > 2000;
+  const bool parallel = threads_ > 1 && grid.NumVertices() >= kMinParallelVertices;
   auto add = [&](double weight, const Row& r) {
     const double k = std::sqrt(weight);
     const double value = k * r.value;
@@ -176,7 +176,7 @@ bool GaussNewton::SolveDirect(const Eigen::VectorXd& shift, const Eigen::VectorX
 bool GaussNewton::SolveCg(const Eigen::VectorXd& shift, const Eigen::VectorXd& g,
                           Eigen::VectorXd& delta, int* iterations) {
   const int n = H_.NumVertices();
-  const bool parallel = threads_ > 1 && n > 2000;
+  const bool parallel = threads_ > 1 && n >= kMinParallelVertices;
   precond_.resize(n);
   bool ok = true;
 #pragma omp parallel for num_threads(threads_) schedule(static) reduction(&& : ok) if (parallel)

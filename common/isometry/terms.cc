@@ -8,6 +8,7 @@
 #include <omp.h>
 #endif
 
+#include "common/isometry/block_matrix.h"
 #include "common/isometry/solver_internal.h"
 
 namespace docunfold::isometry::internal {
@@ -50,7 +51,7 @@ double WeightedF(const TermValues& t, const Weights& w) { return t.Weighted(w); 
 TermValues EvaluateTerms(const State& s, const StepData& data, int threads) {
   const int quads = s.grid.NumQuads(), points = int(data.points.size());
   const int triplets = NumFairTriplets(s.grid), markers = int(data.markers.size());
-  threads = quads > 2000 ? threads : 1;
+  threads = quads >= kMinParallelVertices ? threads : 1;
   const double iso = OrderedSums<1>(quads, threads, [&](int q, Row* rows, auto& acc) {
     AddSquares(rows, IsoRows(s, data, q, rows), &acc[0]);
   })[0];
