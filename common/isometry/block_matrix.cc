@@ -33,26 +33,9 @@ void GridBlockMatrix::SetZero() {
   for (Mat5& b : blocks_) b.setZero();
 }
 
-int GridBlockMatrix::Slot(int vi, int vj) const {
-  // From the index difference and the column (the grid may be narrow, so
-  // test the cases in this order).
-  const int d = vj - vi, c = vi % grid_.nx, nx = grid_.nx;
-  if (d == 0) return 0;
-  if (d == 1 && c + 1 < nx) return 1;
-  if (d == 2 && c + 2 < nx) return 2;
-  if (d == nx - 1 && c > 0) return 3;
-  if (d == nx) return 4;
-  if (d == nx + 1 && c + 1 < nx) return 5;
-  if (d == 2 * nx) return 6;
+void GridBlockMatrix::NotNeighbours(int vi, int vj) {
   throw std::logic_error("GridBlockMatrix: vertices " + std::to_string(vi) + " and " +
                          std::to_string(vj) + " are not grid neighbours");
-}
-
-void GridBlockMatrix::AddOuter(int vi, const Vec5d& a, int vj, const Vec5d& b) {
-  if (vi <= vj)
-    Block(vi, Slot(vi, vj)).noalias() += a * b.transpose();
-  else
-    Block(vj, Slot(vj, vi)).noalias() += b * a.transpose();
 }
 
 void GridBlockMatrix::Multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y, int threads) const {

@@ -40,7 +40,12 @@ class GridBlockMatrix {
   const Mat5& Block(int i, int k) const { return blocks_[size_t(i) * kSlots + k]; }
   // Adds a·bᵀ to the block (vi, vj) of the full symmetric matrix (either
   // order; vi == vj allowed). Throws if the pair is not a stored neighbour.
-  void AddOuter(int vi, const Vec5d& a, int vj, const Vec5d& b);
+  void AddOuter(int vi, const Vec5d& a, int vj, const Vec5d& b) {
+    if (vi <= vj)
+      Block(vi, Slot(vi, vj)).noalias() += a * b.transpose();
+    else
+      Block(vj, Slot(vj, vi)).noalias() += b * a.transpose();
+  }
 
   // y = A x for the full symmetric matrix (x, y of size 5n), on `threads`.
   void Multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y, int threads = 1) const;
@@ -53,7 +58,23 @@ class GridBlockMatrix {
   void ToSparseUpper(Eigen::SparseMatrix<double>& out, const Eigen::VectorXd& shift) const;
 
  private:
-  int Slot(int vi, int vj) const;  // vi <= vj
+  // The slot of (vi, vj), vi <= vj; in the header, because assembly calls it
+  // for every pair of every row.
+  int Slot(int vi, int vj) const {
+    const int d = vj - vi, nx = grid_.nx;
+    if (d == 0) return 0;
+    // Only these two need no column test (no other slot's offset can equal
+    // them where its column test passes).
+    if (d == nx) return 4;
+    if (d == 2 * nx) return 6;
+    const int c = vi % nx;
+    if (d == 1 && c + 1 < nx) return 1;
+    if (d == 2 && c + 2 < nx) return 2;
+    if (d == nx - 1 && c > 0) return 3;
+    if (d == nx + 1 && c + 1 < nx) return 5;
+    NotNeighbours(vi, vj);
+  }
+  [[noreturn]] static void NotNeighbours(int vi, int vj);
   QuadGrid grid_;
   int n_ = 0;
   std::vector<int> neighbour_;
