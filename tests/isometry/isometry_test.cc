@@ -515,27 +515,32 @@ TEST(Isometry, MarkersStraightenLinesAndFollowTheirRays) {
 }
 
 TEST(Isometry, SolveIsTheSameForAnyNumberOfThreads) {
-  // Large enough for every parallel loop (2000+ vertices and quads, several
-  // chunks of points), with conjugate-gradient steps: the solver's sums are
-  // added in an order that does not depend on the threads, so one thread and
-  // two give bit-identical meshes (the solver picks the number per outer
-  // iteration from the machine's load).
-  const MeshPair truth = CurledSheet(61, 41, 0.8, 0.6, 0.45);
-  Problem p;
-  p.meshes = Flattened(truth, 0.6);
-  p.points = SampleSurface(truth, 5000, 0.002 * isometry::ModelSize(truth), 0.02, 5).points;
-  SolveOptions o;
-  o.max_outer_iterations = 4;
-  o.num_threads = 1;
-  const auto one = isometry::Solve(p, o);
-  o.num_threads = 2;
-  const auto two = isometry::Solve(p, o);
-  EXPECT_EQ(one.report.method, "gauss-newton/cg");
-  ASSERT_EQ(one.report.iterations.size(), two.report.iterations.size());
-  for (size_t i = 0; i < one.report.iterations.size(); ++i)
-    EXPECT_EQ(one.report.iterations[i].F, two.report.iterations[i].F) << "iteration " << i;
-  EXPECT_TRUE(one.meshes.mesh3d == two.meshes.mesh3d);
-  EXPECT_TRUE(one.meshes.mesh2d == two.meshes.mesh2d);
+  // On a grid as optimize's coarsest (651 vertices, conjugate gradients to
+  // the coarse tolerance) and one past 1000 vertices (the fine tolerance),
+  // both large enough for the parallel loops (kMinParallelVertices; several
+  // chunks of points): the solver's sums are added in an order that does not
+  // depend on the threads, so one thread and two give bit-identical meshes
+  // (the solver picks the number per outer iteration from the machine's load).
+  for (const auto& [nx, ny] : {std::pair{31, 21}, std::pair{61, 41}}) {
+    SCOPED_TRACE(std::to_string(nx) + "x" + std::to_string(ny));
+    ASSERT_GE(nx * ny, isometry::internal::kMinParallelVertices);
+    const MeshPair truth = CurledSheet(nx, ny, 0.8, 0.6, 0.45);
+    Problem p;
+    p.meshes = Flattened(truth, 0.6);
+    p.points = SampleSurface(truth, 5000, 0.002 * isometry::ModelSize(truth), 0.02, 5).points;
+    SolveOptions o;
+    o.max_outer_iterations = 4;
+    o.num_threads = 1;
+    const auto one = isometry::Solve(p, o);
+    o.num_threads = 2;
+    const auto two = isometry::Solve(p, o);
+    EXPECT_EQ(one.report.method, "gauss-newton/cg");
+    ASSERT_EQ(one.report.iterations.size(), two.report.iterations.size());
+    for (size_t i = 0; i < one.report.iterations.size(); ++i)
+      EXPECT_EQ(one.report.iterations[i].F, two.report.iterations[i].F) << "iteration " << i;
+    EXPECT_TRUE(one.meshes.mesh3d == two.meshes.mesh3d);
+    EXPECT_TRUE(one.meshes.mesh2d == two.meshes.mesh2d);
+  }
 }
 
 // A 6x5 curled sheet started flat, fitted to 300 exact points of it: small,
