@@ -141,9 +141,13 @@ fuzz: deps
 # evaluate when the data set has ground truth.
 CHAIN := sfm:sfm boundary:segment-boundary points:densify features:detect-features \
   init:init-mesh optimize:optimize render:render
-IMPLEMENTED := $(foreach s,$(CHAIN),$(if $(wildcard $(ROOT)/stages/$(word 2,$(subst :, ,$(s)))),$(word 1,$(subst :, ,$(s)))))
+# The two halves of a `name:value` pair.
+pair_name = $(word 1,$(subst :, ,$(1)))
+pair_value = $(word 2,$(subst :, ,$(1)))
+CHAIN_PROGRAMS := $(foreach s,$(CHAIN),$(call pair_value,$(s)))
+IMPLEMENTED := $(foreach s,$(CHAIN),$(if $(wildcard $(ROOT)/stages/$(call pair_value,$(s))),$(call pair_name,$(s))))
 # The programs of the implemented stages a run may use.
-PROGRAMS := $(notdir $(wildcard $(addprefix $(ROOT)/stages/,$(foreach s,$(CHAIN),$(word 2,$(subst :, ,$(s)))) pdf evaluate report)))
+PROGRAMS := $(notdir $(wildcard $(addprefix $(ROOT)/stages/,$(CHAIN_PROGRAMS) pdf evaluate report)))
 HAS_GT := $(wildcard $(DATA_DIR)/ground_truth/flat.png)
 all: $(lastword $(IMPLEMENTED)) $(if $(wildcard $(ROOT)/stages/pdf),pdf) $(if $(and $(HAS_GT),$(wildcard $(ROOT)/stages/evaluate)),evaluate) $(if $(wildcard $(ROOT)/stages/report),report)
 	@echo "docunfold: $(NAME) done; results in $(WORK)$(if $(wildcard $(ROOT)/stages/report),; open $(WORK)/report.html)"
@@ -227,7 +231,7 @@ REPORT_OUT := $(WORK)/report.html
 report: check-data $(REPORT_OUT)
 STAGE_OUTPUTS := sfm:SFM_OUT boundary:BOUNDARY_OUT points:POINTS_OUT features:FEATURES_OUT init:INIT_OUT \
   optimize:OPTIMIZE_OUT render:RENDER_OUT pdf:PDF_OUT
-REPORT_IN := $(foreach s,$(STAGE_OUTPUTS),$(if $(filter $(word 1,$(subst :, ,$(s))),$(IMPLEMENTED) $(if $(wildcard $(ROOT)/stages/pdf),pdf)),$($(word 2,$(subst :, ,$(s)))))) \
+REPORT_IN := $(foreach s,$(STAGE_OUTPUTS),$(if $(filter $(call pair_name,$(s)),$(IMPLEMENTED) $(if $(wildcard $(ROOT)/stages/pdf),pdf)),$($(call pair_value,$(s))))) \
   $(if $(and $(HAS_GT),$(wildcard $(ROOT)/stages/evaluate)),$(EVAL_OUT) $(FRONT_END_OUT))
 $(REPORT_OUT): $(BIN)/report $(REPORT_IN) | check-data
 	$(BIN)/report --data $(DATA_DIR) --work $(WORK) --out $@
