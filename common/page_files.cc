@@ -1,5 +1,6 @@
 #include "common/page_files.h"
 
+#include <algorithm>
 #include <cmath>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -43,6 +44,19 @@ Boundary ParseBoundary(const Json& doc, const fs::path& file) {
       if (!parts.is_array()) r.Fail(p + "/real_parts", "expected an array of polylines");
       for (size_t k = 0; k < parts.size(); ++k)
         b.sides[i].real_parts.push_back(r.Points(p + "/real_parts/" + std::to_string(k), 2));
+    }
+  }
+  if (r.Has("/folded_corners")) {
+    const Json& folded = r.At("/folded_corners");
+    if (!folded.is_array()) r.Fail("/folded_corners", "expected an array");
+    constexpr const char* kCornerNames[4] = {"TL", "TR", "BR", "BL"};
+    for (size_t k = 0; k < folded.size(); ++k) {
+      const std::string p = "/folded_corners/" + std::to_string(k);
+      const std::string name = r.String(p + "/corner");
+      const auto* it = std::find(std::begin(kCornerNames), std::end(kCornerNames), name);
+      if (it == std::end(kCornerNames)) r.Fail(p + "/corner", "expected TL, TR, BR or BL");
+      const std::vector<Eigen::Vector2d> fold = r.Points(p + "/fold", 2);
+      b.folded_away.push_back({b.corners[it - std::begin(kCornerNames)], fold[0], fold[1]});
     }
   }
   return b;

@@ -37,6 +37,9 @@ struct Boundary {
   std::vector<Eigen::Vector2d> contour;    // closed outline
   std::array<Eigen::Vector2d, 4> corners;  // TL TR BR BL
   std::array<BoundarySide, 4> sides;       // top, right, bottom, left
+  // Corners folded over or under the page: each the triangle of the image
+  // between the page's corner and the fold's two ends, which shows no page.
+  std::vector<std::array<Eigen::Vector2d, 3>> folded_away;
   int RealSides() const;
 };
 

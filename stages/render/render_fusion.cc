@@ -36,8 +36,20 @@ SampleStats FusePixels(const RenderOptions& options, const RenderInputs& in,
   surface.width = W;
   surface.height = H;
   // The reference first: reference.png, undistorted; its outline is where
-  // M comes from, so it needs no mask.
-  std::vector<FusionView> views = {{in.camera, {}, photos.reference, {}, in.camera.image}};
+  // M comes from, so it needs no mask, but where a corner is folded away
+  // past its outline.
+  cv::Mat1b reference_mask;
+  if (!in.boundary.folded_away.empty()) {
+    reference_mask = cv::Mat1b(photos.reference.size(), uchar(255));
+    for (const auto& triangle : in.boundary.folded_away) {
+      std::vector<cv::Point> corners;
+      for (const Eigen::Vector2d& p : triangle)
+        corners.emplace_back(int(std::lround(p.x())), int(std::lround(p.y())));
+      cv::fillConvexPoly(reference_mask, corners, cv::Scalar(0));
+    }
+  }
+  std::vector<FusionView> views = {
+      {in.camera, {}, photos.reference, reference_mask, in.camera.image}};
   for (size_t v = 0; v < in.views.size(); ++v)
     if (!photos.views[v].empty())
       views.push_back({in.views[v].camera, in.views[v].distortion, photos.views[v],

@@ -43,6 +43,12 @@ Json BoundaryToJson(const BoundaryResult& r, const std::string& image_name, int 
                                    {"cut_fraction", s.cut_fraction},
                                    {"real_parts", parts}};
   }
+  if (!r.folded_corners.empty()) {
+    doc["folded_corners"] = Json::array();
+    for (const FoldedCorner& f : r.folded_corners)
+      doc["folded_corners"].push_back(
+          {{"corner", kCornerNames[f.corner]}, {"fold", line({f.fold[0], f.fold[1]})}});
+  }
   doc["orientation"] = {{"method", r.orientation.method},
                         {"confidence", r.orientation.confidence},
                         {"votes", r.orientation.votes}};

@@ -84,4 +84,22 @@ Side TraceSide(const std::vector<cv::Point>& contour, const std::array<int, 4>& 
                const std::array<cv::Point2d, 4>& corners, const BorderTest& on_border,
                const BoundaryOptions& options);
 
+// --- Folded corners (folded_corners.cc) --------------------------------------
+
+// Step 5: where a corner of the page is folded over or under it (a dog-ear),
+// the outline has a straight fold between two sides, and the corner found is
+// one end of the fold. Moves such corners to where the two sides' lines meet
+// past the fold (a point of the image that is not page), runs both sides on
+// to it (they stay real: page edge, straight), and returns the folds.
+// A corner counts as folded when the fold (at least 6.5 % of the outline)
+// and the side past it are straight, each end of the fold turns by 20-70
+// degrees, the corner they make turns by 50-130 degrees, and at most a fifth
+// of the triangle cut off is page. A shading step running from either end
+// of the fold across the page to the outline makes it a crease meeting a
+// side instead. Reads result->mask; sides simplified to `epsilon_px`.
+std::vector<FoldedCorner> CompleteFoldedCorners(const std::vector<cv::Point>& contour,
+                                                const ShadingImage& shading,
+                                                const BorderTest& on_border, double epsilon_px,
+                                                BoundaryResult* result);
+
 }  // namespace docunfold::boundary::internal

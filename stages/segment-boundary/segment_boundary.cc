@@ -105,8 +105,8 @@ BoundaryResult SegmentBoundary(const cv::Mat& image, const BoundaryOptions& opti
   // 3. Corners: clockwise, then rotated so that the top side is first.
   const internal::BorderTest on_border =
       internal::OnImageBorder(mask.size(), options.border_tolerance_px);
-  std::array<int, 4> idx = internal::FindCorners(
-      contour, internal::MakeShadingImage(region.small, mask, full.cols), on_border);
+  const internal::ShadingImage shading = internal::MakeShadingImage(region.small, mask, full.cols);
+  std::array<int, 4> idx = internal::FindCorners(contour, shading, on_border);
   std::array<cv::Point2d, 4> corners;
   for (int i = 0; i < 4; ++i) corners[i] = contour[idx[i]];
   step("corners");
@@ -124,6 +124,9 @@ BoundaryResult SegmentBoundary(const cv::Mat& image, const BoundaryOptions& opti
   for (int i = 0; i < 4; ++i) result.corner_in_image[i] = !on_border(contour[idx[i]]);
   for (int i = 0; i < 4; ++i)
     result.sides[i] = internal::TraceSide(contour, idx, i, result.corners, on_border, options);
+  // 5. Corners folded over or under the page, completed past the fold.
+  result.folded_corners = internal::CompleteFoldedCorners(contour, shading, on_border,
+                                                          options.contour_epsilon_px, &result);
   return result;
 }
 

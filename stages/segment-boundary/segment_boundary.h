@@ -82,10 +82,20 @@ void DeclareOptions(OptionTable& table, BoundaryOptions* options, OtherViews* vi
 // next, and which parts of it are the true page edge.
 struct Side {
   std::vector<cv::Point2d> points;
-  bool real = true;  // the whole side is page edge (not cut by the image)
+  // The whole side is page edge (not cut by the image border; a side that
+  // runs on past a folded corner's fold to the corner is).
+  bool real = true;
   // Pieces of `points` that are page edge; all of it when `real`.
   std::vector<std::vector<cv::Point2d>> real_parts;
   double cut_fraction = 0;  // fraction of its length on the image border
+};
+
+// A page corner folded over or under the page: the outline runs along the
+// fold from `fold[0]` (where corner finding put the corner) to `fold[1]`,
+// and the corner is placed where the two sides' lines meet past it.
+struct FoldedCorner {
+  int corner = 0;  // index into BoundaryResult::corners
+  std::array<cv::Point2d, 2> fold;
 };
 
 enum SideIndex { kTop = 0, kRight = 1, kBottom = 2, kLeft = 3 };
@@ -107,6 +117,7 @@ struct BoundaryResult {
   std::array<bool, 4> corner_in_image{{true, true, true, true}};
   // top: TL->TR, right: TR->BR, bottom: BL->BR, left: TL->BL.
   std::array<Side, 4> sides;
+  std::vector<FoldedCorner> folded_corners;
   Orientation orientation;
   double area_fraction = 0;  // page area / image area
 };

@@ -7,6 +7,7 @@
 #include <random>
 
 #include "common/errors.h"
+#include "common/page_files.h"
 #include "stages/segment-boundary/segment_boundary.h"
 
 namespace docunfold::boundary {
@@ -86,6 +87,42 @@ TEST(SegmentBoundary, FindsAPageOnAPlainTable) {
   EXPECT_LE(cv::norm(r.sides[kRight].points.back() - r.corners[2]), 1e-9);
   EXPECT_LE(cv::norm(r.sides[kBottom].points.front() - r.corners[3]), 1e-9);
   EXPECT_LE(cv::norm(r.sides[kLeft].points.back() - r.corners[3]), 1e-9);
+  EXPECT_TRUE(r.folded_corners.empty());
+}
+
+TEST(SegmentBoundary, AFoldedCornerIsCompletedPastTheFold) {
+  // kTilted with its top-right corner folded under: the triangle between the
+  // corner and a fold from 70 % along the top side to 30 % down the right
+  // side shows the table.
+  Scene s = DrawScene(kTilted, false);
+  const cv::Point2d corner = kTilted[1];
+  const cv::Point2d fold_top = kTilted[0] + 0.7 * (kTilted[1] - kTilted[0]);
+  const cv::Point2d fold_right = kTilted[1] + 0.3 * (kTilted[2] - kTilted[1]);
+  const std::vector<cv::Point> gone = {corner, fold_top, fold_right};
+  cv::fillConvexPoly(s.image, gone, cv::Scalar(70, 110, 60));
+  cv::fillConvexPoly(s.mask, gone, cv::Scalar(0));
+  BoundaryOptions opt;
+  opt.orientation = OrientationSource::kGeometry;
+  const BoundaryResult r = SegmentBoundary(s.image, opt);
+  EXPECT_GE(Iou(r.mask, s.mask), 0.98);
+  ASSERT_EQ(r.folded_corners.size(), 1u);
+  EXPECT_EQ(r.folded_corners[0].corner, 1);  // TR
+  EXPECT_LE(cv::norm(r.corners[1] - corner), 4.0) << r.corners[1];
+  for (int i : {0, 2, 3}) EXPECT_LE(cv::norm(r.corners[i] - kTilted[i]), 3.0) << i;
+  const std::array<cv::Point2d, 2>& fold = r.folded_corners[0].fold;
+  EXPECT_LE(std::min(cv::norm(fold[0] - fold_top) + cv::norm(fold[1] - fold_right),
+                     cv::norm(fold[0] - fold_right) + cv::norm(fold[1] - fold_top)),
+            10.0);
+  // Both sides run on to the corner and stay real (straightened downstream).
+  EXPECT_TRUE(r.sides[kTop].real && r.sides[kRight].real);
+  EXPECT_LE(cv::norm(r.sides[kTop].points.back() - r.corners[1]), 1e-9);
+  EXPECT_LE(cv::norm(r.sides[kRight].points.front() - r.corners[1]), 1e-9);
+  // boundary.json names it, and the reader gives the triangle with no page.
+  const Boundary b =
+      ParseBoundary(BoundaryToJson(r, "reference.png", s.image.cols, s.image.rows, Json::object()),
+                    "boundary.json");
+  ASSERT_EQ(b.folded_away.size(), 1u);
+  EXPECT_LE((b.folded_away[0][0] - Eigen::Vector2d(corner.x, corner.y)).norm(), 4.0);
 }
 
 TEST(SegmentBoundary, FindsAPageOnATexturedTable) {
