@@ -82,8 +82,8 @@ void DeclareOptions(OptionTable& table, BoundaryOptions* options, OtherViews* vi
 // next, and which parts of it are the true page edge.
 struct Side {
   std::vector<cv::Point2d> points;
-  // The whole side is page edge (not cut by the image border; a side that
-  // runs on past a folded corner's fold to the corner is).
+  // The whole side is page edge, not cut by the image border. A side run on
+  // past a folded corner's fold to the corner counts as page edge all along.
   bool real = true;
   // Pieces of `points` that are page edge; all of it when `real`.
   std::vector<std::vector<cv::Point2d>> real_parts;
