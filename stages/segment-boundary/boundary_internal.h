@@ -74,6 +74,9 @@ std::vector<cv::Point> ClockwiseOutline(const cv::Mat1b& mask);
 
 std::vector<cv::Point2d> ToDouble(const std::vector<cv::Point>& pts);
 
+// The length of the open polyline `p` (pixels).
+double PolylineLength(const std::vector<cv::Point2d>& p);
+
 // Douglas-Peucker simplification with tolerance `eps` (pixels).
 std::vector<cv::Point2d> Simplify(const std::vector<cv::Point2d>& pts, double eps, bool closed);
 

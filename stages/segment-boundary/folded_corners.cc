@@ -15,12 +15,6 @@ namespace {
 
 using Polyline = std::vector<cv::Point2d>;
 
-double Length(const Polyline& p) {
-  double l = 0;
-  for (size_t i = 1; i < p.size(); ++i) l += cv::norm(p[i] - p[i - 1]);
-  return l;
-}
-
 // Straight within 3 px plus 1 % of the chord: a page edge in a photo bows a
 // little with the lens and the paper, and print next to a fold notches it;
 // a fold's kink turns by 20 degrees and more.
@@ -77,9 +71,9 @@ double AngleDeg(const cv::Point2d& u, const cv::Point2d& v) {
   return std::acos(std::clamp(c, -1.0, 1.0)) * 180 / CV_PI;
 }
 
-// Side s as stored runs from corner kSideStart[s] to kSideEnd[s].
+// Side s as stored starts at corner kSideStart[s] (top and bottom run left to
+// right, left and right top to bottom).
 constexpr int kSideStart[4] = {0, 1, 3, 0};
-constexpr int kSideEnd[4] = {1, 2, 2, 3};
 
 // Side s from `corner` on, resampled every 2 px or closer (the stored side
 // is simplified: a straight stretch is two points).
@@ -109,7 +103,6 @@ struct Completion {
 // `kinked` the side that runs along the fold first and `straight` the other
 // (both from the corner found); nullopt when the outline there is no folded
 // corner.
-
 std::optional<Completion> TryCorner(const Polyline& kinked, const Polyline& straight,
                                     const cv::Mat1b& mask, const BorderTest& on_border,
                                     const std::function<bool(const cv::Point2d&)>& crease_end,
@@ -204,7 +197,7 @@ std::vector<FoldedCorner> CompleteFoldedCorners(const std::vector<cv::Point>& co
   };
   std::vector<FoldedCorner> folded;
   double perimeter = 0;
-  for (const Side& side : r->sides) perimeter += Length(side.points);
+  for (const Side& side : r->sides) perimeter += PolylineLength(side.points);
   for (int corner = 0; corner < 4; ++corner) {
     const int after = corner, before = (corner + 3) % 4;  // the sides meeting there
     if (!r->corner_in_image[corner] || !r->sides[after].real || !r->sides[before].real) continue;

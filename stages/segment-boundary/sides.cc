@@ -11,12 +11,6 @@
 namespace docunfold::boundary::internal {
 namespace {
 
-double PolylineLength(const std::vector<cv::Point2d>& p) {
-  double l = 0;
-  for (size_t i = 1; i < p.size(); ++i) l += cv::norm(p[i] - p[i - 1]);
-  return l;
-}
-
 // Drops the points next to either end of a side that lie behind its corner:
 // a sharpened corner of a shallow turn (150 degrees and more) moves along
 // the outline's rounding, and the points of the rounding past it would make
@@ -53,6 +47,12 @@ std::vector<cv::Point> ClockwiseOutline(const cv::Mat1b& mask) {
       [](const auto& a, const auto& b) { return cv::contourArea(a) < cv::contourArea(b); });
   if (SignedArea(contour) < 0) std::reverse(contour.begin(), contour.end());
   return contour;
+}
+
+double PolylineLength(const std::vector<cv::Point2d>& p) {
+  double l = 0;
+  for (size_t i = 1; i < p.size(); ++i) l += cv::norm(p[i] - p[i - 1]);
+  return l;
 }
 
 std::vector<cv::Point2d> ToDouble(const std::vector<cv::Point>& pts) {
