@@ -6,6 +6,7 @@
 #include <array>
 #include <functional>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -76,6 +77,12 @@ std::vector<cv::Point2d> ToDouble(const std::vector<cv::Point>& pts);
 
 // The length of the open polyline `p` (pixels).
 double PolylineLength(const std::vector<cv::Point2d>& p);
+
+// The parameter s at which the line a + s da meets the line b + t db (unit
+// directions); nullopt when they cross at an angle whose sine is below
+// `min_sine` (nearly parallel).
+std::optional<double> LineMeeting(const cv::Point2d& a, const cv::Point2d& da, const cv::Point2d& b,
+                                  const cv::Point2d& db, double min_sine);
 
 // Douglas-Peucker simplification with tolerance `eps` (pixels).
 std::vector<cv::Point2d> Simplify(const std::vector<cv::Point2d>& pts, double eps, bool closed);

@@ -27,6 +27,7 @@ int CornerReach(size_t outline_points) { return std::max(2, int(0.025 * double(o
 }  // namespace internal
 
 using internal::CornerReach;
+using internal::LineMeeting;
 using internal::SignedArea;
 
 namespace {
@@ -361,11 +362,9 @@ cv::Point2d RefineCorner(const std::vector<cv::Point>& contour, int index, int r
   if (!fit_side(-1, &before) || !fit_side(+1, &after)) return corner;
   const cv::Point2d d1(before[0], before[1]), o1(before[2], before[3]);
   const cv::Point2d d2(after[0], after[1]), o2(after[2], after[3]);
-  const double cross = d1.x * d2.y - d1.y * d2.x;
-  if (std::abs(cross) < std::sin(20.0 * CV_PI / 180)) return corner;  // nearly parallel
-  const cv::Point2d w = o2 - o1;
-  const double t = (w.x * d2.y - w.y * d2.x) / cross;
-  const cv::Point2d x = o1 + t * d1;
+  const auto t = LineMeeting(o1, d1, o2, d2, std::sin(20.0 * CV_PI / 180));
+  if (!t) return corner;  // nearly parallel
+  const cv::Point2d x = o1 + *t * d1;
   // The rounding the mask leaves is a few pixels: a far intersection means
   // the fits are not of this corner's sides.
   double step = 0;

@@ -55,17 +55,6 @@ Line FitLine(const Polyline& q, size_t from, size_t to) {
   return {cv::Point2d(l[2], l[3]), d};
 }
 
-// Parameters s, t with a.point + s a.direction = b.point + t b.direction;
-// false when the lines are (nearly) parallel.
-bool Intersect(const Line& a, const Line& b, double* s, double* t) {
-  const double det = a.direction.x * (-b.direction.y) - a.direction.y * (-b.direction.x);
-  if (std::abs(det) < 1e-6) return false;
-  const cv::Point2d r = b.point - a.point;
-  *s = (r.x * (-b.direction.y) - r.y * (-b.direction.x)) / det;
-  *t = (a.direction.x * r.y - a.direction.y * r.x) / det;
-  return true;
-}
-
 double AngleDeg(const cv::Point2d& u, const cv::Point2d& v) {
   const double c = u.dot(v) / std::max(1e-12, cv::norm(u) * cv::norm(v));
   return std::acos(std::clamp(c, -1.0, 1.0)) * 180 / CV_PI;
@@ -133,9 +122,9 @@ std::optional<Completion> TryCorner(const Polyline& kinked, const Polyline& stra
   const double at_c = AngleDeg(along.direction, fold_end - c);
   const double at_k = AngleDeg(c - fold_end, far.direction);
   if (at_c < 110 || at_c > 160 || at_k < 110 || at_k > 160) return std::nullopt;
-  double s = 0, t = 0;
-  if (!Intersect(along, far, &s, &t)) return std::nullopt;
-  const cv::Point2d v = along.point + s * along.direction;
+  const auto s = LineMeeting(along.point, along.direction, far.point, far.direction, 1e-6);
+  if (!s) return std::nullopt;
+  const cv::Point2d v = along.point + *s * along.direction;
   // The page's corner lies behind both sides' visible parts.
   if ((c - v).dot(along.direction) <= 0 || (fold_end - v).dot(far.direction) <= 0)
     return std::nullopt;

@@ -55,6 +55,14 @@ double PolylineLength(const std::vector<cv::Point2d>& p) {
   return l;
 }
 
+std::optional<double> LineMeeting(const cv::Point2d& a, const cv::Point2d& da, const cv::Point2d& b,
+                                  const cv::Point2d& db, double min_sine) {
+  const double cross = da.x * db.y - da.y * db.x;
+  if (std::abs(cross) < min_sine) return std::nullopt;
+  const cv::Point2d w = b - a;
+  return (w.x * db.y - w.y * db.x) / cross;
+}
+
 std::vector<cv::Point2d> ToDouble(const std::vector<cv::Point>& pts) {
   return std::vector<cv::Point2d>(pts.begin(), pts.end());
 }
