@@ -9,6 +9,7 @@
 
 #include "common/atomic_file.h"
 #include "common/errors.h"
+#include "common/photo.h"
 #include "common/program.h"
 #include "stages/sfm/matching.h"
 #include "stages/sfm/sfm_internal.h"
@@ -255,14 +256,18 @@ bool Better(const MapperAttempt& a, const MapperAttempt& b) {
 struct MapperSetting {
   bool refine;               // distortion refined in bundle adjustment
   double filter;             // px at matching resolution
-  bool refine_focal = true;  // false: the focal length stays at its EXIF prior
+  bool refine_focal = true;  // false: the focal length stays at its prior
+  // Before mapping, cameras without an EXIF prior get a phone's
+  // (kPhoneFocal35mm) as theirs.
+  bool phone_prior = false;
 };
 
 // Two photos of a page may not determine the focal length: the page is
 // nearly a plane, and bundle adjustment trades focal length for depth (on
-// two of three two-photo synth pages with EXIF it ran to 2.0 and 4.6 times
-// the truth). A phone's EXIF focal length is then the better value, and is
-// kept.
+// three two-photo synth pages it ran to 2.0-5.8 times the truth). A phone's
+// EXIF focal length is then the better value, and is kept; without EXIF, a
+// focal length no phone's main camera has is taken for such a trade, and
+// the photos are mapped again with a phone's.
 bool KeepExifFocal(const PhotoSet& photos) {
   if (photos.photos.size() != 2) return false;
   for (const CameraGroup& g : photos.groups)
@@ -270,10 +275,15 @@ bool KeepExifFocal(const PhotoSet& photos) {
   return true;
 }
 
+// A phone's main camera, 35 mm equivalent (mm), and how far (a factor
+// either way) a focal length two photos give may be from it and be believed.
+constexpr double kPhoneFocal35mm = 26;
+constexpr double kPhoneFocalFactor = 1.4;
+
 // Judges the model an attempt made: every view registered, a plausible
 // focal length, enough points.
 void JudgeModel(const ColmapModel& m, const PhotoSet& photos, const SfmOptions& o,
-                MapperAttempt* attempt) {
+                const MapperSetting& s, MapperAttempt* attempt) {
   const int n = int(photos.photos.size());
   attempt->produced_model = true;
   attempt->registered = int(m.images.size());
@@ -291,6 +301,18 @@ void JudgeModel(const ColmapModel& m, const PhotoSet& photos, const SfmOptions& 
     if (factor < o.min_focal_factor || factor > o.max_focal_factor) {
       problems.push_back("implausible focal length " + Fixed(cam.MeanFocal(), 0) + " px");
       break;
+    }
+  }
+  if (n == 2 && s.refine_focal) {
+    for (const auto& [id, cam] : m.cameras) {
+      const double ratio =
+          cam.MeanFocal() / FocalPixelsFrom35mm(kPhoneFocal35mm, cam.width, cam.height);
+      if (ratio > kPhoneFocalFactor || ratio < 1 / kPhoneFocalFactor) {
+        problems.push_back("focal length " + Fixed(cam.MeanFocal(), 0) + " px, " +
+                           Fixed(ratio * kPhoneFocal35mm, 0) +
+                           " mm equivalent: two photos do not fix it");
+        break;
+      }
     }
   }
   if (attempt->points < o.min_points)
@@ -312,7 +334,11 @@ MapperAttempt RunMapper(const Colmap& colmap, const PhotoSet& photos, const Mapp
       (model_id >= 2 ? (s.refine ? ", distortion refined" : ", distortion fixed at 0")
                      : std::string()) +
       ", filter " + Fixed(s.filter, 1) + " px" +
-      (s.refine_focal ? std::string() : ", focal length fixed at EXIF's");
+      (s.refine_focal ? std::string()
+       : s.phone_prior
+           ? ", focal length fixed (EXIF's, else a phone's " + Fixed(kPhoneFocal35mm, 0) + " mm)"
+           : ", focal length fixed at EXIF's");
+  if (s.phone_prior) SetMissingFocalPriors(colmap.database, kPhoneFocal35mm);
   EnsureDirectory(dir);
   Log("mapping (" + attempt.description + ")");
   const std::regex registering(R"(Registering image #\d+ \((\d+)\))");
@@ -339,7 +365,7 @@ MapperAttempt RunMapper(const Colmap& colmap, const PhotoSet& photos, const Mapp
       /*throw_on_failure=*/false);
   attempt.seconds = run.seconds;
   if (ReadBestModel(dir, m, m_dir)) {
-    JudgeModel(*m, photos, o, &attempt);
+    JudgeModel(*m, photos, o, s, &attempt);
   } else {
     attempt.problem = run.timed_out ? "stopped after the time limit"
                                     : "no model (no initial pair of views found)";
@@ -368,6 +394,9 @@ Mapping MapWithRetries(const Colmap& colmap, const PhotoSet& photos) {
     Log("two photos: the focal length is kept at EXIF's, not refined");
     settings = {{false, o.max_reprojection_error, false}};
     if (o.retry && o.max_reprojection_error < 4) settings.push_back({false, 4.0, false});
+  } else if (o.retry && photos.photos.size() == 2) {
+    settings.push_back({false, o.max_reprojection_error, false, true});
+    if (o.max_reprojection_error < 4) settings.push_back({false, 4.0, false, true});
   } else if (o.retry) {
     if (model_id >= 2) settings.push_back({!o.refine_distortion, o.max_reprojection_error});
     if (o.max_reprojection_error < 4) settings.push_back({o.refine_distortion, 4.0});

@@ -12,6 +12,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "common/photo.h"
 #include "stages/sfm/descriptor_dots.h"
 
 namespace docunfold::sfm {
@@ -97,6 +98,60 @@ void NumberImagesByName(const fs::path& database) {
     sqlite3_free(error);
     throw std::runtime_error(database.string() + ": renumbering the images: " + why);
   }
+}
+
+int SetMissingFocalPriors(const fs::path& database, double focal_35mm) {
+  const Database db = OpenDatabase(database, SQLITE_OPEN_READWRITE);
+  struct Camera {
+    int id, model, width, height;
+    std::vector<double> params;
+  };
+  std::vector<Camera> cameras;
+  {
+    sqlite3_stmt* stmt = nullptr;
+    if (sqlite3_prepare_v2(db.get(),
+                           "SELECT camera_id, model, width, height, params FROM cameras "
+                           "WHERE prior_focal_length = 0",
+                           -1, &stmt, nullptr) != SQLITE_OK)
+      throw std::runtime_error(database.string() + ": " + sqlite3_errmsg(db.get()));
+    while (sqlite3_step(stmt) == SQLITE_ROW) {
+      Camera c{sqlite3_column_int(stmt, 0),
+               sqlite3_column_int(stmt, 1),
+               sqlite3_column_int(stmt, 2),
+               sqlite3_column_int(stmt, 3),
+               {}};
+      const auto* data = static_cast<const double*>(sqlite3_column_blob(stmt, 4));
+      c.params.assign(data, data + sqlite3_column_bytes(stmt, 4) / sizeof(double));
+      cameras.push_back(std::move(c));
+    }
+    sqlite3_finalize(stmt);
+  }
+  for (Camera& c : cameras) {
+    // COLMAP's model ids: 0 SIMPLE_PINHOLE, 2 SIMPLE_RADIAL, 3 RADIAL have
+    // one focal length, PINHOLE (1) and the OpenCV models (4 on) two; then
+    // the principal point, then the distortion.
+    const size_t focals = c.model == 1 || c.model >= 4 ? 2 : 1;
+    if (c.params.size() < focals + 2)
+      throw std::runtime_error(database.string() + ": camera " + std::to_string(c.id) + " has " +
+                               std::to_string(c.params.size()) + " parameters");
+    const double f = FocalPixelsFrom35mm(focal_35mm, c.width, c.height);
+    for (size_t i = 0; i < c.params.size(); ++i)
+      if (i < focals || i >= focals + 2) c.params[i] = i < focals ? f : 0;
+    sqlite3_stmt* stmt = nullptr;
+    if (sqlite3_prepare_v2(db.get(),
+                           "UPDATE cameras SET params = ?, prior_focal_length = 1 "
+                           "WHERE camera_id = ?",
+                           -1, &stmt, nullptr) != SQLITE_OK)
+      throw std::runtime_error(database.string() + ": " + sqlite3_errmsg(db.get()));
+    sqlite3_bind_blob(stmt, 1, c.params.data(), int(c.params.size() * sizeof(double)),
+                      SQLITE_TRANSIENT);
+    sqlite3_bind_int(stmt, 2, c.id);
+    const int step = sqlite3_step(stmt);
+    sqlite3_finalize(stmt);
+    if (step != SQLITE_DONE)
+      throw std::runtime_error(database.string() + ": " + sqlite3_errmsg(db.get()));
+  }
+  return int(cameras.size());
 }
 
 std::vector<ImageDescriptors> ReadDatabaseDescriptors(const fs::path& database) {

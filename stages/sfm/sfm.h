@@ -65,7 +65,9 @@ struct SfmOptions {
   bool two_view_tracks = true;
   // When the first reconstruction is implausible (views left out, a focal
   // length outside focal_range, too few points), retry with the other
-  // distortion setting and with COLMAP's default filter; keep the best.
+  // distortion setting and with COLMAP's default filter; keep the best. Two
+  // photos without EXIF whose focal length no phone's main camera has are
+  // retried at a phone's instead (colmap_steps.cc).
   bool retry = true;
   // Plausible focal lengths as multiples of the image's long side (a 10x
   // telephoto to a 120-degree wide angle).
