@@ -68,18 +68,25 @@ Database OpenDatabase(const fs::path& database, int flags) {
   return Database(raw, sqlite3_close);
 }
 
+using Statement = std::unique_ptr<sqlite3_stmt, int (*)(sqlite3_stmt*)>;
+
+// `sql` compiled for `db`; throws naming `database` when it does not compile.
+Statement Prepare(const Database& db, const fs::path& database, const char* sql) {
+  sqlite3_stmt* raw = nullptr;
+  if (sqlite3_prepare_v2(db.get(), sql, -1, &raw, nullptr) != SQLITE_OK)
+    throw std::runtime_error(database.string() + ": " + sqlite3_errmsg(db.get()));
+  return Statement(raw, sqlite3_finalize);
+}
+
 }  // namespace
 
 void NumberImagesByName(const fs::path& database) {
   const Database db = OpenDatabase(database, SQLITE_OPEN_READWRITE);
   std::vector<int> old_ids;
   {
-    sqlite3_stmt* stmt = nullptr;
-    if (sqlite3_prepare_v2(db.get(), "SELECT image_id FROM images ORDER BY name", -1, &stmt,
-                           nullptr) != SQLITE_OK)
-      throw std::runtime_error(database.string() + ": " + sqlite3_errmsg(db.get()));
-    while (sqlite3_step(stmt) == SQLITE_ROW) old_ids.push_back(sqlite3_column_int(stmt, 0));
-    sqlite3_finalize(stmt);
+    const Statement stmt = Prepare(db, database, "SELECT image_id FROM images ORDER BY name");
+    while (sqlite3_step(stmt.get()) == SQLITE_ROW)
+      old_ids.push_back(sqlite3_column_int(stmt.get(), 0));
   }
   // Moved out of the way first, so that no id is ever taken twice.
   constexpr long kOffset = 1000000;
@@ -100,31 +107,29 @@ void NumberImagesByName(const fs::path& database) {
   }
 }
 
-int SetMissingFocalPriors(const fs::path& database, double focal_35mm) {
+void SetMissingFocalPriors(const fs::path& database, double focal_35mm) {
   const Database db = OpenDatabase(database, SQLITE_OPEN_READWRITE);
+  const Statement select = Prepare(db, database,
+                                   "SELECT camera_id, model, width, height, params FROM cameras "
+                                   "WHERE prior_focal_length = 0");
+  const Statement update = Prepare(
+      db, database, "UPDATE cameras SET params = ?, prior_focal_length = 1 WHERE camera_id = ?");
+  // Read whole before the first update: SQLite leaves undefined whether a
+  // running SELECT sees rows an UPDATE changed.
   struct Camera {
     int id, model, width, height;
     std::vector<double> params;
   };
   std::vector<Camera> cameras;
-  {
-    sqlite3_stmt* stmt = nullptr;
-    if (sqlite3_prepare_v2(db.get(),
-                           "SELECT camera_id, model, width, height, params FROM cameras "
-                           "WHERE prior_focal_length = 0",
-                           -1, &stmt, nullptr) != SQLITE_OK)
-      throw std::runtime_error(database.string() + ": " + sqlite3_errmsg(db.get()));
-    while (sqlite3_step(stmt) == SQLITE_ROW) {
-      Camera c{sqlite3_column_int(stmt, 0),
-               sqlite3_column_int(stmt, 1),
-               sqlite3_column_int(stmt, 2),
-               sqlite3_column_int(stmt, 3),
-               {}};
-      const auto* data = static_cast<const double*>(sqlite3_column_blob(stmt, 4));
-      c.params.assign(data, data + sqlite3_column_bytes(stmt, 4) / sizeof(double));
-      cameras.push_back(std::move(c));
-    }
-    sqlite3_finalize(stmt);
+  while (sqlite3_step(select.get()) == SQLITE_ROW) {
+    Camera c{sqlite3_column_int(select.get(), 0),
+             sqlite3_column_int(select.get(), 1),
+             sqlite3_column_int(select.get(), 2),
+             sqlite3_column_int(select.get(), 3),
+             {}};
+    const auto* data = static_cast<const double*>(sqlite3_column_blob(select.get(), 4));
+    c.params.assign(data, data + sqlite3_column_bytes(select.get(), 4) / sizeof(double));
+    cameras.push_back(std::move(c));
   }
   for (Camera& c : cameras) {
     // COLMAP's model ids: 0 SIMPLE_PINHOLE, 2 SIMPLE_RADIAL, 3 RADIAL have
@@ -134,37 +139,25 @@ int SetMissingFocalPriors(const fs::path& database, double focal_35mm) {
     if (c.params.size() < focals + 2)
       throw std::runtime_error(database.string() + ": camera " + std::to_string(c.id) + " has " +
                                std::to_string(c.params.size()) + " parameters");
-    const double f = FocalPixelsFrom35mm(focal_35mm, c.width, c.height);
-    for (size_t i = 0; i < c.params.size(); ++i)
-      if (i < focals || i >= focals + 2) c.params[i] = i < focals ? f : 0;
-    sqlite3_stmt* stmt = nullptr;
-    if (sqlite3_prepare_v2(db.get(),
-                           "UPDATE cameras SET params = ?, prior_focal_length = 1 "
-                           "WHERE camera_id = ?",
-                           -1, &stmt, nullptr) != SQLITE_OK)
-      throw std::runtime_error(database.string() + ": " + sqlite3_errmsg(db.get()));
-    sqlite3_bind_blob(stmt, 1, c.params.data(), int(c.params.size() * sizeof(double)),
+    std::fill(c.params.begin(), c.params.begin() + focals,
+              FocalPixelsFrom35mm(focal_35mm, c.width, c.height));
+    std::fill(c.params.begin() + focals + 2, c.params.end(), 0.0);
+    sqlite3_reset(update.get());
+    sqlite3_bind_blob(update.get(), 1, c.params.data(), int(c.params.size() * sizeof(double)),
                       SQLITE_TRANSIENT);
-    sqlite3_bind_int(stmt, 2, c.id);
-    const int step = sqlite3_step(stmt);
-    sqlite3_finalize(stmt);
-    if (step != SQLITE_DONE)
+    sqlite3_bind_int(update.get(), 2, c.id);
+    if (sqlite3_step(update.get()) != SQLITE_DONE)
       throw std::runtime_error(database.string() + ": " + sqlite3_errmsg(db.get()));
   }
-  return int(cameras.size());
 }
 
 std::vector<ImageDescriptors> ReadDatabaseDescriptors(const fs::path& database) {
   const Database db = OpenDatabase(database, SQLITE_OPEN_READONLY);
-  sqlite3_stmt* stmt_raw = nullptr;
-  const char* sql =
-      "SELECT images.image_id, images.name, descriptors.rows, "
-      "descriptors.cols, "
-      "descriptors.data FROM images JOIN descriptors ON images.image_id = "
-      "descriptors.image_id ORDER BY images.image_id";
-  if (sqlite3_prepare_v2(db.get(), sql, -1, &stmt_raw, nullptr) != SQLITE_OK)
-    throw std::runtime_error(database.string() + ": " + sqlite3_errmsg(db.get()));
-  const std::unique_ptr<sqlite3_stmt, int (*)(sqlite3_stmt*)> stmt(stmt_raw, sqlite3_finalize);
+  const Statement stmt = Prepare(db, database,
+                                 "SELECT images.image_id, images.name, descriptors.rows, "
+                                 "descriptors.cols, descriptors.data FROM images JOIN descriptors "
+                                 "ON images.image_id = descriptors.image_id "
+                                 "ORDER BY images.image_id");
   std::vector<ImageDescriptors> images;
   int step;
   while ((step = sqlite3_step(stmt.get())) == SQLITE_ROW) {

@@ -35,10 +35,9 @@ void NumberImagesByName(const fs::path& database);
 
 // Gives every camera of a COLMAP database that has no focal length prior the
 // focal length of a lens of `focal_35mm` (35 mm equivalent) at its size, and
-// no distortion, as its prior (before mapping). Returns how many cameras it
-// changed. Throws std::runtime_error naming the database when it cannot be
-// changed.
-int SetMissingFocalPriors(const fs::path& database, double focal_35mm);
+// no distortion, as its prior (before mapping). Throws std::runtime_error
+// naming the database when it cannot be changed.
+void SetMissingFocalPriors(const fs::path& database, double focal_35mm);
 
 // Every image of a COLMAP database with its descriptors, by image id.
 // Throws std::runtime_error naming the database when it cannot be read.
