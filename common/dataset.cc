@@ -15,10 +15,15 @@ DataSet OpenDataSet(const fs::path& root) {
                      ": missing (a data set keeps its photos in images/)");
   DataSet set;
   set.root = root;
-  for (const auto& entry : fs::directory_iterator(root / "images", ec))
-    if (entry.is_regular_file() && entry.path().filename().string().rfind('.', 0) != 0)
+  for (const auto& entry : fs::directory_iterator(root / "images", ec)) {
+    if (entry.path().filename().string().rfind('.', 0) == 0) continue;
+    if (entry.is_regular_file())
       set.images.push_back(entry.path());
+    else if (entry.is_directory())
+      set.folders.push_back(entry.path());
+  }
   std::sort(set.images.begin(), set.images.end());
+  std::sort(set.folders.begin(), set.folders.end());
   set.has_ground_truth = fs::is_directory(root / "ground_truth", ec);
   return set;
 }

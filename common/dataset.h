@@ -17,6 +17,9 @@ struct DataSet {
   // Every file in images/ but hidden ones, sorted by name: which are photos
   // the photo reader (photo.h) tells by their content.
   std::vector<fs::path> images;
+  // Folders in images/ (hidden ones aside), sorted: never read, so that a
+  // reader can say photos go directly in images/.
+  std::vector<fs::path> folders;
   bool has_ground_truth = false;
 
   fs::path ground_truth(const std::string& file) const { return root / "ground_truth" / file; }

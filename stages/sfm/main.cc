@@ -26,10 +26,9 @@ int main(int argc, char** argv) {
 
   return RunStage("sfm", command, argc, argv, [&] {
     const sfm::SfmResult r = sfm::RunSfm(o, command.Record());
-    const size_t left_out = r.photos.left_out.size();
     Log(std::to_string(r.cameras.views.size()) + "/" + std::to_string(r.photos.photos.size()) +
         " views registered" +
-        (left_out ? " (" + std::to_string(left_out) + " files left out)" : std::string()) + ", " +
+        (r.photos.left_out.empty() ? "" : " (" + r.photos.LeftOutSummary() + ")") + ", " +
         std::to_string(r.points.size()) + " points, " + r.camera_model + ", reference " +
         r.reference + " (" + r.reference_choice + ", focal " +
         std::to_string(int(r.cameras.Find(r.reference)->K(0, 0) + 0.5)) + " px), " +

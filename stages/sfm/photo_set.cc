@@ -109,10 +109,29 @@ std::vector<std::string> PhotoSet::Names() const {
   return names;
 }
 
+std::string PhotoSet::LeftOutSummary() const {
+  const auto folders = size_t(
+      std::count_if(left_out.begin(), left_out.end(), [](const LeftOut& l) { return l.folder; }));
+  const size_t files = left_out.size() - folders;
+  auto count = [](size_t n, const std::string& what) {
+    return std::to_string(n) + " " + what + (n == 1 ? "" : "s");
+  };
+  if (left_out.empty()) return "";
+  return (files ? count(files, "file") : "") + (files && folders ? " and " : "") +
+         (folders ? count(folders, "folder") : "") + " left out";
+}
+
 PhotoSet PreparePhotos(const fs::path& data_dir, int max_image_size, const fs::path& copy_dir,
                        std::vector<cv::Mat>* thumbnails) {
   const DataSet data = OpenDataSet(data_dir);
   PhotoSet set;
+  // A folder of photos inside images/ (one per document, or as a phone
+  // exported them) would otherwise be passed over without a word.
+  for (const fs::path& folder : data.folders) {
+    set.left_out.push_back(
+        {folder.filename().string() + "/", "a folder: photos go directly in images/", true});
+    Log("left out: " + set.left_out.back().name + " (" + set.left_out.back().reason + ")");
+  }
   std::set<std::string> taken;
   Progress progress("reading photos", long(data.images.size()));
   for (size_t i = 0; i < data.images.size(); ++i) {
@@ -148,9 +167,7 @@ PhotoSet PreparePhotos(const fs::path& data_dir, int max_image_size, const fs::p
     const fs::path images_dir = data_dir / "images";
     throw InputError(images_dir.string() + ": " + std::to_string(set.photos.size()) + " photo" +
                      (set.photos.size() == 1 ? "" : "s") +
-                     (set.left_out.empty()
-                          ? std::string()
-                          : " (" + std::to_string(set.left_out.size()) + " files left out)") +
+                     (set.left_out.empty() ? std::string() : " (" + set.LeftOutSummary() + ")") +
                      "; sfm needs at least 2 views of the page");
   }
   GroupCameras(&set);

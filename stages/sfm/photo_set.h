@@ -39,11 +39,12 @@ struct CameraGroup {
   double focal_prior = 0;  // COLMAP's focal length prior from it (copy pixels); 0 = none
 };
 
-// A file of images/ that is not used, and why ("not a photo", "damaged: the
-// file ends early").
+// A file or folder of images/ that is not used, and why ("not a photo",
+// "damaged: the file ends early", "a folder: ...").
 struct LeftOut {
-  std::string name;
+  std::string name;  // a folder's ends in '/'
   std::string reason;
+  bool folder = false;
 };
 
 struct PhotoSet {
@@ -53,14 +54,16 @@ struct PhotoSet {
 
   const PhotoCopy* Find(const std::string& name) const;  // by file name; nullptr if absent
   std::vector<std::string> Names() const;                // the photos' file names, in order
+  // "2 files left out", "1 file and 1 folder left out"; "" when nothing is.
+  std::string LeftOutSummary() const;
 };
 
 // Reads every file in <data_dir>/images (hidden files aside): each photo is
 // turned upright; when `copy_dir` is not empty its copy is written there, and
 // when `thumbnails` is given the copy scaled to a long side of at most 640 px
-// is appended. Files that are not photos or are damaged are left out, each
-// logged in one line. InputError when the folder is missing or fewer than 2
-// photos remain.
+// is appended. Files that are not photos or are damaged, and folders, are
+// left out, each logged in one line. InputError when the folder is missing or
+// fewer than 2 photos remain.
 PhotoSet PreparePhotos(const fs::path& data_dir, int max_image_size, const fs::path& copy_dir,
                        std::vector<cv::Mat>* thumbnails);
 

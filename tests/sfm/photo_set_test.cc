@@ -34,6 +34,9 @@ TEST(PreparePhotos, LeavesOutWhatIsNotAPhotoOrDamagedAndGroupsBySize) {
   cv::imwrite((tmp / "set/images/d.png").string(), Noise(300, 400));  // larger: scaled
   std::ofstream(tmp / "set/images/IMG_0001.AAE") << "<?xml version=\"1.0\"?><plist/>";
   std::ofstream(tmp / "set/images/.DS_Store") << "hidden";
+  fs::create_directories(tmp / "set/images/letter 2");  // a folder of photos: never read
+  cv::imwrite((tmp / "set/images/letter 2/f.jpg").string(), Noise(60, 80));
+  fs::create_directories(tmp / "set/images/.thumbnails");  // hidden: passed over
   {
     std::vector<uchar> jpeg;
     cv::imencode(".jpg", Noise(60, 80), jpeg);
@@ -44,11 +47,14 @@ TEST(PreparePhotos, LeavesOutWhatIsNotAPhotoOrDamagedAndGroupsBySize) {
   const sfm::PhotoSet set = sfm::PreparePhotos(tmp / "set", 200, tmp / "copies", &thumbnails);
   ASSERT_EQ(set.photos.size(), 4u);
   EXPECT_EQ(thumbnails.size(), 4u);
-  ASSERT_EQ(set.left_out.size(), 2u);
-  EXPECT_EQ(set.left_out[0].name, "IMG_0001.AAE");
-  EXPECT_EQ(set.left_out[0].reason, "not a photo");
-  EXPECT_EQ(set.left_out[1].name, "e.jpg");
-  EXPECT_EQ(set.left_out[1].reason, "damaged: the file ends early");
+  ASSERT_EQ(set.left_out.size(), 3u);
+  EXPECT_EQ(set.left_out[0].name, "letter 2/");
+  EXPECT_EQ(set.left_out[0].reason, "a folder: photos go directly in images/");
+  EXPECT_EQ(set.left_out[1].name, "IMG_0001.AAE");
+  EXPECT_EQ(set.left_out[1].reason, "not a photo");
+  EXPECT_EQ(set.left_out[2].name, "e.jpg");
+  EXPECT_EQ(set.left_out[2].reason, "damaged: the file ends early");
+  EXPECT_EQ(set.LeftOutSummary(), "2 files and 1 folder left out");
 
   const sfm::PhotoCopy& a = *set.Find("a b.jpg");
   EXPECT_EQ(a.colmap_name, "a_b.jpg");  // COLMAP reads it as it is, through a link
@@ -68,16 +74,25 @@ TEST(PreparePhotos, LeavesOutWhatIsNotAPhotoOrDamagedAndGroupsBySize) {
   EXPECT_EQ(a.group, c.group);
   EXPECT_NE(a.group, d.group);
 
+  // What PreparePhotos throws with too few photos left ("" if it does not).
+  auto error = [&] {
+    try {
+      sfm::PreparePhotos(tmp / "set", 200, "", nullptr);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
   fs::remove(tmp / "set/images/b.png");
   fs::remove(tmp / "set/images/b.jpg");
   fs::remove(tmp / "set/images/d.png");
-  try {
-    sfm::PreparePhotos(tmp / "set", 200, "", nullptr);
-    FAIL() << "one photo is not enough";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("1 photo (2 files left out)"), std::string::npos)
-        << e.what();
-  }
+  EXPECT_NE(error().find("1 photo (2 files and 1 folder left out)"), std::string::npos) << error();
+  // Every photo in folders: the error counts them (each is logged by name).
+  fs::remove(tmp / "set/images/a b.jpg");
+  fs::remove(tmp / "set/images/e.jpg");
+  fs::remove(tmp / "set/images/IMG_0001.AAE");
+  fs::create_directories(tmp / "set/images/letter 3");
+  EXPECT_NE(error().find("0 photos (2 folders left out)"), std::string::npos) << error();
   EXPECT_THROW(sfm::PreparePhotos(tmp / "nope", 200, "", nullptr), InputError);
 }
 
