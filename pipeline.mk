@@ -153,7 +153,7 @@ all: $(lastword $(IMPLEMENTED)) $(if $(wildcard $(ROOT)/stages/pdf),pdf) $(if $(
 	@echo "docunfold: $(NAME) done; results in $(WORK)$(if $(wildcard $(ROOT)/stages/report),; open $(WORK)/report.html)"
 
 check-data:
-	@test -n "$(DATA_DIR)" || { echo "pipeline.mk: DATA=$(DATA): no data set (looked for images/ in samples/$(DATA), data/$(DATA) and $(DATA))" >&2; exit 3; }
+	@test -n "$(DATA_DIR)" || { echo "pipeline.mk: DATA=$(DATA): no data set or folder of photos (looked in samples/$(DATA), data/$(DATA) and $(DATA))" >&2; exit 3; }
 
 SFM_OUT := $(addprefix $(WORK)/10_sfm/,cameras.json points.ply reference.png)
 sfm: check-data $(SFM_OUT)
@@ -294,7 +294,8 @@ help:
 	@echo
 	@echo "Variables:"
 	@echo "  DATA=set01     data set: samples/<DATA>, data/<DATA>, or a path (default set01;"
-	@echo "                 spaces, accents, . and .. work: DATA=\"My Scans/letter 1\")"
+	@echo "                 spaces, accents, . and .. work: DATA=\"My Scans/letter 1\"): a folder"
+	@echo "                 with the photos in its images/, or the folder of photos itself"
 	@echo "  WORK=dir       work directory (default work/<name>/)"
 	@echo "  WORK_ROOT=dir  where work directories go (default work/)"
 	@echo "  DATASETS=...   data sets for all-samples (default: every samples/*)"

@@ -129,7 +129,7 @@ PhotoSet PreparePhotos(const fs::path& data_dir, int max_image_size, const fs::p
   // exported them) would otherwise be passed over without a word.
   for (const fs::path& folder : data.folders) {
     set.left_out.push_back(
-        {folder.filename().string() + "/", "a folder: photos go directly in images/", true});
+        {folder.filename().string() + "/", "a folder: its photos are not read", true});
     Log("left out: " + set.left_out.back().name + " (" + set.left_out.back().reason + ")");
   }
   std::set<std::string> taken;

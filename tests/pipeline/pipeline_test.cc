@@ -158,5 +158,41 @@ TEST(PipelineInput, UnknownDataSetIsReported) {
   EXPECT_FALSE(fs::exists("/tmp/docunfold-none/10_sfm/cameras.json"));
 }
 
+// DATA may name a folder of photos without images/ (as a phone or an app
+// exports them; read where they are, through WORK/.photos/images) or a data
+// set's images/ folder (its data set). A dry run shows what sfm is given.
+TEST(PipelineInput, AFolderOfPhotosOrADataSetsImagesFolder) {
+  TempDir tmp;
+  const fs::path photos = tmp / "Letter 2";
+  fs::create_directories(photos);
+  for (const auto& entry : fs::directory_iterator(SampleDir(kSample) / "images"))
+    fs::copy_file(entry.path(), photos / entry.path().filename());
+  auto dry_run = [&](const fs::path& data) {
+    return RunCommand("make --no-print-directory -n -f " +
+                      Quote((SourceDir() / "pipeline.mk").string()) +
+                      " NO_BUILD=1 DATA=" + Quote(data.string()) +
+                      " WORK_ROOT=" + Quote((tmp / "work").string()) + " sfm");
+  };
+  CommandResult r = dry_run(photos);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const fs::path work = tmp / "work/Letter_2";
+  EXPECT_NE(r.output.find("--data " + (work / ".photos").string() + " "), std::string::npos)
+      << r.output;
+  EXPECT_EQ(fs::read_symlink(work / ".photos/images"), fs::canonical(photos));
+  EXPECT_EQ(std::distance(fs::directory_iterator(photos), fs::directory_iterator()),
+            std::distance(fs::directory_iterator(SampleDir(kSample) / "images"),
+                          fs::directory_iterator()))
+      << "nothing is written beside the photos";
+
+  r = dry_run(SampleDir(kSample) / "images");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("--data " + fs::canonical(SampleDir(kSample)).string() + " "),
+            std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("--out " + (tmp / "work" / kSample / "10_sfm").string()),
+            std::string::npos)
+      << r.output;
+}
+
 }  // namespace
 }  // namespace docunfold::testing

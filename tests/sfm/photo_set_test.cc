@@ -49,7 +49,7 @@ TEST(PreparePhotos, LeavesOutWhatIsNotAPhotoOrDamagedAndGroupsBySize) {
   EXPECT_EQ(thumbnails.size(), 4u);
   ASSERT_EQ(set.left_out.size(), 3u);
   EXPECT_EQ(set.left_out[0].name, "letter 2/");
-  EXPECT_EQ(set.left_out[0].reason, "a folder: photos go directly in images/");
+  EXPECT_EQ(set.left_out[0].reason, "a folder: its photos are not read");
   EXPECT_EQ(set.left_out[1].name, "IMG_0001.AAE");
   EXPECT_EQ(set.left_out[1].reason, "not a photo");
   EXPECT_EQ(set.left_out[2].name, "e.jpg");
