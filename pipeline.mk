@@ -30,7 +30,9 @@ WORK_ROOT ?= $(ROOT)/work
 DATA_RESOLVED := $(shell $(ROOT)/scripts/data-dir '$(ROOT)' '$(WORK_ROOT)' '$(subst ','\'',$(WORK))' '$(subst ','\'',$(DATA))')
 DATA_DIR := $(word 1,$(DATA_RESOLVED))
 NAME := $(word 2,$(DATA_RESOLVED))
-override WORK := $(or $(word 3,$(DATA_RESOLVED)),$(WORK_ROOT)/$(notdir $(DATA)))
+# (When DATA names nothing, check-data stops the run; WORK is then one word
+# all the same, so that a DATA with spaces cannot turn into stray targets.)
+override WORK := $(or $(word 3,$(DATA_RESOLVED)),$(WORK_ROOT)/$(lastword $(notdir $(DATA))))
 # The photos' names, sizes and times (names may have spaces, which Make's
 # prerequisites cannot): sfm and densify rerun when a photo changes.
 IMAGES_LIST := $(if $(DATA_DIR),$(shell cd '$(DATA_DIR)/images' && ls -lA --time-style=+%s | md5sum))
@@ -153,7 +155,7 @@ all: $(lastword $(IMPLEMENTED)) $(if $(wildcard $(ROOT)/stages/pdf),pdf) $(if $(
 	@echo "docunfold: $(NAME) done; results in $(WORK)$(if $(wildcard $(ROOT)/stages/report),; open $(WORK)/report.html)"
 
 check-data:
-	@test -n "$(DATA_DIR)" || { echo "pipeline.mk: DATA=$(DATA): no data set or folder of photos (looked in samples/$(DATA), data/$(DATA) and $(DATA))" >&2; exit 3; }
+	@test -n "$(DATA_DIR)" || { echo "pipeline.mk: DATA=$(DATA): no data set or folder of photos $(if $(filter /%,$(firstword $(DATA))),there,(looked in samples/ and data/ and from $(CURDIR)))" >&2; exit 3; }
 
 SFM_OUT := $(addprefix $(WORK)/10_sfm/,cameras.json points.ply reference.png)
 sfm: check-data $(SFM_OUT)

@@ -156,6 +156,15 @@ TEST(PipelineInput, UnknownDataSetIsReported) {
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.output.find("DATA=no-such-set: no data set"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists("/tmp/docunfold-none/10_sfm/cameras.json"));
+  // A path with spaces that names nothing: the one line, and no warnings
+  // from its words taken for targets.
+  r = RunCommand("make --no-print-directory -f " + Quote((SourceDir() / "pipeline.mk").string()) +
+                 " NO_BUILD=1 'DATA=/no such/letter 1' WORK_ROOT=/tmp/docunfold-none");
+  EXPECT_EQ(r.exit_code, 2) << r.output;  // make's own code for a failed recipe
+  EXPECT_NE(r.output.find("DATA=/no such/letter 1: no data set or folder of photos there"),
+            std::string::npos)
+      << r.output;
+  EXPECT_EQ(r.output.find("warning"), std::string::npos) << r.output;
 }
 
 // DATA may name a folder of photos without images/ (as a phone or an app
