@@ -120,6 +120,7 @@ void PhotosSection(const ReportOptions& o, const DataSet& data, const Json& came
   page->Section("photos", "Photos and the reference view");
   std::string reference = cameras.is_object() ? cameras.value("reference", "") : "";
   std::string html;
+  size_t photos = 0;
   for (const fs::path& p : data.images) {
     cv::Mat image;
     try {
@@ -127,6 +128,7 @@ void PhotosSection(const ReportOptions& o, const DataSet& data, const Json& came
     } catch (const InputError&) {
       continue;  // left out: listed below from cameras.json
     }
+    ++photos;
     const std::string name = p.filename().string();
     const bool is_ref = name == reference;
     std::string img = InlineImage(image, o.thumbnail_width, name);
@@ -177,7 +179,6 @@ void PhotosSection(const ReportOptions& o, const DataSet& data, const Json& came
     for (const Json& l : left_out_files)
       left_out += "<li>" + MarkupEscape(l.value("image", "?")) + " (" +
                   MarkupEscape(l.value("reason", "")) + ")</li>";
-    const size_t photos = data.images.size() - left_out_files.size();
     page->Add("<p>" + std::to_string(cameras.at("views").size()) + " of " + std::to_string(photos) +
               " photos registered. " + why + "</p>" +
               (left_out.empty() ? "" : "<p>Left out:</p><ul>" + left_out + "</ul>"));

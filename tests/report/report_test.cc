@@ -38,5 +38,30 @@ TEST(ReportRun, ShowsRendersWarningsAboveTheResult) {
   EXPECT_LT(warning, html.find("60_render/rectified.png ("));
 }
 
+// The photos count only what was read as a photo: a note and a folder sfm
+// left out are listed, not counted.
+TEST(ReportRun, CountsThePhotosAndListsWhatWasLeftOut) {
+  TempDir dir;
+  ReportOptions o;
+  o.data = dir / "data";
+  o.work = dir / "work";
+  o.out = dir / "work" / "report.html";
+  EnsureDirectory(o.data / "images" / "Edited");
+  for (const char* name : {"a.png", "b.png"})
+    WriteImageAtomic(o.data / "images" / name, cv::Mat3b(30, 40, cv::Vec3b(90, 120, 200)));
+  WriteTextAtomic(o.data / "images" / "note.txt", "not a photo");
+  EnsureDirectory(o.work / "10_sfm");
+  WriteJsonAtomic(o.work / "10_sfm" / "cameras.json",
+                  Json{{"reference", "a.png"},
+                       {"views", {{{"image", "a.png"}}}},
+                       {"left_out",
+                        {{{"image", "Edited/"}, {"reason", "a folder: its photos are not read"}},
+                         {{"image", "note.txt"}, {"reason", "not a photo"}}}}});
+  const std::string html = report::Run(o).html;
+  EXPECT_NE(html.find("1 of 2 photos registered."), std::string::npos);
+  EXPECT_NE(html.find("<li>Edited/ (a folder: its photos are not read)</li>"), std::string::npos);
+  EXPECT_NE(html.find("<li>note.txt (not a photo)</li>"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace docunfold::report
