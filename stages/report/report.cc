@@ -563,11 +563,16 @@ ReportResult Run(const ReportOptions& o) {
   const std::time_t now = std::time(nullptr);
   char date[64];
   std::strftime(date, sizeof date, "%Y-%m-%d %H:%M", std::localtime(&now));
-  const std::string name = fs::absolute(o.data).lexically_normal().filename().string();
+  // The photos' own folder, links resolved: pipeline.mk reaches a folder of
+  // photos through WORK/.photos/images, and a path Make cannot carry through
+  // WORK/.data. The report is named after the data set's folder, or that one.
+  fs::path photos = fs::canonical(o.data / "images", ec);
+  if (ec) photos = fs::absolute(o.data / "images").lexically_normal();
+  const fs::path named = photos.filename() == "images" ? photos.parent_path() : photos;
   ReportResult r;
-  r.html = page.Html("docunfold report: " + name,
-                     "Data set <code>" + MarkupEscape(fs::absolute(o.data).string()) + "</code>, " +
-                         std::to_string(data.images.size()) + " files in images/; made " + date +
+  r.html = page.Html("docunfold report: " + named.filename().string(),
+                     "Photos from <code>" + MarkupEscape(photos.string()) + "</code> (" +
+                         std::to_string(data.images.size()) + " files); made " + date +
                          " by docunfold " + ProgramVersion() + ".");
   return r;
 }

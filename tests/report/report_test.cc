@@ -38,18 +38,23 @@ TEST(ReportRun, ShowsRendersWarningsAboveTheResult) {
   EXPECT_LT(warning, html.find("60_render/rectified.png ("));
 }
 
-// The photos count only what was read as a photo: a note and a folder sfm
-// left out are listed, not counted.
-TEST(ReportRun, CountsThePhotosAndListsWhatWasLeftOut) {
+// A folder of photos as pipeline.mk passes it (WORK/.photos/images a link to
+// it): the report is named after that folder, and the photos count only what
+// was read as a photo: a note and a folder sfm left out are listed, not
+// counted.
+TEST(ReportRun, NamedAfterThePhotosFolderCountsThePhotosAndListsWhatWasLeftOut) {
   TempDir dir;
+  const fs::path folder = dir / "Letter 2";
   ReportOptions o;
-  o.data = dir / "data";
   o.work = dir / "work";
+  o.data = o.work / ".photos";
   o.out = dir / "work" / "report.html";
-  EnsureDirectory(o.data / "images" / "Edited");
+  EnsureDirectory(folder / "Edited");
+  EnsureDirectory(o.data);
+  fs::create_directory_symlink(folder, o.data / "images");
   for (const char* name : {"a.png", "b.png"})
-    WriteImageAtomic(o.data / "images" / name, cv::Mat3b(30, 40, cv::Vec3b(90, 120, 200)));
-  WriteTextAtomic(o.data / "images" / "note.txt", "not a photo");
+    WriteImageAtomic(folder / name, cv::Mat3b(30, 40, cv::Vec3b(90, 120, 200)));
+  WriteTextAtomic(folder / "note.txt", "not a photo");
   EnsureDirectory(o.work / "10_sfm");
   WriteJsonAtomic(o.work / "10_sfm" / "cameras.json",
                   Json{{"reference", "a.png"},
@@ -58,6 +63,9 @@ TEST(ReportRun, CountsThePhotosAndListsWhatWasLeftOut) {
                         {{{"image", "Edited/"}, {"reason", "a folder: its photos are not read"}},
                          {{"image", "note.txt"}, {"reason", "not a photo"}}}}});
   const std::string html = report::Run(o).html;
+  EXPECT_NE(html.find("<title>docunfold report: Letter 2</title>"), std::string::npos);
+  EXPECT_NE(html.find("Photos from <code>" + fs::canonical(folder).string() + "</code> (3 files)"),
+            std::string::npos);
   EXPECT_NE(html.find("1 of 2 photos registered."), std::string::npos);
   EXPECT_NE(html.find("<li>Edited/ (a folder: its photos are not read)</li>"), std::string::npos);
   EXPECT_NE(html.find("<li>note.txt (not a photo)</li>"), std::string::npos);
