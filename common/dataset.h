@@ -17,8 +17,8 @@ struct DataSet {
   // Every file in images/ but hidden ones, sorted by name: which are photos
   // the photo reader (photo.h) tells by their content.
   std::vector<fs::path> images;
-  // Folders in images/ (hidden ones aside), sorted: never read, so that a
-  // reader can say photos go directly in images/.
+  // Folders in images/ (hidden ones aside), sorted: never read, listed so
+  // that a reader can say they are left out.
   std::vector<fs::path> folders;
   bool has_ground_truth = false;
 

@@ -164,7 +164,10 @@ PhotoSet PreparePhotos(const fs::path& data_dir, int max_image_size, const fs::p
     progress.Update(long(i + 1));
   }
   if (set.photos.size() < 2) {
-    const fs::path images_dir = data_dir / "images";
+    // (links resolved: pipeline.mk reaches a folder of photos through one)
+    std::error_code ec;
+    fs::path images_dir = fs::canonical(data_dir / "images", ec);
+    if (ec) images_dir = data_dir / "images";
     throw InputError(images_dir.string() + ": " + std::to_string(set.photos.size()) + " photo" +
                      (set.photos.size() == 1 ? "" : "s") +
                      (set.left_out.empty() ? std::string() : " (" + set.LeftOutSummary() + ")") +
