@@ -1,6 +1,7 @@
 // The Snakemake workflow (workflow/Snakefile) on a real single-node Slurm
-// cluster started for the test: a sample and a data set with a broken photo
-// submitted through the Slurm profile, each data set one Slurm job.
+// cluster started for the test: a sample's photos in a plain folder and a data
+// set with a broken photo submitted through the Slurm profile, each data set
+// one Slurm job.
 #include <gtest/gtest.h>
 
 #include <opencv2/core.hpp>
@@ -33,14 +34,15 @@ TEST(Workflow, SlurmRunsEachDataSetAsAJob) {
   if (RunCommand("command -v snakemake > /dev/null").exit_code != 0)
     GTEST_SKIP() << "snakemake is missing (Debian: snakemake)";
 
-  // A sample's images only (no ground truth: no evaluate, a shorter run), so
-  // its result must equal the e2e run's of the same photos. One sample: each
-  // more is another whole pipeline run in CI's half hour.
+  // A sample's photos only, in a plain folder as a phone exports them (no
+  // images/; no ground truth: no evaluate, a shorter run), so its result must
+  // equal the e2e run's of the same photos. One sample: each more is another
+  // whole pipeline run in CI's half hour.
   const std::vector<std::string> samples = {"set07"};
   std::string sets;
   for (const std::string& s : samples) {
     fs::create_directories(dir / "sets" / s);
-    fs::copy(SampleDir(s) / "images", dir / "sets" / s / "images");
+    fs::copy(SampleDir(s) / "images", dir / "sets" / s);
     sets += (dir / "sets" / s).string() + ",";
   }
   sets += BrokenDataSet(dir / "sets").string();
