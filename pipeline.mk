@@ -155,7 +155,9 @@ all: $(lastword $(IMPLEMENTED)) $(if $(wildcard $(ROOT)/stages/pdf),pdf) $(if $(
 	@echo "docunfold: $(NAME) done; results in $(WORK)$(if $(wildcard $(ROOT)/stages/report),; open $(WORK)/report.html)"
 
 check-data:
-	@test -n "$(DATA_DIR)" || { echo "pipeline.mk: DATA=$(DATA): no data set or folder of photos $(if $(filter /%,$(firstword $(DATA))),there,(looked in samples/ and data/ and from $(CURDIR)))" >&2; exit 3; }
+	@test -n "$(DATA_DIR)" || { if test -d '$(subst ','\'',$(DATA))'; then \
+	  echo "pipeline.mk: DATA=$(DATA): no photos in it (a run takes one document's photos; for a folder of such folders: all-samples DATASETS=\"...\" or the workflow's sets_dir=)"; else \
+	  echo "pipeline.mk: DATA=$(DATA): no data set or folder of photos $(if $(filter /%,$(firstword $(DATA))),there,(looked in samples/ and data/ and from $(CURDIR)))"; fi >&2; exit 3; }
 
 SFM_OUT := $(addprefix $(WORK)/10_sfm/,cameras.json points.ply reference.png)
 sfm: check-data $(SFM_OUT)

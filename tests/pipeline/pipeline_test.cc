@@ -169,7 +169,8 @@ TEST(PipelineInput, UnknownDataSetIsReported) {
 
 // DATA may name a folder of photos without images/ (as a phone or an app
 // exports them; read where they are, through WORK/.photos/images) or a data
-// set's images/ folder (its data set). A dry run shows what sfm is given.
+// set's images/ folder (its data set). A dry run shows what sfm is given. A
+// folder of folders is refused in one line.
 TEST(PipelineInput, AFolderOfPhotosOrADataSetsImagesFolder) {
   TempDir tmp;
   const fs::path photos = tmp / "Letter 2";
@@ -199,6 +200,17 @@ TEST(PipelineInput, AFolderOfPhotosOrADataSetsImagesFolder) {
             std::string::npos)
       << r.output;
   EXPECT_NE(r.output.find("--out " + (tmp / "work" / kSample / "10_sfm").string()),
+            std::string::npos)
+      << r.output;
+
+  // A box of documents (folders only): one line saying what a run takes.
+  fs::create_directories(tmp / "box/letter 3");
+  fs::rename(photos, tmp / "box" / photos.filename());
+  r = RunCommand("make --no-print-directory -f " + Quote((SourceDir() / "pipeline.mk").string()) +
+                 " NO_BUILD=1 DATA=" + Quote((tmp / "box").string()) +
+                 " WORK_ROOT=" + Quote((tmp / "work").string()) + " sfm");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("box: no photos in it (a run takes one document's photos;"),
             std::string::npos)
       << r.output;
 }
