@@ -15,6 +15,8 @@ DataSet OpenDataSet(const fs::path& root) {
                      ": missing (a data set keeps its photos in images/)");
   DataSet set;
   set.root = root;
+  set.photos_dir = fs::canonical(root / "images", ec);
+  if (ec) set.photos_dir = fs::absolute(root / "images").lexically_normal();
   for (const auto& entry : fs::directory_iterator(root / "images", ec)) {
     if (entry.path().filename().string().rfind('.', 0) == 0) continue;
     if (entry.is_regular_file())

@@ -14,6 +14,10 @@ namespace fs = std::filesystem;
 
 struct DataSet {
   fs::path root;
+  // The photos' own folder: root/images with links resolved (pipeline.mk
+  // reaches a plain folder of photos through a link), absolute; what a
+  // message or a report names as where the photos are.
+  fs::path photos_dir;
   // Every file in images/ but hidden ones, sorted by name: which are photos
   // the photo reader (photo.h) tells by their content.
   std::vector<fs::path> images;

@@ -563,11 +563,10 @@ ReportResult Run(const ReportOptions& o) {
   const std::time_t now = std::time(nullptr);
   char date[64];
   std::strftime(date, sizeof date, "%Y-%m-%d %H:%M", std::localtime(&now));
-  // The photos' own folder, links resolved: pipeline.mk reaches a folder of
-  // photos through WORK/.photos/images, and a path Make cannot carry through
-  // WORK/.data. The report is named after the data set's folder, or that one.
-  fs::path photos = fs::canonical(o.data / "images", ec);
-  if (ec) photos = fs::absolute(o.data / "images").lexically_normal();
+  // pipeline.mk reaches a folder of photos through WORK/.photos/images, and a
+  // path Make cannot carry through WORK/.data: the report is named after the
+  // data set's folder, or the photos' own folder.
+  const fs::path& photos = data.photos_dir;
   const fs::path named = photos.filename() == "images" ? photos.parent_path() : photos;
   ReportResult r;
   r.html = page.Html("docunfold report: " + named.filename().string(),

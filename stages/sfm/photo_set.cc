@@ -110,8 +110,8 @@ std::vector<std::string> PhotoSet::Names() const {
 }
 
 std::string PhotoSet::LeftOutSummary() const {
-  const auto folders = size_t(
-      std::count_if(left_out.begin(), left_out.end(), [](const LeftOut& l) { return l.folder; }));
+  const auto folders = size_t(std::count_if(left_out.begin(), left_out.end(),
+                                            [](const LeftOut& l) { return l.IsFolder(); }));
   const size_t files = left_out.size() - folders;
   auto count = [](size_t n, const std::string& what) {
     return std::to_string(n) + " " + what + (n == 1 ? "" : "s");
@@ -128,8 +128,7 @@ PhotoSet PreparePhotos(const fs::path& data_dir, int max_image_size, const fs::p
   // A folder of photos inside images/ (one per document, or as a phone
   // exported them) would otherwise be passed over without a word.
   for (const fs::path& folder : data.folders) {
-    set.left_out.push_back(
-        {folder.filename().string() + "/", "a folder: its photos are not read", true});
+    set.left_out.push_back({folder.filename().string() + "/", "a folder: its photos are not read"});
     Log("left out: " + set.left_out.back().name + " (" + set.left_out.back().reason + ")");
   }
   std::set<std::string> taken;
@@ -164,12 +163,8 @@ PhotoSet PreparePhotos(const fs::path& data_dir, int max_image_size, const fs::p
     progress.Update(long(i + 1));
   }
   if (set.photos.size() < 2) {
-    // (links resolved: pipeline.mk reaches a folder of photos through one)
-    std::error_code ec;
-    fs::path images_dir = fs::canonical(data_dir / "images", ec);
-    if (ec) images_dir = data_dir / "images";
-    throw InputError(images_dir.string() + ": " + std::to_string(set.photos.size()) + " photo" +
-                     (set.photos.size() == 1 ? "" : "s") +
+    throw InputError(data.photos_dir.string() + ": " + std::to_string(set.photos.size()) +
+                     " photo" + (set.photos.size() == 1 ? "" : "s") +
                      (set.left_out.empty() ? std::string() : " (" + set.LeftOutSummary() + ")") +
                      "; sfm needs at least 2 views of the page");
   }

@@ -44,7 +44,8 @@ struct CameraGroup {
 struct LeftOut {
   std::string name;  // a folder's ends in '/'
   std::string reason;
-  bool folder = false;
+
+  bool IsFolder() const { return !name.empty() && name.back() == '/'; }
 };
 
 struct PhotoSet {
