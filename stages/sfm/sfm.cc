@@ -362,9 +362,8 @@ SfmResult RunSfm(const SfmOptions& o, const Json& options_record) {
     Log(std::to_string(photos.groups.size()) +
         " cameras (photos of different sizes or from different phones)");
   if (!o.reference.empty() && !photos.Find(o.reference))
-    throw InputError("--ref " + o.reference + ": no such photo in " +
-                     (o.data_dir / "images").string() + " (there are " + JoinNames(photos.Names()) +
-                     ")");
+    throw InputError("--ref " + o.reference + ": no such photo in " + photos.dir.string() +
+                     " (there are " + JoinNames(photos.Names()) + ")");
 
   colmap.exe = FindExecutable(o.colmap);
   if (colmap.exe.empty()) throw std::runtime_error(Colmap::NotFoundMessage(o.colmap));
@@ -381,8 +380,8 @@ SfmResult RunSfm(const SfmOptions& o, const Json& options_record) {
   result.attempts = mapping.attempts;
   result.seconds_mapping = timer.Mark("mapping");
   if (!mapping.found)
-    throw InputError("COLMAP could not reconstruct " + (o.data_dir / "images").string() +
-                     ": no two of the " + std::to_string(n) +
+    throw InputError("COLMAP could not reconstruct " + photos.dir.string() + ": no two of the " +
+                     std::to_string(n) +
                      " photos share enough matching features (fewer than 2 views "
                      "registered)");
   KeepModel(colmap, mapping.model_dir);

@@ -7,6 +7,7 @@
 
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <random>
 
 #include "common/camera.h"
@@ -46,7 +47,9 @@ TEST(PreparePhotos, LeavesOutWhatIsNotAPhotoOrDamagedAndGroupsBySize) {
   std::vector<cv::Mat> thumbnails;
   const sfm::PhotoSet set = sfm::PreparePhotos(tmp / "set", 200, tmp / "copies", &thumbnails);
   ASSERT_EQ(set.photos.size(), 4u);
-  EXPECT_EQ(thumbnails.size(), 4u);
+  ASSERT_EQ(thumbnails.size(), 4u);
+  EXPECT_EQ(thumbnails[3].cols, 200);  // in the photos' order: d.png's copy is the larger
+  EXPECT_EQ(thumbnails[0].cols, 80);
   ASSERT_EQ(set.left_out.size(), 3u);
   EXPECT_EQ(set.left_out[0].name, "letter 2/");
   EXPECT_EQ(set.left_out[0].reason, "a folder: its photos are not read");
@@ -94,6 +97,35 @@ TEST(PreparePhotos, LeavesOutWhatIsNotAPhotoOrDamagedAndGroupsBySize) {
   fs::create_directories(tmp / "set/images/letter 3");
   EXPECT_NE(error().find("0 photos (2 folders left out)"), std::string::npos) << error();
   EXPECT_THROW(sfm::PreparePhotos(tmp / "nope", 200, "", nullptr), InputError);
+}
+
+// The same shot saved twice (a file copied, or kept as HEIC and as JPEG) is
+// one view: the second file is left out, naming the first. A view taken a
+// few centimetres aside is not the same photo.
+TEST(PreparePhotos, ASecondFileOfTheSamePhotoIsLeftOut) {
+  TempDir tmp;
+  fs::create_directories(tmp / "set/images");
+  cv::Mat page(600, 800, CV_8UC3, cv::Scalar(60, 90, 120));
+  cv::rectangle(page, {150, 100, 500, 400}, cv::Scalar(235, 235, 230), cv::FILLED);
+  for (int y = 140; y < 460; y += 24) cv::line(page, {190, y}, {610, y}, cv::Scalar(30, 30, 30), 3);
+  cv::GaussianBlur(page, page, {5, 5}, 0);
+  cv::imwrite((tmp / "set/images/IMG_0001.png").string(), page);
+  cv::imwrite((tmp / "set/images/IMG_0001.jpg").string(), page, {cv::IMWRITE_JPEG_QUALITY, 80});
+  fs::copy_file(tmp / "set/images/IMG_0001.png", tmp / "set/images/IMG_0001 (1).png");
+  cv::Mat aside;
+  cv::warpAffine(page, aside, cv::Mat(cv::Matx23d(1, 0, 40, 0, 1, 25)), page.size(),
+                 cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+  cv::imwrite((tmp / "set/images/IMG_0002.jpg").string(), aside);
+
+  const sfm::PhotoSet set = sfm::PreparePhotos(tmp / "set", 400, "", nullptr);
+  // The original is kept (the shorter name; of equal ones the first).
+  EXPECT_EQ(set.Names(), (std::vector<std::string>{"IMG_0001.jpg", "IMG_0002.jpg"}));
+  ASSERT_EQ(set.left_out.size(), 2u);
+  EXPECT_EQ(set.left_out[0].name, "IMG_0001 (1).png");
+  EXPECT_EQ(set.left_out[0].reason, "the same photo as IMG_0001.jpg");
+  EXPECT_EQ(set.left_out[1].name, "IMG_0001.png");
+  EXPECT_EQ(set.left_out[1].reason, "the same photo as IMG_0001.jpg");
+  EXPECT_EQ(set.dir, fs::canonical(tmp / "set/images"));
 }
 
 // A point COLMAP sees at pixel c of a turned and scaled copy is where the
