@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <fstream>
+#include <map>
 #include <random>
 #include <regex>
 
@@ -222,6 +223,31 @@ void MatchFeatures(const Colmap& colmap, const PhotoSet& photos) {
   }
 }
 
+void ChooseLinkedViews(const PhotoSet& photos, Colmap* colmap) {
+  // COLMAP's own least number of verified matches for a pair of views
+  // (SiftMatchingOptions::min_num_inliers).
+  constexpr int kMinVerifiedMatches = 15;
+  const auto groups = ViewsLinkedByMatches(colmap->database, kMinVerifiedMatches);
+  // (not one pair linked: the mapper fails and says so)
+  if (groups.size() < 2 || groups.front().size() < 2) return;
+  std::map<std::string, std::string> photo_of;  // copy's name -> photo's name
+  for (const PhotoCopy& p : photos.photos) photo_of[p.colmap_name] = p.name;
+  std::string list;
+  for (size_t i = 0; i < groups.size(); ++i)
+    list += (i ? "; " : "") + photo_of[groups[i].front()] +
+            (groups[i].size() > 1 ? " and " + std::to_string(groups[i].size() - 1) + " more"
+                                  : std::string());
+  Log("the photos fall into " + std::to_string(groups.size()) +
+      " groups with no features in common (a page each, or photos of something else): " + list +
+      "; mapping the first (one run takes one page's photos)");
+  colmap->mapped = groups.front();
+  const fs::path list_file = colmap->dir / "mapped_images.txt";
+  std::ofstream out(list_file);
+  for (const std::string& name : colmap->mapped) out << name << '\n';
+  out.close();
+  if (!out) throw OutputError(list_file.string() + ": write failed");
+}
+
 namespace {
 
 // Largest model (most registered images, then most points) among
@@ -280,11 +306,17 @@ bool KeepExifFocal(const PhotoSet& photos) {
 constexpr double kPhoneFocal35mm = 26;
 constexpr double kPhoneFocalFactor = 1.4;
 
+std::vector<std::string> Joined(std::vector<std::string> a, const std::vector<std::string>& b) {
+  a.insert(a.end(), b.begin(), b.end());
+  return a;
+}
+
 // Judges the model an attempt made: every view registered, a plausible
 // focal length, enough points.
-void JudgeModel(const ColmapModel& m, const PhotoSet& photos, const SfmOptions& o,
+void JudgeModel(const ColmapModel& m, const Colmap& colmap, const PhotoSet& photos,
                 const MapperSetting& s, MapperAttempt* attempt) {
-  const int n = int(photos.photos.size());
+  const SfmOptions& o = *colmap.options;
+  const int n = int(colmap.mapped.empty() ? photos.photos.size() : colmap.mapped.size());
   attempt->produced_model = true;
   attempt->registered = int(m.images.size());
   attempt->points = int(m.points.size());
@@ -344,13 +376,22 @@ MapperAttempt RunMapper(const Colmap& colmap, const PhotoSet& photos, const Mapp
   const std::regex registering(R"(Registering image #\d+ \((\d+)\))");
   long registered_so_far = 2;
   auto last_log = std::chrono::steady_clock::now();
+  // (From photos it cannot join to its first model the mapper builds one
+  // model per initial pair and drops each below 10 views: 10 minutes on two
+  // pages' photos. It is given only the views that can join; further models
+  // stay allowed, for set01's first is a poor one.)
+  std::vector<std::string> image_list;
+  if (!colmap.mapped.empty())
+    image_list = {"--image_list_path", (colmap.dir / "mapped_images.txt").string()};
   const SubprocessResult run = colmap.Run(
       "mapper",
-      {"--database_path", colmap.database.string(), "--image_path", colmap.image_dir.string(),
-       "--output_path", dir.string(), "--Mapper.num_threads", colmap.threads,
-       "--Mapper.ba_refine_extra_params", s.refine ? "1" : "0", "--Mapper.ba_refine_focal_length",
-       s.refine_focal ? "1" : "0", "--Mapper.filter_max_reproj_error", Fixed(s.filter, 3),
-       "--Mapper.tri_ignore_two_view_tracks", o.two_view_tracks ? "0" : "1"},
+      Joined({"--database_path", colmap.database.string(), "--image_path",
+              colmap.image_dir.string(), "--output_path", dir.string(), "--Mapper.num_threads",
+              colmap.threads, "--Mapper.ba_refine_extra_params", s.refine ? "1" : "0",
+              "--Mapper.ba_refine_focal_length", s.refine_focal ? "1" : "0",
+              "--Mapper.filter_max_reproj_error", Fixed(s.filter, 3),
+              "--Mapper.tri_ignore_two_view_tracks", o.two_view_tracks ? "0" : "1"},
+             image_list),
       "mapper.log",
       [&](const std::string& line) {
         std::smatch match;
@@ -365,7 +406,7 @@ MapperAttempt RunMapper(const Colmap& colmap, const PhotoSet& photos, const Mapp
       /*throw_on_failure=*/false);
   attempt.seconds = run.seconds;
   if (ReadBestModel(dir, m, m_dir)) {
-    JudgeModel(*m, photos, o, s, &attempt);
+    JudgeModel(*m, colmap, photos, s, &attempt);
   } else {
     attempt.problem = run.timed_out ? "stopped after the time limit"
                                     : "no model (no initial pair of views found)";

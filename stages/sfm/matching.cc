@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <stdexcept>
@@ -105,6 +106,48 @@ void NumberImagesByName(const fs::path& database) {
     sqlite3_free(error);
     throw std::runtime_error(database.string() + ": renumbering the images: " + why);
   }
+}
+
+std::vector<std::vector<std::string>> ViewsLinkedByMatches(const fs::path& database,
+                                                           int min_inliers) {
+  const Database db = OpenDatabase(database, SQLITE_OPEN_READONLY);
+  std::map<long, std::string> names;
+  {
+    const Statement stmt = Prepare(db, database, "SELECT image_id, name FROM images");
+    while (sqlite3_step(stmt.get()) == SQLITE_ROW)
+      names[sqlite3_column_int64(stmt.get(), 0)] =
+          reinterpret_cast<const char*>(sqlite3_column_text(stmt.get(), 1));
+  }
+  std::map<long, long> parent;  // union-find over image ids
+  for (const auto& [id, name] : names) parent[id] = id;
+  auto root = [&](long id) {
+    while (parent[id] != id) id = parent[id] = parent[parent[id]];
+    return id;
+  };
+  {
+    // COLMAP's pair id is id1 * 2147483647 + id2 (id1 < id2); config 2 and
+    // up is a verified geometry (0 undefined, 1 degenerate).
+    const Statement stmt = Prepare(
+        db, database, "SELECT pair_id FROM two_view_geometries WHERE config >= 2 AND rows >= ?");
+    sqlite3_bind_int(stmt.get(), 1, min_inliers);
+    constexpr long kPairBase = 2147483647;
+    while (sqlite3_step(stmt.get()) == SQLITE_ROW) {
+      const long pair = sqlite3_column_int64(stmt.get(), 0);
+      const long a = pair / kPairBase, b = pair % kPairBase;
+      if (parent.count(a) && parent.count(b)) parent[root(a)] = root(b);
+    }
+  }
+  std::map<long, std::vector<std::string>> by_root;
+  for (const auto& [id, name] : names) by_root[root(id)].push_back(name);
+  std::vector<std::vector<std::string>> groups;
+  for (auto& [id, group] : by_root) {
+    std::sort(group.begin(), group.end());
+    groups.push_back(std::move(group));
+  }
+  std::sort(groups.begin(), groups.end(), [](const auto& a, const auto& b) {
+    return a.size() != b.size() ? a.size() > b.size() : a.front() < b.front();
+  });
+  return groups;
 }
 
 void SetMissingFocalPriors(const fs::path& database, double focal_35mm) {

@@ -39,6 +39,15 @@ void NumberImagesByName(const fs::path& database);
 // naming the database when it cannot be changed.
 void SetMissingFocalPriors(const fs::path& database, double focal_35mm);
 
+// The images of a COLMAP database (their names) in groups: two are in one
+// group when a chain of pairs links them, each pair with at least
+// `min_inliers` matches COLMAP verified. Photos of two pages, or a photo of
+// something else, fall into groups the mapper cannot join. Each group sorted
+// by name; the groups by size, largest first, then by their first name.
+// Throws std::runtime_error naming the database when it cannot be read.
+std::vector<std::vector<std::string>> ViewsLinkedByMatches(const fs::path& database,
+                                                           int min_inliers);
+
 // Every image of a COLMAP database with its descriptors, by image id.
 // Throws std::runtime_error naming the database when it cannot be read.
 std::vector<ImageDescriptors> ReadDatabaseDescriptors(const fs::path& database);

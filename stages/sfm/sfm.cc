@@ -375,6 +375,7 @@ SfmResult RunSfm(const SfmOptions& o, const Json& options_record) {
   ExtractFeatures(colmap, photos);
   result.seconds_extracting = timer.Mark("extracting");
   MatchFeatures(colmap, photos);
+  ChooseLinkedViews(photos, &colmap);
   result.seconds_matching = timer.Mark("matching");
   Mapping mapping = MapWithRetries(colmap, photos);
   result.attempts = mapping.attempts;

@@ -46,6 +46,10 @@ struct Colmap {
   fs::path database;    // <dir>/database.db
   fs::path image_dir;   // <dir>/images: the photos' copies (photo_set.h)
   std::string threads;  // --threads as COLMAP takes it
+  // When the photos fall into groups with no features in common, the copies
+  // of the largest, which alone the mapper is given (listed in
+  // <dir>/mapped_images.txt); empty: every photo.
+  std::vector<std::string> mapped;
 
   // Runs one COLMAP command, its output into <dir>/<log>; throws when it
   // fails (except for the mapper, whose failure the caller judges).
@@ -63,6 +67,11 @@ void ExtractFeatures(const Colmap& colmap, const PhotoSet& photos);
 // Matches between every pair of photos: exact nearest neighbours
 // (matching.h) verified by COLMAP, or COLMAP's own exhaustive matcher.
 void MatchFeatures(const Colmap& colmap, const PhotoSet& photos);
+
+// Groups the photos by the matches COLMAP verified between them: when they
+// fall into more than one group (photos of two pages, or of something else),
+// says so in one line and leaves the mapper the largest (Colmap::mapped).
+void ChooseLinkedViews(const PhotoSet& photos, Colmap* colmap);
 
 // What the mapper made, over its attempts.
 struct Mapping {

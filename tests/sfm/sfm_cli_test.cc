@@ -296,8 +296,12 @@ TEST_F(SfmCli, RefNotRegistered) {
   cv::imwrite((data / "images" / "zz_noise.jpg").string(), Noise(sample.cols, sample.rows, 3));
   const fs::path out = tmp_ / "work" / "10_sfm";
   fs::create_directories(out.parent_path());
-  ExpectFailure(Sfm(Args(data, out, "--threads 2 --ref zz_noise.jpg")), 3, "could not register",
-                out, {});
+  const CommandResult r = Sfm(Args(data, out, "--threads 2 --ref zz_noise.jpg"));
+  ExpectFailure(r, 3, "could not register", out, {});
+  // It shares no features with the page's photos: the mapper is not given it.
+  EXPECT_NE(r.output.find("2 groups with no features in common"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find(" and 2 more; zz_noise.jpg; mapping the first"), std::string::npos)
+      << r.output;
 }
 
 TEST_F(SfmCli, TooFewPoints) {

@@ -648,6 +648,47 @@ TEST(ExactMatchingTest, ImagesAreNumberedByNameWithTheirFeatures) {
   EXPECT_EQ(keypoints, (std::vector<std::string>{"1:02", "2:03", "3:01"}));
 }
 
+// Photos of two pages in one folder, and one photo of something else: the
+// pairs COLMAP verified (15 matches and up, a geometry) link them into
+// groups, largest first; a pair it found degenerate or too weak links none.
+TEST(ExactMatchingTest, ViewsLinkedByVerifiedMatchesFallIntoGroups) {
+  TempDir tmp;
+  const fs::path db = tmp.path() / "database.db";
+  MakeDatabase(db, {{1, "a0.jpg"},
+                    {2, "a1.jpg"},
+                    {3, "a2.jpg"},
+                    {4, "b0.jpg"},
+                    {5, "b1.jpg"},
+                    {6, "b2.jpg"},
+                    {7, "cat.jpg"}});
+  std::string sql =
+      "CREATE TABLE two_view_geometries (pair_id INTEGER PRIMARY KEY NOT NULL, rows INTEGER NOT "
+      "NULL, cols INTEGER NOT NULL, data BLOB, config INTEGER NOT NULL);";
+  auto pair = [&](long a, long b, int rows, int config) {
+    sql += "INSERT INTO two_view_geometries VALUES (" + std::to_string(a * 2147483647L + b) + ", " +
+           std::to_string(rows) + ", 2, NULL, " + std::to_string(config) + ");";
+  };
+  pair(1, 2, 400, 6);  // a0-a1-a2: a chain
+  pair(2, 3, 15, 3);
+  pair(1, 3, 0, 1);
+  pair(4, 5, 900, 2);  // b0-b1, b1-b2
+  pair(5, 6, 300, 4);
+  pair(3, 4, 14, 3);  // too few to link a page to the other
+  pair(6, 7, 80, 1);  // degenerate: no link
+  sqlite3* raw = nullptr;
+  ASSERT_EQ(sqlite3_open(db.c_str(), &raw), SQLITE_OK);
+  ASSERT_EQ(sqlite3_exec(raw, sql.c_str(), nullptr, nullptr, nullptr), SQLITE_OK);
+  sqlite3_close(raw);
+  using Groups = std::vector<std::vector<std::string>>;
+  EXPECT_EQ(sfm::ViewsLinkedByMatches(db, 15),
+            (Groups{{"a0.jpg", "a1.jpg", "a2.jpg"}, {"b0.jpg", "b1.jpg", "b2.jpg"}, {"cat.jpg"}}));
+  EXPECT_EQ(sfm::ViewsLinkedByMatches(db, 14),
+            (Groups{{"a0.jpg", "a1.jpg", "a2.jpg", "b0.jpg", "b1.jpg", "b2.jpg"}, {"cat.jpg"}}));
+  EXPECT_EQ(
+      sfm::ViewsLinkedByMatches(db, 500),
+      (Groups{{"b0.jpg", "b1.jpg"}, {"a0.jpg"}, {"a1.jpg"}, {"a2.jpg"}, {"b2.jpg"}, {"cat.jpg"}}));
+}
+
 TEST(ExactMatchingTest, BadDatabasesAreErrorsNamingTheFile) {
   TempDir tmp;
   const fs::path db = tmp.path() / "short.db";
