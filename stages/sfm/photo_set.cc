@@ -105,8 +105,8 @@ const Likeness* SamePhotoAs(const Likeness& l, const std::vector<Likeness>& earl
   return nullptr;
 }
 
-// Puts the photos (and their thumbnails) in name order, and what was left out
-// too, folders first.
+// Puts the photos in name order, with their thumbnails (the last ones of
+// `thumbnails`, in the order read), and what was left out, folders first.
 void SortByName(PhotoSet* set, std::vector<cv::Mat>* thumbnails) {
   std::vector<size_t> index(set->photos.size());
   std::iota(index.begin(), index.end(), size_t(0));

@@ -63,9 +63,10 @@ struct PhotoSet {
 // Reads every file in <data_dir>/images (hidden files aside): each photo is
 // turned upright; when `copy_dir` is not empty its copy is written there, and
 // when `thumbnails` is given the copy scaled to a long side of at most 640 px
-// is appended. Files that are not photos or are damaged, a second file of the
-// same photo, and folders are left out, each logged in one line. InputError when the folder is
-// missing or fewer than 2 photos remain.
+// is appended, in the photos' order. Files that are not photos or are
+// damaged, a second file of the same photo, and folders are left out, each
+// logged in one line. InputError when the folder is missing or fewer than 2
+// photos remain.
 PhotoSet PreparePhotos(const fs::path& data_dir, int max_image_size, const fs::path& copy_dir,
                        std::vector<cv::Mat>* thumbnails);
 
