@@ -224,8 +224,8 @@ void MatchFeatures(const Colmap& colmap, const PhotoSet& photos) {
 }
 
 void ChooseLinkedViews(const PhotoSet& photos, Colmap* colmap) {
-  // COLMAP's own least number of verified matches for a pair of views
-  // (SiftMatchingOptions::min_num_inliers).
+  // The mapper's own floor (Mapper.min_num_matches): it ignores pairs of
+  // views with fewer verified matches, so no model joins views across groups.
   constexpr int kMinVerifiedMatches = 15;
   const auto groups = ViewsLinkedByMatches(colmap->database, kMinVerifiedMatches);
   // (not one pair linked: the mapper fails and says so)
