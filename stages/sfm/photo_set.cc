@@ -235,10 +235,13 @@ PhotoSet PreparePhotos(const fs::path& data_dir, int max_image_size, const fs::p
   }
   SortByName(&set, thumbnails);
   if (set.photos.size() < 2) {
+    // (a box of documents, a folder of photos each, with a note beside them)
+    const bool in_folders = set.photos.empty() && !data.folders.empty();
     throw InputError(set.dir.string() + ": " + std::to_string(set.photos.size()) + " photo" +
                      (set.photos.size() == 1 ? "" : "s") +
                      (set.left_out.empty() ? std::string() : " (" + set.LeftOutSummary() + ")") +
-                     "; sfm needs at least 2 views of the page");
+                     "; sfm needs at least 2 views of the page" +
+                     (in_folders ? " (a run reads no folder in it: give it one of them)" : ""));
   }
   GroupCameras(&set);
   return set;
