@@ -116,12 +116,27 @@ std::map<std::string, Json> StageTimings(const fs::path& work) {
   return out;
 }
 
+// True when the array at `pointer` in `doc` holds `name`, as a string or as
+// an object's "image".
+bool Lists(const Json& doc, const char* pointer, const std::string& name) {
+  const Json::json_pointer at(pointer);
+  if (!doc.is_object() || !doc.contains(at) || !doc[at].is_array()) return false;
+  for (const Json& e : doc[at])
+    if ((e.is_string() && e.get<std::string>() == name) ||
+        (e.is_object() && e.value("image", "") == name))
+      return true;
+  return false;
+}
+
 void PhotosSection(const ReportOptions& o, const DataSet& data, const Json& cameras, Page* page) {
   page->Section("photos", "Photos and the reference view");
   std::string reference = cameras.is_object() ? cameras.value("reference", "") : "";
   std::string html;
   size_t photos = 0;
   for (const fs::path& p : data.images) {
+    const std::string name = p.filename().string();
+    // (a second file of a photo: listed below with what sfm left out)
+    if (Lists(cameras, "/left_out", name)) continue;
     cv::Mat image;
     try {
       image = ReadPhoto(p).image;
@@ -129,7 +144,6 @@ void PhotosSection(const ReportOptions& o, const DataSet& data, const Json& came
       continue;  // left out: listed below from cameras.json
     }
     ++photos;
-    const std::string name = p.filename().string();
     const bool is_ref = name == reference;
     std::string img = InlineImage(image, o.thumbnail_width, name);
     if (is_ref) img.insert(4, " class=\"ref\"");
@@ -137,8 +151,13 @@ void PhotosSection(const ReportOptions& o, const DataSet& data, const Json& came
     if (cameras.is_object())
       for (const Json& v : cameras.at("views"))
         registered = registered || v.value("image", "") == name;
+    const bool apart = Lists(cameras, "/colmap/not_mapped", name);
     html += Figure(img, MarkupEscape(name) + (is_ref ? " — <b>reference</b>" : "") +
-                            (cameras.is_object() && !registered ? " — not registered" : ""));
+                            (cameras.is_object() && !registered
+                                 ? apart ? " — not registered (no features in common with the "
+                                           "registered ones: another page?)"
+                                         : " — not registered"
+                                 : ""));
   }
   page->Add(html);
   if (!cameras.is_object()) {

@@ -221,15 +221,12 @@ Json CamerasJson(const SfmResult& r, const Json& options_record) {
                        {"focal_prior_px", group.focal_prior},
                        {"images", images}});
   }
-  doc["colmap"] = {{"camera_model", r.camera_model},
-                   {"cameras", cameras},
-                   {"images", r.photos.photos.size()},
-                   {"registered", r.cameras.views.size()},
-                   {"unregistered", r.unregistered},
-                   {"points", r.points.size()},
-                   {"mean_reprojection_error_px", r.mean_reprojection_error},
-                   {"scale_divisor", r.scale_divisor},
-                   {"mapper_attempts", attempts}};
+  doc["colmap"] = {
+      {"camera_model", r.camera_model},   {"cameras", cameras},
+      {"images", r.photos.photos.size()}, {"registered", r.cameras.views.size()},
+      {"unregistered", r.unregistered},   {"not_mapped", r.not_mapped},
+      {"points", r.points.size()},        {"mean_reprojection_error_px", r.mean_reprojection_error},
+      {"scale_divisor", r.scale_divisor}, {"mapper_attempts", attempts}};
   doc["seconds"] = {{"checking_images", r.seconds_reading},
                     {"extracting", r.seconds_extracting},
                     {"matching", r.seconds_matching},
@@ -376,6 +373,11 @@ SfmResult RunSfm(const SfmOptions& o, const Json& options_record) {
   result.seconds_extracting = timer.Mark("extracting");
   MatchFeatures(colmap, photos);
   ChooseLinkedViews(photos, &colmap);
+  if (!colmap.mapped.empty()) {
+    const std::set<std::string> mapped(colmap.mapped.begin(), colmap.mapped.end());
+    for (const PhotoCopy& p : photos.photos)
+      if (!mapped.count(p.colmap_name)) result.not_mapped.push_back(p.name);
+  }
   result.seconds_matching = timer.Mark("matching");
   Mapping mapping = MapWithRetries(colmap, photos);
   result.attempts = mapping.attempts;

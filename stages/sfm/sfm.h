@@ -121,6 +121,9 @@ struct SfmResult {
   // group index: their parameters, in the copies' pixels.
   std::map<int, std::vector<double>> colmap_params;
   std::vector<std::string> unregistered;
+  // Of those, the photos the mapper was not given: no verified matches link
+  // them to the mapped ones (another page, or a photo of something else).
+  std::vector<std::string> not_mapped;
   std::vector<Eigen::Vector3d> points;  // reference frame
   std::vector<std::array<uint8_t, 3>> colors;
   std::vector<int> track_lengths;

@@ -52,23 +52,31 @@ TEST(ReportRun, NamedAfterThePhotosFolderCountsThePhotosAndListsWhatWasLeftOut) 
   EnsureDirectory(folder / "Edited");
   EnsureDirectory(o.data);
   fs::create_directory_symlink(folder, o.data / "images");
-  for (const char* name : {"a.png", "b.png"})
+  // a.png and c.png registered; b.png, a copy of a.png, left out; z.png of
+  // another page, not given to the mapper.
+  for (const char* name : {"a.png", "b.png", "c.png", "z.png"})
     WriteImageAtomic(folder / name, cv::Mat3b(30, 40, cv::Vec3b(90, 120, 200)));
   WriteTextAtomic(folder / "note.txt", "not a photo");
   EnsureDirectory(o.work / "10_sfm");
   WriteJsonAtomic(o.work / "10_sfm" / "cameras.json",
                   Json{{"reference", "a.png"},
-                       {"views", {{{"image", "a.png"}}}},
+                       {"views", {{{"image", "a.png"}}, {{"image", "c.png"}}}},
                        {"left_out",
                         {{{"image", "Edited/"}, {"reason", "a folder: its photos are not read"}},
-                         {{"image", "note.txt"}, {"reason", "not a photo"}}}}});
+                         {{"image", "b.png"}, {"reason", "the same photo as a.png"}},
+                         {{"image", "note.txt"}, {"reason", "not a photo"}}}},
+                       {"colmap", {{"unregistered", {"z.png"}}, {"not_mapped", {"z.png"}}}}});
   const std::string html = report::Run(o).html;
   EXPECT_NE(html.find("<title>docunfold report: Letter 2</title>"), std::string::npos);
-  EXPECT_NE(html.find("Photos from <code>" + fs::canonical(folder).string() + "</code> (3 files)"),
+  EXPECT_NE(html.find("Photos from <code>" + fs::canonical(folder).string() + "</code> (5 files)"),
             std::string::npos);
-  EXPECT_NE(html.find("1 of 2 photos registered."), std::string::npos);
+  EXPECT_NE(html.find("2 of 3 photos registered."), std::string::npos) << html;
   EXPECT_NE(html.find("<li>Edited/ (a folder: its photos are not read)</li>"), std::string::npos);
   EXPECT_NE(html.find("<li>note.txt (not a photo)</li>"), std::string::npos);
+  EXPECT_NE(html.find("<li>b.png (the same photo as a.png)</li>"), std::string::npos);
+  EXPECT_EQ(html.find("b.png — "), std::string::npos);  // no thumbnail of the copy
+  EXPECT_NE(html.find("z.png — not registered (no features in common with the registered ones"),
+            std::string::npos);
 }
 
 }  // namespace
