@@ -221,12 +221,16 @@ Json CamerasJson(const SfmResult& r, const Json& options_record) {
                        {"focal_prior_px", group.focal_prior},
                        {"images", images}});
   }
-  doc["colmap"] = {
-      {"camera_model", r.camera_model},   {"cameras", cameras},
-      {"images", r.photos.photos.size()}, {"registered", r.cameras.views.size()},
-      {"unregistered", r.unregistered},   {"not_mapped", r.not_mapped},
-      {"points", r.points.size()},        {"mean_reprojection_error_px", r.mean_reprojection_error},
-      {"scale_divisor", r.scale_divisor}, {"mapper_attempts", attempts}};
+  doc["colmap"] = {{"camera_model", r.camera_model},
+                   {"cameras", cameras},
+                   {"images", r.photos.photos.size()},
+                   {"registered", r.cameras.views.size()},
+                   {"unregistered", r.unregistered},
+                   {"points", r.points.size()},
+                   {"mean_reprojection_error_px", r.mean_reprojection_error},
+                   {"scale_divisor", r.scale_divisor},
+                   {"mapper_attempts", attempts}};
+  doc["colmap"]["not_mapped"] = r.not_mapped;
   doc["seconds"] = {{"checking_images", r.seconds_reading},
                     {"extracting", r.seconds_extracting},
                     {"matching", r.seconds_matching},
