@@ -147,10 +147,7 @@ void PhotosSection(const ReportOptions& o, const DataSet& data, const Json& came
     const bool is_ref = name == reference;
     std::string img = InlineImage(image, o.thumbnail_width, name);
     if (is_ref) img.insert(4, " class=\"ref\"");
-    bool registered = false;
-    if (cameras.is_object())
-      for (const Json& v : cameras.at("views"))
-        registered = registered || v.value("image", "") == name;
+    const bool registered = Lists(cameras, "/views", name);
     const bool apart = Lists(cameras, "/colmap/not_mapped", name);
     html += Figure(img, MarkupEscape(name) + (is_ref ? " — <b>reference</b>" : "") +
                             (cameras.is_object() && !registered

@@ -105,8 +105,8 @@ const Likeness* SamePhotoAs(const Likeness& l, const std::vector<Likeness>& earl
   return nullptr;
 }
 
-// Puts the photos in name order, with their thumbnails (the last ones of
-// `thumbnails`, in the order read), and what was left out, folders first.
+// Puts the photos in name order, with their thumbnails (one per photo, in the
+// order read), and what was left out, folders first.
 void SortByName(PhotoSet* set, std::vector<cv::Mat>* thumbnails) {
   std::vector<size_t> index(set->photos.size());
   std::iota(index.begin(), index.end(), size_t(0));
@@ -116,11 +116,10 @@ void SortByName(PhotoSet* set, std::vector<cv::Mat>* thumbnails) {
   std::vector<cv::Mat> small;
   for (size_t i : index) {
     photos.push_back(std::move(set->photos[i]));
-    if (thumbnails) small.push_back((*thumbnails)[thumbnails->size() - set->photos.size() + i]);
+    small.push_back((*thumbnails)[i]);
   }
-  if (thumbnails)
-    std::copy(small.begin(), small.end(), thumbnails->end() - std::ptrdiff_t(small.size()));
   set->photos = std::move(photos);
+  *thumbnails = std::move(small);
   std::stable_sort(
       set->left_out.begin(), set->left_out.end(), [](const LeftOut& a, const LeftOut& b) {
         return std::make_pair(!a.IsFolder(), a.name) < std::make_pair(!b.IsFolder(), b.name);
@@ -187,6 +186,7 @@ PhotoSet PreparePhotos(const fs::path& data_dir, int max_image_size, const fs::p
   }
   std::set<std::string> taken;
   std::vector<Likeness> likenesses;
+  std::vector<cv::Mat> small_copies;  // one per photo kept, in the order read
   Progress progress("reading photos", long(data.images.size()));
   // Read by (length of the name's stem, name): of two files of one photo the
   // original is kept, not the copy a phone or a file manager named
@@ -228,12 +228,15 @@ PhotoSet PreparePhotos(const fs::path& data_dir, int max_image_size, const fs::p
       const double f = std::min(1.0, 640.0 / std::max(image.cols, image.rows));
       cv::Mat small;
       cv::resize(image, small, cv::Size(), f, f, cv::INTER_AREA);
-      thumbnails->push_back(small);
+      small_copies.push_back(small);
+    } else {
+      small_copies.emplace_back();
     }
     set.photos.push_back(std::move(copy));
     progress.Update(long(i + 1));
   }
-  SortByName(&set, thumbnails);
+  SortByName(&set, &small_copies);
+  if (thumbnails) thumbnails->insert(thumbnails->end(), small_copies.begin(), small_copies.end());
   if (set.photos.size() < 2) {
     // (a box of documents, a folder of photos each, with a note beside them)
     const bool in_folders = set.photos.empty() && !data.folders.empty();
