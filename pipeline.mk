@@ -34,8 +34,10 @@ NAME := $(word 2,$(DATA_RESOLVED))
 # all the same, so that a DATA with spaces cannot turn into stray targets.)
 override WORK := $(or $(word 3,$(DATA_RESOLVED)),$(WORK_ROOT)/$(lastword $(notdir $(DATA))))
 # The photos' names, sizes and times (names may have spaces, which Make's
-# prerequisites cannot): sfm and densify rerun when a photo changes.
-IMAGES_LIST := $(if $(DATA_DIR),$(shell cd '$(DATA_DIR)/images' && ls -lA --time-style=+%s | md5sum))
+# prerequisites cannot): sfm and densify rerun when a photo changes. Files
+# only, links followed: a folder beside the photos is not read, and its time
+# changes with whatever is written in it (a WORK_ROOT there).
+IMAGES_LIST := $(if $(DATA_DIR),$(shell cd '$(DATA_DIR)/images' && find -L . -mindepth 1 -maxdepth 1 ! -type d -printf '%s %T@ %p\n' | LC_ALL=C sort | md5sum))
 
 # ---- stage flags --------------------------------------------------------------
 REF ?=

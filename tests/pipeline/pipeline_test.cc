@@ -170,7 +170,8 @@ TEST(PipelineInput, UnknownDataSetIsReported) {
 // DATA may name a folder of photos without images/ (as a phone or an app
 // exports them; read where they are, through WORK/.photos/images) or a data
 // set's images/ folder (its data set). A dry run shows what sfm is given. A
-// folder of folders is refused in one line.
+// folder of folders is refused in one line. A work root inside the photos
+// folder is not taken for a change of the photos.
 TEST(PipelineInput, AFolderOfPhotosOrADataSetsImagesFolder) {
   TempDir tmp;
   const fs::path photos = tmp / "Letter 2";
@@ -193,6 +194,25 @@ TEST(PipelineInput, AFolderOfPhotosOrADataSetsImagesFolder) {
             std::distance(fs::directory_iterator(SampleDir(kSample) / "images"),
                           fs::directory_iterator()))
       << "nothing is written beside the photos";
+
+  // A work root inside the photos folder: another data set's work directory
+  // made there is no change of the photos, so sfm would not rerun.
+  const fs::path scans = tmp / "scans";
+  fs::create_directories(scans);
+  for (const auto& entry : fs::directory_iterator(photos))
+    fs::copy_file(entry.path(), scans / entry.path().filename());
+  auto dry_run_inside = [&] {
+    return RunCommand("make --no-print-directory -n -f " +
+                      Quote((SourceDir() / "pipeline.mk").string()) +
+                      " NO_BUILD=1 DATA=" + Quote(scans.string()) +
+                      " WORK_ROOT=" + Quote((scans / "work").string()) + " sfm");
+  };
+  ASSERT_EQ(dry_run_inside().exit_code, 0);
+  const std::string digest = ReadFileText(scans / "work/scans/.flags/images");
+  EXPECT_FALSE(digest.empty());
+  fs::create_directories(scans / "work/letter/.flags");
+  ASSERT_EQ(dry_run_inside().exit_code, 0);
+  EXPECT_EQ(ReadFileText(scans / "work/scans/.flags/images"), digest);
 
   r = dry_run(SampleDir(kSample) / "images");
   ASSERT_EQ(r.exit_code, 0) << r.output;
