@@ -23,6 +23,12 @@ JOBS ?= 2
 # ---- data set ---------------------------------------------------------------
 DATA ?= set01
 WORK_ROOT ?= $(ROOT)/work
+# Make cannot carry a space, ":" or "%" in a target's path, so a work root
+# (or the repository's own path) with one is refused here, before anything is
+# written, rather than split into words that become stray folders.
+make_unsafe = $(or $(word 2,$(1)),$(findstring :,$(1)),$(findstring %,$(1)))
+$(if $(or $(call make_unsafe,$(ROOT)),$(if $(wildcard $(ROOT)/pipeline.mk),,missing)),$(error the repository's path has a space, ":" or "%", which Make cannot carry; clone it to a path without))
+$(foreach v,WORK_ROOT WORK BUILD,$(if $(call make_unsafe,$($(v))),$(error $(v)=$($(v)): a path with a space, ":" or "%", which Make cannot carry; give one without (a link to the folder will do))))
 # samples/<name>, then data/<name>, then DATA as a path, which may have
 # spaces, accents, "." or "..": scripts/data-dir resolves it (a folder whose
 # path Make cannot carry is reached through the link WORK/.data) and names

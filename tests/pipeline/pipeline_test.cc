@@ -167,6 +167,21 @@ TEST(PipelineInput, UnknownDataSetIsReported) {
   EXPECT_EQ(r.output.find("warning"), std::string::npos) << r.output;
 }
 
+// A work root Make cannot carry (a space in it) is refused in one line before
+// anything is written, not split into words that become stray folders.
+TEST(PipelineInput, AWorkRootWithASpaceIsRefused) {
+  TempDir tmp;
+  CommandResult r =
+      RunCommand("cd " + Quote(tmp.path().string()) + " && make --no-print-directory -f " +
+                 Quote((SourceDir() / "pipeline.mk").string()) + " NO_BUILD=1 DATA=" + kSample +
+                 " 'WORK_ROOT=scans/my work' sfm");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("WORK_ROOT=scans/my work: a path with a space"), std::string::npos)
+      << r.output;
+  EXPECT_EQ(std::distance(fs::directory_iterator(tmp.path()), fs::directory_iterator()), 0)
+      << "nothing is written";
+}
+
 // DATA may name a folder of photos without images/ (as a phone or an app
 // exports them; read where they are, through WORK/.photos/images) or a data
 // set's images/ folder (its data set). A dry run shows what sfm is given. A
