@@ -10,6 +10,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <opencv2/calib3d.hpp>
 #include <stdexcept>
 #include <thread>
 
@@ -148,6 +149,64 @@ std::vector<std::vector<std::string>> ViewsLinkedByMatches(const fs::path& datab
     return a.size() != b.size() ? a.size() > b.size() : a.front() < b.front();
   });
   return groups;
+}
+
+std::vector<SameShot> SameShots(const fs::path& database, int min_matches, double min_share,
+                                double max_error_px) {
+  const Database db = OpenDatabase(database, SQLITE_OPEN_READONLY);
+  std::map<long, std::string> names;
+  std::map<long, std::vector<cv::Point2f>> keypoints;  // x, y of each, in the copy's pixels
+  {
+    const Statement stmt = Prepare(db, database,
+                                   "SELECT images.image_id, images.name, keypoints.rows, "
+                                   "keypoints.cols, keypoints.data FROM images JOIN keypoints ON "
+                                   "images.image_id = keypoints.image_id");
+    while (sqlite3_step(stmt.get()) == SQLITE_ROW) {
+      const long id = sqlite3_column_int64(stmt.get(), 0);
+      names[id] = reinterpret_cast<const char*>(sqlite3_column_text(stmt.get(), 1));
+      const int rows = sqlite3_column_int(stmt.get(), 2), cols = sqlite3_column_int(stmt.get(), 3);
+      const auto* data = static_cast<const float*>(sqlite3_column_blob(stmt.get(), 4));
+      if (rows < 0 || cols < 2 ||
+          sqlite3_column_bytes(stmt.get(), 4) != int(rows * cols * sizeof(float)) ||
+          (rows > 0 && !data))
+        throw std::runtime_error(database.string() + ": keypoints of " + names[id] + " are " +
+                                 std::to_string(rows) + "x" + std::to_string(cols) + " in " +
+                                 std::to_string(sqlite3_column_bytes(stmt.get(), 4)) + " bytes");
+      std::vector<cv::Point2f>& points = keypoints[id];
+      for (int r = 0; r < rows; ++r) points.emplace_back(data[r * cols], data[r * cols + 1]);
+    }
+  }
+  const Statement stmt = Prepare(db, database,
+                                 "SELECT pair_id, rows, cols, data FROM two_view_geometries "
+                                 "WHERE config >= 2 AND rows >= ? ORDER BY pair_id");
+  sqlite3_bind_int(stmt.get(), 1, std::max(3, min_matches));
+  constexpr long kPairBase = 2147483647;  // as in ViewsLinkedByMatches
+  std::vector<SameShot> shots;
+  while (sqlite3_step(stmt.get()) == SQLITE_ROW) {
+    const long pair = sqlite3_column_int64(stmt.get(), 0);
+    const long a = pair / kPairBase, b = pair % kPairBase;
+    const int rows = sqlite3_column_int(stmt.get(), 1), cols = sqlite3_column_int(stmt.get(), 2);
+    const auto* data = static_cast<const uint32_t*>(sqlite3_column_blob(stmt.get(), 3));
+    if (!keypoints.count(a) || !keypoints.count(b) || cols != 2 || !data ||
+        sqlite3_column_bytes(stmt.get(), 3) != int(rows * 2 * sizeof(uint32_t)))
+      throw std::runtime_error(database.string() + ": verified matches of pair " +
+                               std::to_string(pair) + " do not fit its images' keypoints");
+    const std::vector<cv::Point2f>&ka = keypoints[a], &kb = keypoints[b];
+    std::vector<cv::Point2f> from, to;
+    for (int r = 0; r < rows; ++r) {
+      if (data[2 * r] >= ka.size() || data[2 * r + 1] >= kb.size())
+        throw std::runtime_error(database.string() + ": a verified match of pair " +
+                                 std::to_string(pair) + " names a keypoint its image lacks");
+      from.push_back(ka[data[2 * r]]);
+      to.push_back(kb[data[2 * r + 1]]);
+    }
+    // (OpenCV's RANSAC is seeded: the same matches give the same answer)
+    cv::Mat inliers;
+    const cv::Mat map = cv::estimateAffinePartial2D(from, to, inliers, cv::RANSAC, max_error_px);
+    const double share = map.empty() ? 0.0 : cv::countNonZero(inliers) / double(rows);
+    if (share >= min_share) shots.push_back({names[a], names[b], rows, share});
+  }
+  return shots;
 }
 
 void SetMissingFocalPriors(const fs::path& database, double focal_35mm) {

@@ -48,6 +48,25 @@ void SetMissingFocalPriors(const fs::path& database, double focal_35mm);
 std::vector<std::vector<std::string>> ViewsLinkedByMatches(const fs::path& database,
                                                            int min_inliers);
 
+// Two images of a COLMAP database that are one shot: one is the other
+// cropped, turned, scaled or retouched (a phone's edited copy beside the
+// original). A similarity (rotation, scale, shift) takes at least
+// `min_share` of the matches COLMAP verified between them to within
+// `max_error_px` (pixels of the copies COLMAP read). Two photos taken from
+// two places never come that close: the map between them is a perspective
+// one, bent further by the page's creases.
+struct SameShot {
+  std::string first, second;  // image names, first before second by id
+  int matches = 0;            // verified matches
+  double share = 0;           // of them, the similarity's inliers
+};
+
+// Every pair of images with at least `min_matches` verified matches that is
+// one shot, by pair id. Throws std::runtime_error naming the database when
+// it cannot be read.
+std::vector<SameShot> SameShots(const fs::path& database, int min_matches, double min_share,
+                                double max_error_px);
+
 // Every image of a COLMAP database with its descriptors, by image id.
 // Throws std::runtime_error naming the database when it cannot be read.
 std::vector<ImageDescriptors> ReadDatabaseDescriptors(const fs::path& database);

@@ -370,13 +370,18 @@ SfmResult RunSfm(const SfmOptions& o, const Json& options_record) {
   if (colmap.exe.empty()) throw std::runtime_error(Colmap::NotFoundMessage(o.colmap));
   colmap.database = colmap.dir / "database.db";
   colmap.threads = std::to_string(o.threads);
-  const int n = int(photos.photos.size());
   timer.Mark("workspace");
 
   ExtractFeatures(colmap, photos);
   result.seconds_extracting = timer.Mark("extracting");
   MatchFeatures(colmap, photos);
-  ChooseLinkedViews(photos, &colmap);
+  ChooseLinkedViews(&result.photos, &thumbnails, &colmap);
+  if (!o.reference.empty() && !photos.Find(o.reference))  // an edited copy, left out
+    for (const LeftOut& l : photos.left_out)
+      if (l.name == o.reference)
+        throw InputError("--ref " + o.reference + ": left out as " + l.reason +
+                         " (give --ref that photo)");
+  const int n = int(photos.photos.size());
   if (!colmap.mapped.empty()) {
     const std::set<std::string> mapped(colmap.mapped.begin(), colmap.mapped.end());
     for (const PhotoCopy& p : photos.photos)

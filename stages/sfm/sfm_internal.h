@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <functional>
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
 
@@ -68,10 +69,13 @@ void ExtractFeatures(const Colmap& colmap, const PhotoSet& photos);
 // (matching.h) verified by COLMAP, or COLMAP's own exhaustive matcher.
 void MatchFeatures(const Colmap& colmap, const PhotoSet& photos);
 
-// Groups the photos by the matches COLMAP verified between them: when they
+// Leaves out a photo that is an edited copy of another (cropped, turned or
+// retouched; logged, in PhotoSet::left_out, and its thumbnail removed), then
+// groups the photos by the matches COLMAP verified between them: when they
 // fall into more than one group (photos of two pages, or of something else),
 // says so in one line and leaves the mapper the largest (Colmap::mapped).
-void ChooseLinkedViews(const PhotoSet& photos, Colmap* colmap);
+// InputError when fewer than 2 photos remain.
+void ChooseLinkedViews(PhotoSet* photos, std::vector<cv::Mat>* thumbnails, Colmap* colmap);
 
 // What the mapper made, over its attempts.
 struct Mapping {

@@ -157,9 +157,22 @@ TEST_F(SfmCli, MixedSizesTurnedPhotosAndSpacedNames) {
   cv::imwrite(photos[2].string(), small);
   const std::string spaced = "Photo 2026-11-28 10.15 \xc3\xa9t\xc3\xa9.jpg";
   fs::rename(photos[0], data / "images" / spaced);
+  // A phone's edited copy of the last photo, beside it: cropped, turned and
+  // brightened. It is one shot, no second view, and is left out.
+  const cv::Mat last = cv::imread(photos[3].string());
+  cv::Mat edited;
+  cv::rotate(last(cv::Rect(last.cols / 10, last.rows / 8, last.cols * 3 / 4, last.rows * 3 / 4)),
+             edited, cv::ROTATE_90_CLOCKWISE);
+  edited.convertTo(edited, -1, 1.15, 10);
+  const std::string copy = photos[3].stem().string() + "_edited.jpg";
+  cv::imwrite((data / "images" / copy).string(), edited);
   const fs::path out = tmp_ / "work" / "10_sfm";
   const CommandResult r = Sfm(Args(data, out, "--threads 2"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("left out: " + copy + " (the same shot as " +
+                          photos[3].filename().string() + ", edited"),
+            std::string::npos)
+      << r.output;
   EXPECT_FALSE(fs::exists(out / "colmap/exhaustive_matcher.log")) << "the exact matcher ran";
   const CameraSet cameras = ReadCameras(out / "cameras.json");
   ASSERT_EQ(cameras.views.size(), 4u) << r.output;
@@ -176,6 +189,16 @@ TEST_F(SfmCli, MixedSizesTurnedPhotosAndSpacedNames) {
   EXPECT_NEAR(reduced->K(0, 0) / first->K(0, 0), 0.75, 0.03);
   const Json doc = ReadJsonFile(out / "cameras.json");
   EXPECT_EQ(doc.at("colmap").at("cameras").size(), 2u);
+  EXPECT_EQ(doc.at("left_out"),
+            Json::array(
+                {{{"image", copy},
+                  {"reason", "the same shot as " + photos[3].filename().string() + ", edited"}}}));
+  EXPECT_TRUE(doc.at("colmap").at("not_mapped").empty());
+  // Asked for as the reference, the copy is refused in one line.
+  const std::set<std::string> before = Listing(out.parent_path());
+  ExpectFailure(Sfm(Args(data, tmp_ / "work" / "copy_ref", "--threads 2 --ref " + copy)), 3,
+                "--ref " + copy + ": left out as the same shot as", tmp_ / "work" / "copy_ref",
+                before);
 }
 
 TEST_F(SfmCli, RefThatDoesNotExist) {

@@ -13,6 +13,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <random>
+#include <tuple>
 
 #include "common/errors.h"
 #include "stages/sfm/colmap_model.h"
@@ -687,6 +688,78 @@ TEST(ExactMatchingTest, ViewsLinkedByVerifiedMatchesFallIntoGroups) {
   EXPECT_EQ(
       sfm::ViewsLinkedByMatches(db, 500),
       (Groups{{"b0.jpg", "b1.jpg"}, {"a0.jpg"}, {"a1.jpg"}, {"a2.jpg"}, {"b2.jpg"}, {"cat.jpg"}}));
+}
+
+// A phone's edited copy (the photo cropped, turned and scaled) is one shot
+// with its photo: a similarity takes their matches onto each other. A second
+// view of the page, a perspective map away, is not, nor is a pair with too
+// few matches.
+TEST(ExactMatchingTest, AnEditedCopyIsTheSameShotAndASecondViewIsNot) {
+  TempDir tmp;
+  const fs::path db_file = tmp.path() / "database.db";
+  MakeDatabase(db_file, {{1, "IMG_0001.png"}, {2, "IMG_E0001.png"}, {3, "IMG_0002.png"}});
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open(db_file.c_str(), &db), SQLITE_OK);
+  ASSERT_EQ(sqlite3_exec(db,
+                         "DELETE FROM keypoints; CREATE TABLE two_view_geometries (pair_id "
+                         "INTEGER PRIMARY KEY NOT NULL, rows INTEGER NOT NULL, cols INTEGER NOT "
+                         "NULL, data BLOB, config INTEGER NOT NULL);",
+                         nullptr, nullptr, nullptr),
+            SQLITE_OK);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> x(0, 1600), y(0, 1200);
+  std::normal_distribution<float> noise(0, 0.3f);
+  std::vector<cv::Point2f> photo;
+  for (int i = 0; i < 200; ++i) photo.emplace_back(x(rng), y(rng));
+  // The copy: the middle cropped, turned 90°, scaled by 1.3. The other view:
+  // the page seen from elsewhere (a homography).
+  const cv::Matx33f copy_from_photo(0, -1.3f, 1200 * 1.3f - 100, 1.3f, 0, -150, 0, 0, 1);
+  const cv::Matx33f view_from_photo(0.9f, 0.12f, 40, -0.05f, 1.05f, 20, 4e-5f, 6e-5f, 1);
+  std::vector<std::vector<float>> keypoints(3);
+  for (const cv::Point2f& p : photo) {
+    keypoints[0].insert(keypoints[0].end(), {p.x, p.y, 1, 0, 0, 1});
+    for (const auto& [k, h] : {std::pair{1, copy_from_photo}, {2, view_from_photo}}) {
+      const cv::Vec3f q = h * cv::Vec3f(p.x, p.y, 1);
+      keypoints[size_t(k)].insert(keypoints[size_t(k)].end(),
+                                  {q[0] / q[2] + noise(rng), q[1] / q[2] + noise(rng), 1, 0, 0, 1});
+    }
+  }
+  sqlite3_stmt* stmt = nullptr;
+  ASSERT_EQ(
+      sqlite3_prepare_v2(db, "INSERT INTO keypoints VALUES (?, 200, 6, ?)", -1, &stmt, nullptr),
+      SQLITE_OK);
+  for (int k = 0; k < 3; ++k) {
+    sqlite3_bind_int(stmt, 1, k + 1);
+    sqlite3_bind_blob(stmt, 2, keypoints[size_t(k)].data(), 200 * 6 * sizeof(float),
+                      SQLITE_TRANSIENT);
+    EXPECT_EQ(sqlite3_step(stmt), SQLITE_DONE);
+    sqlite3_reset(stmt);
+  }
+  sqlite3_finalize(stmt);
+  // Every keypoint matched to its own, in each pair; 1-3 with 40 only.
+  std::vector<uint32_t> matches;
+  for (uint32_t i = 0; i < 200; ++i) matches.insert(matches.end(), {i, i});
+  ASSERT_EQ(sqlite3_prepare_v2(db, "INSERT INTO two_view_geometries VALUES (?, ?, 2, ?, 6)", -1,
+                               &stmt, nullptr),
+            SQLITE_OK);
+  for (const auto& [a, b, rows] : {std::tuple{1L, 2L, 200}, {2L, 3L, 200}, {1L, 3L, 40}}) {
+    sqlite3_bind_int64(stmt, 1, a * 2147483647L + b);
+    sqlite3_bind_int(stmt, 2, rows);
+    sqlite3_bind_blob(stmt, 3, matches.data(), int(rows * 2 * sizeof(uint32_t)), SQLITE_TRANSIENT);
+    EXPECT_EQ(sqlite3_step(stmt), SQLITE_DONE);
+    sqlite3_reset(stmt);
+  }
+  sqlite3_finalize(stmt);
+  sqlite3_close(db);
+
+  const std::vector<sfm::SameShot> shots = sfm::SameShots(db_file, 50, 0.9, 2.0);
+  ASSERT_EQ(shots.size(), 1u);
+  EXPECT_EQ(shots[0].first, "IMG_0001.png");
+  EXPECT_EQ(shots[0].second, "IMG_E0001.png");
+  EXPECT_EQ(shots[0].matches, 200);
+  EXPECT_GE(shots[0].share, 0.99);
+  // With few enough matches asked for, 1-3 is looked at too: still a second view.
+  EXPECT_EQ(sfm::SameShots(db_file, 30, 0.9, 2.0).size(), 1u);
 }
 
 TEST(ExactMatchingTest, BadDatabasesAreErrorsNamingTheFile) {
