@@ -1,7 +1,10 @@
 #include "common/atomic_file.h"
 
+#include <signal.h>
 #include <unistd.h>
 
+#include <cctype>
+#include <cerrno>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
 
@@ -11,9 +14,10 @@ namespace docunfold {
 
 AtomicOutput::AtomicOutput(const fs::path& target) : target_(target) {
   EnsureDirectory(target.has_parent_path() ? target.parent_path() : fs::path("."));
+  const std::string prefix = "." + target.stem().string() + ".tmp.";
+  RemoveLeftBehind(target.parent_path(), prefix);
   temp_ = target;
-  temp_.replace_filename("." + target.stem().string() + ".tmp." + std::to_string(::getpid()) +
-                         target.extension().string());
+  temp_.replace_filename(prefix + std::to_string(::getpid()) + target.extension().string());
 }
 
 AtomicOutput::~AtomicOutput() {
@@ -29,6 +33,22 @@ void AtomicOutput::Commit() {
   fs::rename(temp_, target_, ec);
   if (ec) throw OutputError(target_.string() + ": cannot rename temporary file: " + ec.message());
   committed_ = true;
+}
+
+void RemoveLeftBehind(const fs::path& dir, const std::string& prefix) {
+  std::error_code ec;
+  for (fs::directory_iterator it(dir.empty() ? fs::path(".") : dir, ec), end; !ec && it != end;
+       it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.compare(0, prefix.size(), prefix) != 0) continue;
+    size_t digits = prefix.size();
+    while (digits < name.size() && std::isdigit(static_cast<unsigned char>(name[digits]))) ++digits;
+    if (digits == prefix.size() || digits - prefix.size() > 9) continue;
+    const auto pid = pid_t(std::stol(name.substr(prefix.size(), digits - prefix.size())));
+    if (pid <= 0 || pid == ::getpid() || ::kill(pid, 0) == 0 || errno != ESRCH) continue;
+    std::error_code ignored;
+    fs::remove_all(it->path(), ignored);
+  }
 }
 
 void EnsureDirectory(const fs::path& dir) {

@@ -33,6 +33,12 @@ class AtomicOutput {
   bool committed_ = false;
 };
 
+// Removes what runs that were killed (Ctrl-C, a job's time limit) left in
+// `dir`: every entry named `prefix`, then the process id of a process no
+// longer running, then anything but a digit. A running process's entries
+// are kept (two runs at once on one machine); errors are ignored.
+void RemoveLeftBehind(const fs::path& dir, const std::string& prefix);
+
 // Creates `dir` and its parents; throws OutputError when that fails.
 void EnsureDirectory(const fs::path& dir);
 

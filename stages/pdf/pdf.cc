@@ -34,6 +34,7 @@ constexpr int kSpeckPasses = 2;
 class Staging {
  public:
   explicit Staging(const fs::path& out) : dir_(out / (".pdf-staging-" + std::to_string(getpid()))) {
+    RemoveLeftBehind(out, ".pdf-staging-");
     std::error_code ec;
     fs::remove_all(dir_, ec);
     if (!fs::create_directories(dir_, ec))

@@ -22,8 +22,9 @@ StagingDir::StagingDir(const fs::path& target) : target_(target) {
   const fs::path parent = target.has_parent_path() ? target.parent_path() : fs::path(".");
   EnsureDirectory(parent);
   std::random_device rd;
-  path_ = parent / ("." + target.filename().string() + ".tmp-" + std::to_string(::getpid()) + "-" +
-                    std::to_string(rd() % 100000));
+  const std::string prefix = "." + target.filename().string() + ".tmp-";
+  RemoveLeftBehind(parent, prefix);  // a COLMAP workspace an interrupted run left
+  path_ = parent / (prefix + std::to_string(::getpid()) + "-" + std::to_string(rd() % 100000));
   std::error_code ec;
   fs::remove_all(path_, ec);
   fs::create_directories(path_, ec);

@@ -321,8 +321,9 @@ SynthResult Run(const SynthOptions& o, const Json& options_record) {
 
   // Everything goes to a temporary folder first, renamed at the end.
   const fs::path out = fs::absolute(o.out);
-  const fs::path tmp =
-      out.parent_path() / ("." + out.filename().string() + ".tmp." + std::to_string(::getpid()));
+  const std::string prefix = "." + out.filename().string() + ".tmp.";
+  RemoveLeftBehind(out.parent_path(), prefix);
+  const fs::path tmp = out.parent_path() / (prefix + std::to_string(::getpid()));
   struct Cleanup {
     fs::path dir;
     ~Cleanup() {

@@ -1,6 +1,8 @@
 #include "common/atomic_file.h"
 
 #include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <fstream>
 
@@ -24,6 +26,33 @@ TEST(AtomicFile, LeavesNoTemporaryOnFailure) {
   std::string s;
   f >> s;
   EXPECT_EQ(s, "whole");
+}
+
+// A run killed half way (Ctrl-C) leaves its temporary behind; the next
+// output to that place removes it, but not a running process's.
+TEST(AtomicFile, WhatAKilledRunLeftIsRemovedNextTime) {
+  testing::TempDir dir;
+  const pid_t child = ::fork();
+  if (child == 0) ::_exit(0);
+  ASSERT_GT(child, 0);
+  ASSERT_EQ(::waitpid(child, nullptr, 0), child);  // a process id no longer running
+  const std::string gone = std::to_string(child);
+  std::ofstream(dir / (".x.tmp." + gone + ".txt")) << "partial";
+  std::ofstream(dir / ".x.tmp.1.txt") << "being written by a running process";
+  std::ofstream(dir / (".y.tmp." + gone + ".txt")) << "another output's";
+  std::ofstream(dir / ".x.tmp.notes.txt") << "a user's file";
+  WriteTextAtomic(dir / "x.txt", "whole");
+  EXPECT_FALSE(fs::exists(dir / (".x.tmp." + gone + ".txt")));
+  EXPECT_TRUE(fs::exists(dir / ".x.tmp.1.txt"));
+  EXPECT_TRUE(fs::exists(dir / (".y.tmp." + gone + ".txt")));
+  EXPECT_TRUE(fs::exists(dir / ".x.tmp.notes.txt"));
+  // A whole folder, as a stage's staging folder.
+  fs::create_directories(dir / (".out.tmp-" + gone + "-123/colmap"));
+  std::ofstream(dir / (".out.tmp-" + gone + "-123/colmap/database.db")) << "x";
+  RemoveLeftBehind(dir.path(), ".out.tmp-");
+  EXPECT_FALSE(fs::exists(dir / (".out.tmp-" + gone + "-123")));
+  EXPECT_TRUE(fs::exists(dir / "x.txt"));
+  RemoveLeftBehind(dir / "none", ".out.tmp-");  // no such folder: nothing to do
 }
 
 TEST(AtomicFile, UnwritableDirectoryIsAnOutputError) {
