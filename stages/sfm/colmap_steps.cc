@@ -261,7 +261,8 @@ std::set<std::string> LeaveOutEditedCopies(const Colmap& colmap, PhotoSet* photo
     const PhotoCopy& kept = keep_a ? a : b;
     const PhotoCopy& copy = keep_a ? b : a;
     copies.insert(copy.colmap_name);
-    photos->left_out.push_back({copy.name, "the same shot as " + kept.name + ", edited"});
+    photos->left_out.push_back(
+        {copy.name, "the same shot as " + kept.name + ", edited or taken from the same spot"});
     Log("left out: " + copy.name + " (" + photos->left_out.back().reason + ": " +
         std::to_string(int(std::lround(100 * shot.share))) + " % of " +
         std::to_string(shot.matches) + " matches one similarity apart)");

@@ -190,9 +190,9 @@ TEST_F(SfmCli, MixedSizesTurnedPhotosAndSpacedNames) {
   const Json doc = ReadJsonFile(out / "cameras.json");
   EXPECT_EQ(doc.at("colmap").at("cameras").size(), 2u);
   EXPECT_EQ(doc.at("left_out"),
-            Json::array(
-                {{{"image", copy},
-                  {"reason", "the same shot as " + photos[3].filename().string() + ", edited"}}}));
+            Json::array({{{"image", copy},
+                          {"reason", "the same shot as " + photos[3].filename().string() +
+                                         ", edited or taken from the same spot"}}}));
   EXPECT_TRUE(doc.at("colmap").at("not_mapped").empty());
   // Asked for as the reference, the copy is refused in one line.
   const std::set<std::string> before = Listing(out.parent_path());
