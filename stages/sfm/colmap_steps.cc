@@ -309,7 +309,8 @@ void ChooseLinkedViews(PhotoSet* photos, std::vector<cv::Mat>* thumbnails, Colma
                                     : std::string());
     Log("the photos fall into " + std::to_string(groups.size()) +
         " groups with no features in common (a page each, or photos of something else): " + list +
-        "; mapping the first (one run takes one page's photos)");
+        "; mapping the first (one run takes one page's photos: give each page a folder of "
+        "its own, and `make -f pipeline.mk book` joins the pages into one PDF)");
   }
   colmap->mapped = groups.front();
   const fs::path list_file = colmap->dir / "mapped_images.txt";
