@@ -299,9 +299,9 @@ void ChooseLinkedViews(PhotoSet* photos, std::vector<cv::Mat>* thumbnails, Colma
   const bool several_pages = groups.size() >= 2 && groups.front().size() >= 2;
   // (not one pair linked: the mapper fails and says so)
   if (!several_pages && (copies.empty() || groups.front().size() < 2)) return;
+  std::map<std::string, std::string> photo_of;  // copy's name -> photo's name
+  for (const PhotoCopy& p : photos->photos) photo_of[p.colmap_name] = p.name;
   if (several_pages) {
-    std::map<std::string, std::string> photo_of;  // copy's name -> photo's name
-    for (const PhotoCopy& p : photos->photos) photo_of[p.colmap_name] = p.name;
     std::string list;
     for (size_t i = 0; i < groups.size(); ++i)
       list += (i ? "; " : "") + photo_of[groups[i].front()] +
@@ -309,10 +309,18 @@ void ChooseLinkedViews(PhotoSet* photos, std::vector<cv::Mat>* thumbnails, Colma
                                     : std::string());
     Log("the photos fall into " + std::to_string(groups.size()) +
         " groups with no features in common (a page each, or photos of something else): " + list +
-        "; mapping the first (one run takes one page's photos: give each page a folder of "
-        "its own, and `make -f pipeline.mk book` joins the pages into one PDF)");
+        "; mapping the first (the other groups of two or more are other pages, listed in "
+        "cameras.json; pipeline.mk makes each and joins them into one PDF)");
   }
   colmap->mapped = groups.front();
+  for (size_t i = 1; i < groups.size(); ++i) {
+    if (groups[i].size() < 2) continue;  // a photo of something else
+    std::vector<std::string> page;
+    for (const std::string& name : groups[i]) page.push_back(photo_of[name]);
+    std::sort(page.begin(), page.end());
+    colmap->other_pages.push_back(std::move(page));
+  }
+  std::sort(colmap->other_pages.begin(), colmap->other_pages.end());
   const fs::path list_file = colmap->dir / "mapped_images.txt";
   std::ofstream out(list_file);
   for (const std::string& name : colmap->mapped) out << name << '\n';

@@ -231,6 +231,7 @@ Json CamerasJson(const SfmResult& r, const Json& options_record) {
                    {"scale_divisor", r.scale_divisor},
                    {"mapper_attempts", attempts}};
   doc["colmap"]["not_mapped"] = r.not_mapped;
+  doc["colmap"]["other_pages"] = r.other_pages;
   doc["seconds"] = {{"checking_images", r.seconds_reading},
                     {"extracting", r.seconds_extracting},
                     {"matching", r.seconds_matching},
@@ -242,16 +243,20 @@ Json CamerasJson(const SfmResult& r, const Json& options_record) {
 namespace {
 
 // The names of the views COLMAP registered; the others into
-// result->unregistered, with a warning.
+// result->unregistered, with a warning for those the mapper was given.
 std::set<std::string> NoteRegistered(const ColmapModel& model, SfmResult* result) {
   std::set<std::string> registered;
   for (const auto& [id, im] : model.images) registered.insert(im.name);
-  for (const std::string& name : result->photos.Names())
-    if (!registered.count(name)) result->unregistered.push_back(name);
-  if (!result->unregistered.empty())
-    Log("warning: " + std::to_string(result->unregistered.size()) + " views not registered (" +
-        JoinNames(result->unregistered) + "); going on with " +
-        std::to_string(model.images.size()));
+  const std::set<std::string> set_aside(result->not_mapped.begin(), result->not_mapped.end());
+  std::vector<std::string> lost;  // given to the mapper, and not registered
+  for (const std::string& name : result->photos.Names()) {
+    if (registered.count(name)) continue;
+    result->unregistered.push_back(name);
+    if (!set_aside.count(name)) lost.push_back(name);
+  }
+  if (!lost.empty())
+    Log("warning: " + std::to_string(lost.size()) + " views not registered (" + JoinNames(lost) +
+        "); going on with " + std::to_string(model.images.size()));
   return registered;
 }
 
@@ -386,6 +391,7 @@ SfmResult RunSfm(const SfmOptions& o, const Json& options_record) {
     const std::set<std::string> mapped(colmap.mapped.begin(), colmap.mapped.end());
     for (const PhotoCopy& p : photos.photos)
       if (!mapped.count(p.colmap_name)) result.not_mapped.push_back(p.name);
+    result.other_pages = colmap.other_pages;
   }
   result.seconds_matching = timer.Mark("matching");
   Mapping mapping = MapWithRetries(colmap, photos);

@@ -124,6 +124,9 @@ struct SfmResult {
   // Of those, the photos the mapper was not given: no verified matches link
   // them to the mapped ones (another page, or a photo of something else).
   std::vector<std::string> not_mapped;
+  // Of those, the groups of two or more linked among themselves: other pages
+  // (each sorted by name; the groups by their first name).
+  std::vector<std::vector<std::string>> other_pages;
   std::vector<Eigen::Vector3d> points;  // reference frame
   std::vector<std::array<uint8_t, 3>> colors;
   std::vector<int> track_lengths;

@@ -51,6 +51,9 @@ struct Colmap {
   // of the largest, which alone the mapper is given (listed in
   // <dir>/mapped_images.txt); empty: every photo.
   std::vector<std::string> mapped;
+  // The other groups of two or more photos (other pages), as photo file
+  // names, each sorted, the groups by their first name.
+  std::vector<std::vector<std::string>> other_pages;
 
   // Runs one COLMAP command, its output into <dir>/<log>; throws when it
   // fails (except for the mapper, whose failure the caller judges).

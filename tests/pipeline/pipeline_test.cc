@@ -3,7 +3,10 @@
 // and what follows, and FEATURES= substitutes another detector's file.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "common/json_io.h"
 #include "tests/support/ground_truth.h"
@@ -165,6 +168,71 @@ TEST(PipelineInput, UnknownDataSetIsReported) {
             std::string::npos)
       << r.output;
   EXPECT_EQ(r.output.find("warning"), std::string::npos) << r.output;
+}
+
+// A folder holding the photos of two pages (small copies of set01's and
+// set04's): the page with more photos is made in WORK, the other in
+// WORK_ROOT/<name>-p1 (its photos' names come first), and both are joined
+// into WORK_ROOT/<name>.pdf in that order, the other page made with the same
+// flags; a second make remakes nothing.
+TEST(PipelineInput, AFolderOfTwoPagesGivesOnePdfOfBoth) {
+  if (!fs::is_directory(SampleDir("set01")) || !fs::is_directory(SampleDir("set04")))
+    GTEST_SKIP() << "no samples set01 and set04";
+  TempDir tmp;
+  const fs::path photos = tmp / "Letter 3";
+  fs::create_directories(photos);
+  auto copy_views = [&](const std::string& set, int count, int first_number) {
+    for (int i = 0; i < count; ++i) {
+      const cv::Mat image = cv::imread(
+          (SampleDir(set) / "images" / ("view_0" + std::to_string(i) + ".jpg")).string());
+      ASSERT_FALSE(image.empty());
+      cv::Mat small;
+      cv::resize(image, small, cv::Size(800, image.rows * 800 / image.cols), 0, 0, cv::INTER_AREA);
+      cv::imwrite((photos / ("IMG_00" + std::to_string(first_number + i) + ".jpg")).string(), small,
+                  {cv::IMWRITE_JPEG_QUALITY, 92});
+    }
+  };
+  copy_views("set04", 3, 10);  // IMG_0010-12: the other page, first by name
+  copy_views("set01", 4, 20);  // IMG_0020-23: the page with more photos
+  const fs::path work_root = tmp / "work";
+  auto make = [&] {
+    return RunCommand(
+        "make --no-print-directory -f " + Quote((SourceDir() / "pipeline.mk").string()) +
+        " NO_BUILD=1 BUILD=" + Quote(fs::path(DOCUNFOLD_BIN_DIR).parent_path().string()) +
+        " DATA=" + Quote(photos.string()) + " WORK_ROOT=" + Quote(work_root.string()) +
+        " OPTIMIZE_FLAGS='--rounds 1' all");  // (what is made where, not how well)
+  };
+  const CommandResult r = make();
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  auto views = [&](const std::string& work) {
+    const Json cameras = ReadJsonFile(work_root / work / "10_sfm/cameras.json");
+    std::vector<std::string> names;
+    for (const Json& v : cameras.at("views")) names.push_back(v.at("image"));
+    std::sort(names.begin(), names.end());
+    return names;
+  };
+  EXPECT_EQ(views("Letter_3"), (std::vector<std::string>{"IMG_0020.jpg", "IMG_0021.jpg",
+                                                         "IMG_0022.jpg", "IMG_0023.jpg"}));
+  EXPECT_EQ(views("Letter_3-p1"),
+            (std::vector<std::string>{"IMG_0010.jpg", "IMG_0011.jpg", "IMG_0012.jpg"}));
+  const CommandResult pages =
+      RunCommand("qpdf --show-npages " + Quote((work_root / "Letter_3.pdf").string()));
+  EXPECT_EQ(pages.output, "2\n") << r.output;
+  EXPECT_TRUE(fs::exists(work_root / "Letter_3.alto/001-Letter_3-p1.alto.xml")) << r.output;
+  EXPECT_TRUE(fs::exists(work_root / "Letter_3.alto/002-Letter_3.alto.xml")) << r.output;
+  EXPECT_NE(ReadFileText(work_root / "Letter_3-p1/.flags/optimize").find("--rounds 1"),
+            std::string::npos)
+      << "the other page is made with the same flags";
+  EXPECT_EQ(std::distance(fs::directory_iterator(photos), fs::directory_iterator()), 7)
+      << "nothing is written beside the photos";
+
+  const CommandResult again = make();
+  ASSERT_EQ(again.exit_code, 0) << again.output;
+  EXPECT_EQ(again.output.find("bin/"), std::string::npos) << again.output;
+  EXPECT_EQ(again.output.find("book: wrote"), std::string::npos) << again.output;
+  EXPECT_NE(again.output.find("all its pages in " + (work_root / "Letter_3.pdf").string()),
+            std::string::npos)
+      << again.output;
 }
 
 // A work root Make cannot carry (a space in it) is refused in one line before
