@@ -294,8 +294,10 @@ void ChooseLinkedViews(PhotoSet* photos, std::vector<cv::Mat>* thumbnails, Colma
                 group.end());
     if (!group.empty()) groups.push_back(std::move(group));
   }
-  std::stable_sort(groups.begin(), groups.end(),
-                   [](const auto& a, const auto& b) { return a.size() > b.size(); });
+  // Largest first, then the first by name (as ViewsLinkedByMatches, copies left out).
+  std::sort(groups.begin(), groups.end(), [](const auto& a, const auto& b) {
+    return a.size() != b.size() ? a.size() > b.size() : a.front() < b.front();
+  });
   const bool several_pages = groups.size() >= 2 && groups.front().size() >= 2;
   // (not one pair linked: the mapper fails and says so)
   if (!several_pages && (copies.empty() || groups.front().size() < 2)) return;

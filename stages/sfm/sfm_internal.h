@@ -76,8 +76,9 @@ void MatchFeatures(const Colmap& colmap, const PhotoSet& photos);
 // retouched; logged, in PhotoSet::left_out, and its thumbnail removed), then
 // groups the photos by the matches COLMAP verified between them: when they
 // fall into more than one group (photos of two pages, or of something else),
-// says so in one line and leaves the mapper the largest (Colmap::mapped).
-// InputError when fewer than 2 photos remain.
+// says so in one line, leaves the mapper the largest (Colmap::mapped) and
+// lists the other groups of two or more (Colmap::other_pages). InputError
+// when fewer than 2 photos remain.
 void ChooseLinkedViews(PhotoSet* photos, std::vector<cv::Mat>* thumbnails, Colmap* colmap);
 
 // What the mapper made, over its attempts.
