@@ -80,6 +80,12 @@ Statement Prepare(const Database& db, const fs::path& database, const char* sql)
   return Statement(raw, sqlite3_finalize);
 }
 
+// The two image ids of a COLMAP pair id: id1 * 2147483647 + id2 (id1 < id2).
+std::pair<long, long> ImagesOfPair(long pair_id) {
+  constexpr long kPairBase = 2147483647;
+  return {pair_id / kPairBase, pair_id % kPairBase};
+}
+
 }  // namespace
 
 void NumberImagesByName(const fs::path& database) {
@@ -126,15 +132,13 @@ std::vector<std::vector<std::string>> ViewsLinkedByMatches(const fs::path& datab
     return id;
   };
   {
-    // COLMAP's pair id is id1 * 2147483647 + id2 (id1 < id2); config 2 and
-    // up is a verified geometry (0 undefined, 1 degenerate).
+    // Config 2 and up is a verified geometry (0 undefined, 1 degenerate).
     const Statement stmt = Prepare(
         db, database, "SELECT pair_id FROM two_view_geometries WHERE config >= 2 AND rows >= ?");
     sqlite3_bind_int(stmt.get(), 1, min_inliers);
-    constexpr long kPairBase = 2147483647;
     while (sqlite3_step(stmt.get()) == SQLITE_ROW) {
       const long pair = sqlite3_column_int64(stmt.get(), 0);
-      const long a = pair / kPairBase, b = pair % kPairBase;
+      const auto [a, b] = ImagesOfPair(pair);
       if (parent.count(a) && parent.count(b)) parent[root(a)] = root(b);
     }
   }
@@ -180,11 +184,10 @@ std::vector<SameShot> SameShots(const fs::path& database, int min_matches, doubl
                                  "SELECT pair_id, rows, cols, data FROM two_view_geometries "
                                  "WHERE config >= 2 AND rows >= ? ORDER BY pair_id");
   sqlite3_bind_int(stmt.get(), 1, std::max(3, min_matches));
-  constexpr long kPairBase = 2147483647;  // as in ViewsLinkedByMatches
   std::vector<SameShot> shots;
   while (sqlite3_step(stmt.get()) == SQLITE_ROW) {
     const long pair = sqlite3_column_int64(stmt.get(), 0);
-    const long a = pair / kPairBase, b = pair % kPairBase;
+    const auto [a, b] = ImagesOfPair(pair);
     const int rows = sqlite3_column_int(stmt.get(), 1), cols = sqlite3_column_int(stmt.get(), 2);
     const auto* data = static_cast<const uint32_t*>(sqlite3_column_blob(stmt.get(), 3));
     if (!keypoints.count(a) || !keypoints.count(b) || cols != 2 || !data ||
