@@ -3,6 +3,7 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cctype>
 #include <cerrno>
 #include <fstream>
@@ -33,6 +34,48 @@ void AtomicOutput::Commit() {
   fs::rename(temp_, target_, ec);
   if (ec) throw OutputError(target_.string() + ": cannot rename temporary file: " + ec.message());
   committed_ = true;
+}
+
+AtomicDirectory::AtomicDirectory(const fs::path& target)
+    : target_(fs::absolute(target).lexically_normal()) {
+  if (target_.filename().empty()) target_ = target_.parent_path();  // "out/" names out
+  const fs::path parent = target_.parent_path();
+  EnsureDirectory(parent);
+  const std::string prefix = "." + target_.filename().string() + ".tmp.";
+  RemoveLeftBehind(parent, prefix);
+  static std::atomic<int> made{0};
+  path_ = parent / (prefix + std::to_string(::getpid()) + "." + std::to_string(++made));
+  std::error_code ec;
+  fs::remove_all(path_, ec);
+  fs::create_directories(path_, ec);
+  if (ec) throw OutputError(path_.string() + ": cannot create: " + ec.message());
+}
+
+AtomicDirectory::~AtomicDirectory() {
+  if (committed_) return;
+  std::error_code ec;
+  fs::remove_all(path_, ec);
+}
+
+void AtomicDirectory::Commit() {
+  std::error_code ec;
+  fs::path old;
+  if (fs::exists(target_, ec)) {
+    old = path_;
+    old += ".old";
+    fs::remove_all(old, ec);
+    fs::rename(target_, old, ec);
+    if (ec)
+      throw OutputError(target_.string() + ": cannot move the old output aside: " + ec.message());
+  }
+  fs::rename(path_, target_, ec);
+  if (ec) {
+    std::error_code ignored;
+    if (!old.empty()) fs::rename(old, target_, ignored);
+    throw OutputError(target_.string() + ": cannot rename into place: " + ec.message());
+  }
+  committed_ = true;
+  if (!old.empty()) fs::remove_all(old, ec);
 }
 
 void RemoveLeftBehind(const fs::path& dir, const std::string& prefix) {

@@ -33,6 +33,28 @@ class AtomicOutput {
   bool committed_ = false;
 };
 
+// A folder beside `target`, `.<name>.tmp.<pid>.<n>`, that a stage fills and
+// Commit() puts in the target's place (an earlier target is moved aside, and
+// back if the rename fails); the destructor removes it if Commit() was never
+// reached. Folders that killed runs left beside the target are removed first.
+class AtomicDirectory {
+ public:
+  explicit AtomicDirectory(const fs::path& target);
+  ~AtomicDirectory();
+  AtomicDirectory(const AtomicDirectory&) = delete;
+  AtomicDirectory& operator=(const AtomicDirectory&) = delete;
+
+  const fs::path& path() const { return path_; }
+  const fs::path& target() const { return target_; }
+  // Replaces the target with the folder; throws OutputError.
+  void Commit();
+
+ private:
+  fs::path target_;
+  fs::path path_;
+  bool committed_ = false;
+};
+
 // Removes what runs that were killed (Ctrl-C, a job's time limit) left in
 // `dir`: every entry named `prefix`, then the process id of a process no
 // longer running, then anything but a digit. A running process's entries

@@ -1,11 +1,8 @@
-// The steps of sfm that run COLMAP, and the staging directory they work in.
-#include <unistd.h>
-
+// The steps of sfm that run COLMAP.
 #include <algorithm>
 #include <chrono>
 #include <fstream>
 #include <map>
-#include <random>
 #include <regex>
 #include <set>
 
@@ -17,46 +14,6 @@
 #include "stages/sfm/sfm_internal.h"
 
 namespace docunfold::sfm::detail {
-
-StagingDir::StagingDir(const fs::path& target) : target_(target) {
-  const fs::path parent = target.has_parent_path() ? target.parent_path() : fs::path(".");
-  EnsureDirectory(parent);
-  std::random_device rd;
-  const std::string prefix = "." + target.filename().string() + ".tmp-";
-  RemoveLeftBehind(parent, prefix);  // a COLMAP workspace an interrupted run left
-  path_ = parent / (prefix + std::to_string(::getpid()) + "-" + std::to_string(rd() % 100000));
-  std::error_code ec;
-  fs::remove_all(path_, ec);
-  fs::create_directories(path_, ec);
-  if (ec) throw OutputError(path_.string() + ": cannot create: " + ec.message());
-}
-
-StagingDir::~StagingDir() {
-  if (committed_) return;
-  std::error_code ec;
-  fs::remove_all(path_, ec);
-}
-
-void StagingDir::Commit() {
-  std::error_code ec;
-  fs::path old;
-  if (fs::exists(target_, ec)) {
-    old = path_;
-    old += ".old";
-    fs::remove_all(old, ec);
-    fs::rename(target_, old, ec);
-    if (ec)
-      throw OutputError(target_.string() + ": cannot move the old output aside: " + ec.message());
-  }
-  fs::rename(path_, target_, ec);
-  if (ec) {
-    std::error_code ignored;
-    if (!old.empty()) fs::rename(old, target_, ignored);
-    throw OutputError(target_.string() + ": cannot rename into place: " + ec.message());
-  }
-  committed_ = true;
-  if (!old.empty()) fs::remove_all(old, ec);
-}
 
 void CheckOutputDir(const fs::path& out) {
   std::error_code ec;

@@ -352,7 +352,7 @@ SfmResult RunSfm(const SfmOptions& o, const Json& options_record) {
 
   SfmResult result;
   CheckOutputDir(o.out_dir);
-  StagingDir staging(o.out_dir);
+  AtomicDirectory staging(o.out_dir);
   // COLMAP's workspace, colmap/ in the staging directory, with the copies of
   // the photos it works on.
   Colmap colmap;

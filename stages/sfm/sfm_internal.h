@@ -1,6 +1,5 @@
-// The steps of RunSfm that run COLMAP (colmap_steps.cc): the staging
-// directory the outputs are made in, and feature extraction, matching and
-// mapping with retries.
+// The steps of RunSfm that run COLMAP (colmap_steps.cc): feature extraction,
+// matching and mapping with retries.
 #pragma once
 
 #include <filesystem>
@@ -15,25 +14,6 @@
 #include "stages/sfm/subprocess.h"
 
 namespace docunfold::sfm::detail {
-
-// A directory beside the output that becomes the output when Commit() is
-// called, and disappears otherwise.
-class StagingDir {
- public:
-  explicit StagingDir(const fs::path& target);
-  ~StagingDir();
-  StagingDir(const StagingDir&) = delete;
-  StagingDir& operator=(const StagingDir&) = delete;
-  const fs::path& path() const { return path_; }
-
-  // Replaces the target (an earlier sfm output) with the staging directory.
-  void Commit();
-
- private:
-  fs::path target_;
-  fs::path path_;
-  bool committed_ = false;
-};
 
 // An existing --out must be a folder sfm wrote (or an empty one): we replace
 // it as a whole and must not wipe anything else.

@@ -1,7 +1,5 @@
 #include "stages/synth/synth.h"
 
-#include <unistd.h>
-
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -319,31 +317,16 @@ SynthResult Run(const SynthOptions& o, const Json& options_record) {
   std::mt19937 rng(o.seed);
   const Scene scene = MakeScene(o, &rng);
 
-  // Everything goes to a temporary folder first, renamed at the end.
-  const fs::path out = fs::absolute(o.out);
-  const std::string prefix = "." + out.filename().string() + ".tmp.";
-  RemoveLeftBehind(out.parent_path(), prefix);
-  const fs::path tmp = out.parent_path() / (prefix + std::to_string(::getpid()));
-  struct Cleanup {
-    fs::path dir;
-    ~Cleanup() {
-      std::error_code e;
-      if (!dir.empty()) fs::remove_all(dir, e);
-    }
-  } cleanup{tmp};
-  fs::remove_all(tmp, ec);
+  // Everything goes to a folder beside --out first, put in its place at the end.
+  AtomicDirectory staging(o.out);
+  const fs::path& tmp = staging.path();
   EnsureDirectory(tmp / "images");
   EnsureDirectory(tmp / "ground_truth");
 
   WritePhotos(scene, o.render, tmp, &rng);
   WriteGroundTruth(scene, o, options_record, tmp / "ground_truth");
   if (!o.command_line.empty()) WriteTextAtomic(tmp / "COMMAND", o.command_line + "\n");
-
-  if (fs::exists(out, ec)) fs::remove_all(out, ec);
-  fs::rename(tmp, out, ec);
-  if (ec)
-    throw OutputError(out.string() + ": cannot move the data set into place: " + ec.message());
-  cleanup.dir.clear();
+  staging.Commit();
 
   SynthResult r;
   r.views = int(scene.cameras.size());

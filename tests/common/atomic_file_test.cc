@@ -47,12 +47,31 @@ TEST(AtomicFile, WhatAKilledRunLeftIsRemovedNextTime) {
   EXPECT_TRUE(fs::exists(dir / (".y.tmp." + gone + ".txt")));
   EXPECT_TRUE(fs::exists(dir / ".x.tmp.notes.txt"));
   // A whole folder, as a stage's staging folder.
-  fs::create_directories(dir / (".out.tmp-" + gone + "-123/colmap"));
-  std::ofstream(dir / (".out.tmp-" + gone + "-123/colmap/database.db")) << "x";
-  RemoveLeftBehind(dir.path(), ".out.tmp-");
-  EXPECT_FALSE(fs::exists(dir / (".out.tmp-" + gone + "-123")));
+  fs::create_directories(dir / (".out.tmp." + gone + ".1/colmap"));
+  std::ofstream(dir / (".out.tmp." + gone + ".1/colmap/database.db")) << "x";
+  { AtomicDirectory next(dir / "out"); }
+  EXPECT_FALSE(fs::exists(dir / (".out.tmp." + gone + ".1")));
   EXPECT_TRUE(fs::exists(dir / "x.txt"));
-  RemoveLeftBehind(dir / "none", ".out.tmp-");  // no such folder: nothing to do
+  RemoveLeftBehind(dir / "none", ".out.tmp.");  // no such folder: nothing to do
+}
+
+TEST(AtomicFile, AFolderReplacesItsTargetWholeOrNotAtAll) {
+  testing::TempDir dir;
+  fs::create_directories(dir / "out");
+  std::ofstream(dir / "out/old.txt") << "an earlier run's";
+  {
+    AtomicDirectory staging(dir / "out/");  // a trailing slash names the same folder
+    EXPECT_EQ(staging.path().parent_path(), fs::path(dir.path()));
+    std::ofstream(staging.path() / "new.txt") << "half";
+  }  // not committed: the earlier output stays, the folder is gone
+  EXPECT_TRUE(fs::exists(dir / "out/old.txt"));
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir.path()), fs::directory_iterator()), 1);
+  AtomicDirectory staging(dir / "out");
+  std::ofstream(staging.path() / "new.txt") << "whole";
+  staging.Commit();
+  EXPECT_TRUE(fs::exists(dir / "out/new.txt"));
+  EXPECT_FALSE(fs::exists(dir / "out/old.txt"));
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir.path()), fs::directory_iterator()), 1);
 }
 
 TEST(AtomicFile, UnwritableDirectoryIsAnOutputError) {
