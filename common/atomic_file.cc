@@ -7,6 +7,7 @@
 #include <cctype>
 #include <cerrno>
 #include <fstream>
+#include <iterator>
 #include <opencv2/imgcodecs.hpp>
 
 #include "common/errors.h"
@@ -78,6 +79,20 @@ void AtomicDirectory::Commit() {
   if (!old.empty()) fs::remove_all(old, ec);
 }
 
+namespace {
+
+// Whether process `pid` may still write: it exists and is not a zombie (one
+// killed and not yet reaped by its parent, which keeps its id for a while).
+bool StillRuns(pid_t pid) {
+  if (::kill(pid, 0) != 0 && errno == ESRCH) return false;
+  std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
+  const std::string text((std::istreambuf_iterator<char>(stat)), std::istreambuf_iterator<char>());
+  const size_t name_end = text.rfind(')');  // the state follows the program's name
+  return name_end == std::string::npos || name_end + 2 >= text.size() || text[name_end + 2] != 'Z';
+}
+
+}  // namespace
+
 void RemoveLeftBehind(const fs::path& dir, const std::string& prefix) {
   std::error_code ec;
   for (fs::directory_iterator it(dir.empty() ? fs::path(".") : dir, ec), end; !ec && it != end;
@@ -88,7 +103,7 @@ void RemoveLeftBehind(const fs::path& dir, const std::string& prefix) {
     while (digits < name.size() && std::isdigit(static_cast<unsigned char>(name[digits]))) ++digits;
     if (digits == prefix.size() || digits - prefix.size() > 9) continue;
     const auto pid = pid_t(std::stol(name.substr(prefix.size(), digits - prefix.size())));
-    if (pid <= 0 || pid == ::getpid() || ::kill(pid, 0) == 0 || errno != ESRCH) continue;
+    if (pid <= 0 || pid == ::getpid() || StillRuns(pid)) continue;
     std::error_code ignored;
     fs::remove_all(it->path(), ignored);
   }

@@ -53,6 +53,18 @@ TEST(AtomicFile, WhatAKilledRunLeftIsRemovedNextTime) {
   EXPECT_FALSE(fs::exists(dir / (".out.tmp." + gone + ".1")));
   EXPECT_TRUE(fs::exists(dir / "x.txt"));
   RemoveLeftBehind(dir / "none", ".out.tmp.");  // no such folder: nothing to do
+
+  // A process killed and not yet reaped by its parent keeps its id: it writes nothing more.
+  const pid_t zombie = ::fork();
+  if (zombie == 0) ::_exit(0);
+  ASSERT_GT(zombie, 0);
+  const fs::path its = dir / (".out.tmp." + std::to_string(zombie) + ".1");
+  fs::create_directories(its);
+  siginfo_t info{};
+  ASSERT_EQ(::waitid(P_PID, id_t(zombie), &info, WEXITED | WNOWAIT), 0);  // exited, not reaped
+  RemoveLeftBehind(dir.path(), ".out.tmp.");
+  EXPECT_FALSE(fs::exists(its));
+  ASSERT_EQ(::waitpid(zombie, nullptr, 0), zombie);
 }
 
 TEST(AtomicFile, AFolderReplacesItsTargetWholeOrNotAtAll) {
