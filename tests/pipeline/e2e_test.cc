@@ -47,6 +47,15 @@ std::string Tool(const std::string& script) {
   return Quote((SourceDir() / "tests/tools" / script).string());
 }
 
+// The exit code of the e2e run's pipeline in `work` (scripts/bench.sh writes
+// it), or -1 when it did not record one.
+int PipelineExit(const fs::path& work) {
+  std::ifstream exit_file(work / "bench/pipeline.exit");
+  int status = -1;
+  exit_file >> status;
+  return status;
+}
+
 // Similarity taking the true world to sfm's world: x_sfm = s R x_true + t.
 struct Similarity {
   double s = 1;
@@ -62,10 +71,8 @@ class EndToEnd : public ::testing::TestWithParam<std::string> {
     data_ = DataDir(set_);
     work_ = E2eDir() / "work" / set_;
     ASSERT_TRUE(fs::is_directory(work_)) << work_ << " (did the e2e_run fixture run?)";
-    std::ifstream exit_file(work_ / "bench/pipeline.exit");
-    int status = -1;
-    exit_file >> status;
-    ASSERT_EQ(status, 0) << set_ << ": the pipeline failed; see " << work_ / "bench/pipeline.log";
+    ASSERT_EQ(PipelineExit(work_), 0)
+        << set_ << ": the pipeline failed; see " << work_ / "bench/pipeline.log";
     auto gt = LoadGroundTruth(data_);
     ASSERT_TRUE(gt);
     gt_ = std::move(*gt);
@@ -510,10 +517,7 @@ TEST(EndToEndSummary, EveryReportOpensInHeadlessChromium) {
   std::vector<std::string> sets;
   for (const std::string& set : E2eSets()) {
     const fs::path work = E2eDir() / "work" / set;
-    std::ifstream exit_file(work / "bench/pipeline.exit");
-    int status = -1;
-    exit_file >> status;
-    if (status != 0) continue;  // Sets/EndToEnd names the set whose pipeline failed
+    if (PipelineExit(work) != 0) continue;  // Sets/EndToEnd names the set whose pipeline failed
     const fs::path report = out / (set + ".html");
     const CommandResult r = RunCommand(Quote(StageBinary("report").string()) + " --data " +
                                        Quote(DataDir(set).string()) + " --work " +
