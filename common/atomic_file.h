@@ -45,7 +45,6 @@ class AtomicDirectory {
   AtomicDirectory& operator=(const AtomicDirectory&) = delete;
 
   const fs::path& path() const { return path_; }
-  const fs::path& target() const { return target_; }
   // Replaces the target with the folder; throws OutputError.
   void Commit();
 
