@@ -38,7 +38,7 @@ DATA_DIR := $(word 1,$(DATA_RESOLVED))
 NAME := $(word 2,$(DATA_RESOLVED))
 # (When DATA names nothing, check-data stops the run; WORK is then one word
 # all the same, so that a DATA with spaces cannot turn into stray targets.)
-override WORK := $(or $(word 3,$(DATA_RESOLVED)),$(WORK_ROOT)/$(lastword $(notdir $(DATA))))
+override WORK := $(patsubst %/,%,$(or $(word 3,$(DATA_RESOLVED)),$(WORK_ROOT)/$(lastword $(notdir $(DATA)))))
 # The photos' names, sizes and times (names may have spaces, which Make's
 # prerequisites cannot): sfm and densify rerun when a photo changes. Files
 # only, links followed: a folder beside the photos is not read, and its time
@@ -160,16 +160,17 @@ IMPLEMENTED := $(foreach s,$(CHAIN),$(if $(wildcard $(ROOT)/stages/$(call pair_v
 PROGRAMS := $(notdir $(wildcard $(addprefix $(ROOT)/stages/,$(CHAIN_PROGRAMS) pdf evaluate report)))
 HAS_GT := $(wildcard $(DATA_DIR)/ground_truth/flat.png)
 all: $(lastword $(IMPLEMENTED)) $(if $(wildcard $(ROOT)/stages/pdf),pdf pages) $(if $(and $(HAS_GT),$(wildcard $(ROOT)/stages/evaluate)),evaluate) $(if $(wildcard $(ROOT)/stages/report),report)
-	@echo "docunfold: $(NAME) done; results in $(WORK)$(if $(wildcard $(ROOT)/stages/report),; open $(WORK)/report.html)$(if $(wildcard $(WORK_ROOT)/$(NAME).pdf),; all its pages in $(WORK_ROOT)/$(NAME).pdf)"
+	@echo "docunfold: $(NAME) done; results in $(WORK)$(if $(wildcard $(ROOT)/stages/report),; open $(WORK)/report.html)$(if $(wildcard $(BOOK_PDF)),; all its pages in $(BOOK_PDF))"
 
 # Photos of several pages in one folder: the page with most photos is made
 # here, and each other page sfm found (cameras.json's colmap.other_pages) as
-# a data set of its own, WORK_ROOT/<NAME>-p<k>, all joined by scripts/book
-# into WORK_ROOT/<NAME>.pdf in the order of their photos' names. One page:
-# nothing to do.
+# a data set of its own, WORK-p<k> beside WORK (WORK_ROOT/<NAME>-p<k> by
+# default), all joined by scripts/book into WORK.pdf in the order of their
+# photos' names. One page: nothing to do.
+BOOK_PDF = $(WORK).pdf
 .PHONY: pages
 pages: check-data pdf
-	+@$(ROOT)/scripts/pages '$(ROOT)' '$(WORK_ROOT)' '$(WORK)' '$(NAME)' '$(DATA_DIR)' '$(subst ','\'',$(DATA))' '$(MAKE)'
+	+@$(ROOT)/scripts/pages '$(ROOT)' '$(WORK)' '$(NAME)' '$(DATA_DIR)' '$(MAKE)'
 
 check-data:
 	@test -n "$(DATA_DIR)" || { if test -d '$(subst ','\'',$(DATA))'; then \
@@ -300,8 +301,8 @@ help:
 	@echo "  optimize       joint isometric optimisation with feature lines -> 50_optimize/"
 	@echo "  render         the rectified, cropped page -> 60_render/"
 	@echo "  pdf            searchable PDF at the paper's size, ALTO XML, hOCR -> 80_pdf/"
-	@echo "  pages          photos of several pages in DATA: the others, each to WORK_ROOT/<name>-p<k>,"
-	@echo "                 all joined into WORK_ROOT/<name>.pdf (part of all)"
+	@echo "  pages          photos of several pages in DATA: the others, each to work/<name>-p<k>,"
+	@echo "                 all joined into work/<name>.pdf (WORK=dir: dir-p<k>, dir.pdf; part of all)"
 	@echo "  evaluate       metrics against ground truth -> 70_eval/ (sets with ground_truth/;"
 	@echo "                 front_end.json: boundary and features in the reference view)"
 	@echo "  report         one HTML page with every stage's output -> work/<name>/report.html"

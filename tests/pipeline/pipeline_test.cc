@@ -176,7 +176,7 @@ TEST(PipelineInput, UnknownDataSetIsReported) {
 // set04's): the page with more photos is made in WORK, the other in
 // WORK_ROOT/<name>-p1 (its photos' names come first), and both are joined
 // into WORK_ROOT/<name>.pdf in that order, the other page made with the same
-// flags; a second make remakes nothing.
+// flags; a second make remakes nothing. With WORK=dir, the same beside dir.
 TEST(PipelineInput, AFolderOfTwoPagesGivesOnePdfOfBoth) {
   if (!fs::is_directory(SampleDir("set01")) || !fs::is_directory(SampleDir("set04")))
     GTEST_SKIP() << "no samples set01 and set04";
@@ -197,12 +197,12 @@ TEST(PipelineInput, AFolderOfTwoPagesGivesOnePdfOfBoth) {
   copy_views("set04", 3, 10);  // IMG_0010-12: the other page, first by name
   copy_views("set01", 4, 20);  // IMG_0020-23: the page with more photos
   const fs::path work_root = tmp / "work";
-  auto make = [&] {
+  auto make = [&](const std::string& more = "") {
     return RunCommand(
         "make --no-print-directory -f " + Quote((SourceDir() / "pipeline.mk").string()) +
         " NO_BUILD=1 BUILD=" + Quote(fs::path(DOCUNFOLD_BIN_DIR).parent_path().string()) +
         " DATA=" + Quote(photos.string()) + " WORK_ROOT=" + Quote(work_root.string()) +
-        " OPTIMIZE_FLAGS='--rounds 1' all");  // (what is made where, not how well)
+        " OPTIMIZE_FLAGS='--rounds 1'" + more + " all");  // (what is made where, not how well)
   };
   const CommandResult r = make();
   ASSERT_EQ(r.exit_code, 0) << r.output;
@@ -235,6 +235,24 @@ TEST(PipelineInput, AFolderOfTwoPagesGivesOnePdfOfBoth) {
   EXPECT_NE(again.output.find("all its pages in " + (work_root / "Letter_3.pdf").string()),
             std::string::npos)
       << again.output;
+
+  // With WORK=dir the other pages go beside dir and the book is dir.pdf (the
+  // work copied with its times, so that only what names the pages reruns).
+  const fs::path moved = tmp / "scans" / "letter";
+  fs::create_directories(moved.parent_path());
+  ASSERT_EQ(
+      RunCommand("cp -a " + Quote((work_root / "Letter_3").string()) + " " + Quote(moved.string()) +
+                 " && cp -a " + Quote((work_root / "Letter_3-p1").string()) + " " +
+                 Quote(moved.string() + "-p1"))
+          .exit_code,
+      0);
+  const CommandResult elsewhere = make(" WORK=" + Quote(moved.string() + "/"));
+  ASSERT_EQ(elsewhere.exit_code, 0) << elsewhere.output;
+  EXPECT_EQ(RunCommand("qpdf --show-npages " + Quote(moved.string() + ".pdf")).output, "2\n")
+      << elsewhere.output;
+  EXPECT_TRUE(fs::exists(moved.string() + ".alto/001-letter-p1.alto.xml")) << elsewhere.output;
+  EXPECT_TRUE(fs::exists(moved.string() + ".alto/002-Letter_3.alto.xml")) << elsewhere.output;
+  EXPECT_TRUE(fs::exists(moved.string() + "-p1/80_pdf/letter-p1.pdf")) << elsewhere.output;
 }
 
 // A work root Make cannot carry (a space in it) is refused in one line before
