@@ -155,11 +155,40 @@ std::vector<std::vector<std::string>> ViewsLinkedByMatches(const fs::path& datab
   return groups;
 }
 
-std::vector<SameShot> SameShots(const fs::path& database, int min_matches, double min_share,
-                                double max_error_px) {
+namespace {
+
+// Whether `map` takes all four corners of a `from` frame inside a `to` frame
+// (to within `margin` of its size).
+bool FrameInside(const cv::Mat& map, const cv::Size& from, const cv::Size& to, double margin) {
+  if (map.empty() || from.area() <= 0 || to.area() <= 0) return false;
+  const std::vector<cv::Point2f> corners = {{0, 0},
+                                            {float(from.width), 0},
+                                            {float(from.width), float(from.height)},
+                                            {0, float(from.height)}};
+  std::vector<cv::Point2f> mapped;
+  cv::perspectiveTransform(corners, mapped, map);
+  const double mx = margin * to.width, my = margin * to.height;
+  return std::all_of(mapped.begin(), mapped.end(), [&](const cv::Point2f& p) {
+    return std::isfinite(p.x) && std::isfinite(p.y) && p.x >= -mx && p.y >= -my &&
+           p.x <= to.width + mx && p.y <= to.height + my;
+  });
+}
+
+}  // namespace
+
+std::vector<SameShot> SameShots(const fs::path& database, const SameShotOptions& options) {
   const Database db = OpenDatabase(database, SQLITE_OPEN_READONLY);
   std::map<long, std::string> names;
   std::map<long, std::vector<cv::Point2f>> keypoints;  // x, y of each, in the copy's pixels
+  std::map<long, cv::Size> frames;                     // each copy's size
+  {
+    const Statement stmt = Prepare(db, database,
+                                   "SELECT images.image_id, cameras.width, cameras.height FROM "
+                                   "images JOIN cameras ON images.camera_id = cameras.camera_id");
+    while (sqlite3_step(stmt.get()) == SQLITE_ROW)
+      frames[sqlite3_column_int64(stmt.get(), 0)] = {sqlite3_column_int(stmt.get(), 1),
+                                                     sqlite3_column_int(stmt.get(), 2)};
+  }
   {
     const Statement stmt = Prepare(db, database,
                                    "SELECT images.image_id, images.name, keypoints.rows, "
@@ -183,7 +212,7 @@ std::vector<SameShot> SameShots(const fs::path& database, int min_matches, doubl
   const Statement stmt = Prepare(db, database,
                                  "SELECT pair_id, rows, cols, data FROM two_view_geometries "
                                  "WHERE config >= 2 AND rows >= ? ORDER BY pair_id");
-  sqlite3_bind_int(stmt.get(), 1, std::max(3, min_matches));
+  sqlite3_bind_int(stmt.get(), 1, std::max(4, options.min_matches));
   std::vector<SameShot> shots;
   while (sqlite3_step(stmt.get()) == SQLITE_ROW) {
     const long pair = sqlite3_column_int64(stmt.get(), 0);
@@ -205,9 +234,28 @@ std::vector<SameShot> SameShots(const fs::path& database, int min_matches, doubl
     }
     // (OpenCV's RANSAC is seeded: the same matches give the same answer)
     cv::Mat inliers;
-    const cv::Mat map = cv::estimateAffinePartial2D(from, to, inliers, cv::RANSAC, max_error_px);
+    const cv::Mat map =
+        cv::estimateAffinePartial2D(from, to, inliers, cv::RANSAC, options.max_error_px);
     const double share = map.empty() ? 0.0 : cv::countNonZero(inliers) / double(rows);
-    if (share >= min_share) shots.push_back({names[a], names[b], rows, share});
+    if (share >= options.min_similarity_share) {
+      shots.push_back({names[a], names[b], rows, share, false, ""});
+      continue;
+    }
+    // (RANSAC stops at the first model good enough by its odds, and the
+    // refined map keeps that model's inliers: they are counted again here)
+    const cv::Mat b_from_a = cv::findHomography(from, to, cv::RANSAC, options.max_error_px);
+    if (b_from_a.empty()) continue;
+    std::vector<cv::Point2f> mapped;
+    cv::perspectiveTransform(from, mapped, b_from_a);
+    int close = 0;
+    for (size_t k = 0; k < mapped.size(); ++k)
+      close += cv::norm(mapped[k] - to[k]) <= options.max_error_px;
+    const double perspective_share = close / double(rows);
+    if (perspective_share < options.min_perspective_share) continue;
+    if (FrameInside(b_from_a, frames[a], frames[b], options.frame_margin))
+      shots.push_back({names[a], names[b], rows, perspective_share, true, names[a]});
+    else if (FrameInside(b_from_a.inv(), frames[b], frames[a], options.frame_margin))
+      shots.push_back({names[a], names[b], rows, perspective_share, true, names[b]});
   }
   return shots;
 }

@@ -50,22 +50,35 @@ std::vector<std::vector<std::string>> ViewsLinkedByMatches(const fs::path& datab
 
 // Two images of a COLMAP database that are one shot: one is the other
 // cropped, turned, scaled or retouched (a phone's edited copy beside the
-// original). A similarity (rotation, scale, shift) takes at least
-// `min_share` of the matches COLMAP verified between them to within
-// `max_error_px` (pixels of the copies COLMAP read). Two photos taken from
-// two places never come that close: the map between them is a perspective
-// one, bent further by the page's creases.
+// original), or the page cut out of it and straightened (a scanner app's
+// copy). Two photos taken from two places never come that close: the map
+// between them is a perspective one, bent further by the page's creases,
+// and neither one's frame lies inside the other's (the page with the table
+// around it in each).
 struct SameShot {
   std::string first, second;  // image names, first before second by id
   int matches = 0;            // verified matches
-  double share = 0;           // of them, the similarity's inliers
+  double share = 0;           // of them, the inliers of the map found
+  // The map: a similarity (either may be the copy), or a homography taking
+  // all of `copy`'s frame into the other's (a perspective-corrected copy).
+  bool perspective = false;
+  std::string copy;  // the perspective copy's name; empty for a similarity
 };
 
-// Every pair of images with at least `min_matches` verified matches that is
-// one shot, by pair id. Throws std::runtime_error naming the database when
-// it cannot be read.
-std::vector<SameShot> SameShots(const fs::path& database, int min_matches, double min_share,
-                                double max_error_px);
+struct SameShotOptions {
+  int min_matches = 50;  // verified matches of a pair looked at
+  // Of them, at least this share within max_error_px of one similarity.
+  double min_similarity_share = 0.9;
+  // ... or of one homography that maps one frame's corners inside the
+  // other's frame (to within frame_margin of its size).
+  double min_perspective_share = 0.75;
+  double max_error_px = 2.0;  // pixels of the copies COLMAP read
+  double frame_margin = 0.02;
+};
+
+// Every pair of images that is one shot, by pair id. Throws
+// std::runtime_error naming the database when it cannot be read.
+std::vector<SameShot> SameShots(const fs::path& database, const SameShotOptions& options);
 
 // Every image of a COLMAP database with its descriptors, by image id.
 // Throws std::runtime_error naming the database when it cannot be read.

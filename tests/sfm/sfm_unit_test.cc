@@ -598,7 +598,10 @@ void MakeDatabase(const fs::path& file, const std::vector<std::pair<int, std::st
       "CREATE TABLE keypoints (image_id INTEGER PRIMARY KEY NOT NULL, rows INTEGER NOT NULL, "
       "cols INTEGER NOT NULL, data BLOB);"
       "CREATE TABLE descriptors (image_id INTEGER PRIMARY KEY NOT NULL, rows INTEGER NOT NULL, "
-      "cols INTEGER NOT NULL, data BLOB);";
+      "cols INTEGER NOT NULL, data BLOB);"
+      "CREATE TABLE cameras (camera_id INTEGER PRIMARY KEY NOT NULL, model INTEGER NOT NULL, "
+      "width INTEGER NOT NULL, height INTEGER NOT NULL, params BLOB, prior_focal_length "
+      "INTEGER NOT NULL); INSERT INTO cameras VALUES (1, 0, 1600, 1200, NULL, 0);";
   for (const auto& [id, name] : images) {
     const std::string i = std::to_string(id);
     // One keypoint and one descriptor whose first byte is the id.
@@ -691,34 +694,48 @@ TEST(ExactMatchingTest, ViewsLinkedByVerifiedMatchesFallIntoGroups) {
 }
 
 // A phone's edited copy (the photo cropped, turned and scaled) is one shot
-// with its photo: a similarity takes their matches onto each other. A second
-// view of the page, a perspective map away, is not, nor is a pair with too
-// few matches.
-TEST(ExactMatchingTest, AnEditedCopyIsTheSameShotAndASecondViewIsNot) {
+// with its photo: a similarity takes their matches onto each other. So is a
+// scanner app's copy (the page cut out of the photo and straightened): a
+// homography takes its whole frame inside the photo's, and inside the second
+// view's. A second view of the page, a perspective map away with the
+// table around the page in both, is not, nor is a pair with too few matches.
+TEST(ExactMatchingTest, EditedAndScannedCopiesAreTheSameShotAndASecondViewIsNot) {
   TempDir tmp;
   const fs::path db_file = tmp.path() / "database.db";
-  MakeDatabase(db_file, {{1, "IMG_0001.png"}, {2, "IMG_E0001.png"}, {3, "IMG_0002.png"}});
+  MakeDatabase(
+      db_file,
+      {{1, "IMG_0001.png"}, {2, "IMG_E0001.png"}, {3, "IMG_0002.png"}, {4, "Scan 2026-12-06.png"}});
   sqlite3* db = nullptr;
   ASSERT_EQ(sqlite3_open(db_file.c_str(), &db), SQLITE_OK);
   ASSERT_EQ(sqlite3_exec(db,
                          "DELETE FROM keypoints; CREATE TABLE two_view_geometries (pair_id "
                          "INTEGER PRIMARY KEY NOT NULL, rows INTEGER NOT NULL, cols INTEGER NOT "
-                         "NULL, data BLOB, config INTEGER NOT NULL);",
+                         "NULL, data BLOB, config INTEGER NOT NULL); INSERT INTO cameras VALUES "
+                         "(2, 0, 1000, 1400, NULL, 0); UPDATE images SET camera_id = 2 WHERE "
+                         "image_id = 4;",
                          nullptr, nullptr, nullptr),
             SQLITE_OK);
+  // The page in the photo, and the scan: that quadrilateral made the frame.
+  const std::vector<cv::Point2f> page = {{300, 180}, {1280, 240}, {1330, 1010}, {250, 960}};
+  const cv::Matx33f scan_from_photo(cv::getPerspectiveTransform(
+      page, std::vector<cv::Point2f>{{0, 0}, {1000, 0}, {1000, 1400}, {0, 1400}}));
   std::mt19937 rng(7);
-  std::uniform_real_distribution<float> x(0, 1600), y(0, 1200);
+  std::uniform_real_distribution<float> x(0, 1000), y(0, 1400);
   std::normal_distribution<float> noise(0, 0.3f);
-  std::vector<cv::Point2f> photo;
-  for (int i = 0; i < 200; ++i) photo.emplace_back(x(rng), y(rng));
+  std::vector<cv::Point2f> photo;  // points on the page
+  for (int i = 0; i < 200; ++i) {
+    const cv::Vec3f p = scan_from_photo.inv() * cv::Vec3f(x(rng), y(rng), 1);
+    photo.emplace_back(p[0] / p[2], p[1] / p[2]);
+  }
   // The copy: the middle cropped, turned 90°, scaled by 1.3. The other view:
   // the page seen from elsewhere (a homography).
   const cv::Matx33f copy_from_photo(0, -1.3f, 1200 * 1.3f - 100, 1.3f, 0, -150, 0, 0, 1);
   const cv::Matx33f view_from_photo(0.9f, 0.12f, 40, -0.05f, 1.05f, 20, 4e-5f, 6e-5f, 1);
-  std::vector<std::vector<float>> keypoints(3);
+  std::vector<std::vector<float>> keypoints(4);
   for (const cv::Point2f& p : photo) {
     keypoints[0].insert(keypoints[0].end(), {p.x, p.y, 1, 0, 0, 1});
-    for (const auto& [k, h] : {std::pair{1, copy_from_photo}, {2, view_from_photo}}) {
+    for (const auto& [k, h] :
+         {std::pair{1, copy_from_photo}, {2, view_from_photo}, {3, scan_from_photo}}) {
       const cv::Vec3f q = h * cv::Vec3f(p.x, p.y, 1);
       keypoints[size_t(k)].insert(keypoints[size_t(k)].end(),
                                   {q[0] / q[2] + noise(rng), q[1] / q[2] + noise(rng), 1, 0, 0, 1});
@@ -728,7 +745,7 @@ TEST(ExactMatchingTest, AnEditedCopyIsTheSameShotAndASecondViewIsNot) {
   ASSERT_EQ(
       sqlite3_prepare_v2(db, "INSERT INTO keypoints VALUES (?, 200, 6, ?)", -1, &stmt, nullptr),
       SQLITE_OK);
-  for (int k = 0; k < 3; ++k) {
+  for (int k = 0; k < 4; ++k) {
     sqlite3_bind_int(stmt, 1, k + 1);
     sqlite3_bind_blob(stmt, 2, keypoints[size_t(k)].data(), 200 * 6 * sizeof(float),
                       SQLITE_TRANSIENT);
@@ -742,7 +759,8 @@ TEST(ExactMatchingTest, AnEditedCopyIsTheSameShotAndASecondViewIsNot) {
   ASSERT_EQ(sqlite3_prepare_v2(db, "INSERT INTO two_view_geometries VALUES (?, ?, 2, ?, 6)", -1,
                                &stmt, nullptr),
             SQLITE_OK);
-  for (const auto& [a, b, rows] : {std::tuple{1L, 2L, 200}, {2L, 3L, 200}, {1L, 3L, 40}}) {
+  for (const auto& [a, b, rows] :
+       {std::tuple{1L, 2L, 200}, {2L, 3L, 200}, {1L, 3L, 40}, {1L, 4L, 200}, {3L, 4L, 200}}) {
     sqlite3_bind_int64(stmt, 1, a * 2147483647L + b);
     sqlite3_bind_int(stmt, 2, rows);
     sqlite3_bind_blob(stmt, 3, matches.data(), int(rows * 2 * sizeof(uint32_t)), SQLITE_TRANSIENT);
@@ -752,14 +770,22 @@ TEST(ExactMatchingTest, AnEditedCopyIsTheSameShotAndASecondViewIsNot) {
   sqlite3_finalize(stmt);
   sqlite3_close(db);
 
-  const std::vector<sfm::SameShot> shots = sfm::SameShots(db_file, 50, 0.9, 2.0);
-  ASSERT_EQ(shots.size(), 1u);
+  sfm::SameShotOptions options;
+  const std::vector<sfm::SameShot> shots = sfm::SameShots(db_file, options);
+  ASSERT_EQ(shots.size(), 3u);
   EXPECT_EQ(shots[0].first, "IMG_0001.png");
   EXPECT_EQ(shots[0].second, "IMG_E0001.png");
   EXPECT_EQ(shots[0].matches, 200);
   EXPECT_GE(shots[0].share, 0.99);
+  EXPECT_FALSE(shots[0].perspective);
+  for (size_t i : {1, 2}) {
+    EXPECT_TRUE(shots[i].perspective);
+    EXPECT_EQ(shots[i].copy, "Scan 2026-12-06.png") << shots[i].first << " " << shots[i].second;
+    EXPECT_GE(shots[i].share, 0.95);
+  }
   // With few enough matches asked for, 1-3 is looked at too: still a second view.
-  EXPECT_EQ(sfm::SameShots(db_file, 30, 0.9, 2.0).size(), 1u);
+  options.min_matches = 30;
+  EXPECT_EQ(sfm::SameShots(db_file, options).size(), 3u);
 }
 
 TEST(ExactMatchingTest, BadDatabasesAreErrorsNamingTheFile) {
