@@ -216,6 +216,8 @@ std::set<std::string> LeaveOutEditedCopies(const Colmap& colmap, PhotoSet* photo
     if (copies.count(shot.first) || copies.count(shot.second) || !index.count(shot.first) ||
         !index.count(shot.second))
       continue;
+    // (of two photos left, one inside the other may be a close-up as well)
+    if (shot.perspective && photos->photos.size() - copies.size() <= 2) continue;
     const PhotoCopy& a = photos->photos[index[shot.first]];
     const PhotoCopy& b = photos->photos[index[shot.second]];
     const bool keep_a = shot.perspective ? shot.copy == b.colmap_name : KeptOver(a, b);
