@@ -350,7 +350,8 @@ CoarseRegion FindCoarseRegion(const cv::Mat3b& full, const BoundaryOptions& opti
         "no document found: no region distinct from the background "
         "covers " +
         std::to_string(int(options.min_area_fraction * 100)) +
-        "% of the image (largest: " + Fixed(area / work_area * 100, 2) + "%)");
+        "% of the image (largest: " + Fixed(area / work_area * 100, 2) +
+        "%; is the page that small, or does it fill the photo with no table around it?)");
   return {small, s, coarse};
 }
 

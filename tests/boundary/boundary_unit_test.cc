@@ -172,6 +172,19 @@ TEST(SegmentBoundary, EmptyTableIsNoDocument) {
     EXPECT_NE(std::string(e.what()).find("no document found"), std::string::npos) << e.what();
   }
   EXPECT_THROW(SegmentBoundary(cv::Mat3b(600, 800, cv::Vec3b(128, 128, 128)), {}), InputError);
+  // A page that fills the image (as a scanner app saves it): the message says
+  // what may be wrong.
+  cv::Mat3b scan(800, 600, cv::Vec3b(236, 240, 242));
+  for (int y = 60; y < 760; y += 24)
+    cv::line(scan, {50, y}, {550 - (y * 7) % 200, y}, cv::Scalar(40, 40, 40), 3);
+  try {
+    SegmentBoundary(scan, {});
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("fill the photo with no table around it"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 // The outline through `vertices` and back to the first, one point per pixel
