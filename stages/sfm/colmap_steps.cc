@@ -216,8 +216,6 @@ std::set<std::string> LeaveOutEditedCopies(const Colmap& colmap, PhotoSet* photo
     if (copies.count(shot.first) || copies.count(shot.second) || !index.count(shot.first) ||
         !index.count(shot.second))
       continue;
-    // (of two photos left, one inside the other may be a close-up as well)
-    if (shot.perspective && photos->photos.size() - copies.size() <= 2) continue;
     const PhotoCopy& a = photos->photos[index[shot.first]];
     const PhotoCopy& b = photos->photos[index[shot.second]];
     const bool keep_a = shot.perspective ? shot.copy == b.colmap_name : KeptOver(a, b);
@@ -227,9 +225,8 @@ std::set<std::string> LeaveOutEditedCopies(const Colmap& colmap, PhotoSet* photo
     photos->left_out.push_back(
         {copy.name,
          shot.perspective
-             ? "the page alone, straightened, as a scanner app saves it (all of it lies "
-               "within " +
-                   kept.name + ")"
+             ? "all of it lies within " + kept.name +
+                   " (a scanner app's copy of its page, or a close-up from the same spot)"
              : "the same shot as " + kept.name + ", edited or taken from the same spot"});
     Log("left out: " + copy.name + " (" + photos->left_out.back().reason + ": " +
         std::to_string(int(std::lround(100 * shot.share))) + " % of " +
