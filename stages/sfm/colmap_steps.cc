@@ -218,20 +218,20 @@ std::set<std::string> LeaveOutEditedCopies(const Colmap& colmap, PhotoSet* photo
       continue;
     const PhotoCopy& a = photos->photos[index[shot.first]];
     const PhotoCopy& b = photos->photos[index[shot.second]];
-    const bool keep_a = shot.perspective ? shot.copy == b.colmap_name : KeptOver(a, b);
+    const bool perspective = !shot.copy.empty();
+    const bool keep_a = perspective ? shot.copy == b.colmap_name : KeptOver(a, b);
     const PhotoCopy& kept = keep_a ? a : b;
     const PhotoCopy& copy = keep_a ? b : a;
     copies.insert(copy.colmap_name);
     photos->left_out.push_back(
         {copy.name,
-         shot.perspective
-             ? "all of it lies within " + kept.name +
-                   " (a scanner app's copy of its page, or a close-up from the same spot)"
-             : "the same shot as " + kept.name + ", edited or taken from the same spot"});
+         perspective ? "all of it lies within " + kept.name +
+                           " (a scanner app's copy of its page, or a close-up from the same spot)"
+                     : "the same shot as " + kept.name + ", edited or taken from the same spot"});
     Log("left out: " + copy.name + " (" + photos->left_out.back().reason + ": " +
         std::to_string(int(std::lround(100 * shot.share))) + " % of " +
         std::to_string(shot.matches) + " matches one " +
-        (shot.perspective ? "homography" : "similarity") + " apart)");
+        (perspective ? "homography" : "similarity") + " apart)");
   }
   for (size_t i = photos->photos.size(); i-- > 0;) {
     if (!copies.count(photos->photos[i].colmap_name)) continue;

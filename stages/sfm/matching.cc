@@ -180,23 +180,17 @@ std::vector<SameShot> SameShots(const fs::path& database, const SameShotOptions&
   const Database db = OpenDatabase(database, SQLITE_OPEN_READONLY);
   std::map<long, std::string> names;
   std::map<long, std::vector<cv::Point2f>> keypoints;  // x, y of each, in the copy's pixels
-  std::map<long, cv::Size> frames;                     // each copy's size
+  std::map<long, cv::Size> frames;                     // each copy's size (0 x 0 unknown)
   {
-    const Statement stmt = Prepare(db, database,
-                                   "SELECT images.image_id, cameras.width, cameras.height FROM "
-                                   "images JOIN cameras ON images.camera_id = cameras.camera_id");
-    while (sqlite3_step(stmt.get()) == SQLITE_ROW)
-      frames[sqlite3_column_int64(stmt.get(), 0)] = {sqlite3_column_int(stmt.get(), 1),
-                                                     sqlite3_column_int(stmt.get(), 2)};
-  }
-  {
-    const Statement stmt = Prepare(db, database,
-                                   "SELECT images.image_id, images.name, keypoints.rows, "
-                                   "keypoints.cols, keypoints.data FROM images JOIN keypoints ON "
-                                   "images.image_id = keypoints.image_id");
+    const Statement stmt = Prepare(
+        db, database,
+        "SELECT images.image_id, images.name, keypoints.rows, keypoints.cols, keypoints.data, "
+        "cameras.width, cameras.height FROM images JOIN keypoints ON images.image_id = "
+        "keypoints.image_id LEFT JOIN cameras ON images.camera_id = cameras.camera_id");
     while (sqlite3_step(stmt.get()) == SQLITE_ROW) {
       const long id = sqlite3_column_int64(stmt.get(), 0);
       names[id] = reinterpret_cast<const char*>(sqlite3_column_text(stmt.get(), 1));
+      frames[id] = {sqlite3_column_int(stmt.get(), 5), sqlite3_column_int(stmt.get(), 6)};
       const int rows = sqlite3_column_int(stmt.get(), 2), cols = sqlite3_column_int(stmt.get(), 3);
       const auto* data = static_cast<const float*>(sqlite3_column_blob(stmt.get(), 4));
       if (rows < 0 || cols < 2 ||
@@ -238,7 +232,7 @@ std::vector<SameShot> SameShots(const fs::path& database, const SameShotOptions&
         cv::estimateAffinePartial2D(from, to, inliers, cv::RANSAC, options.max_error_px);
     const double share = map.empty() ? 0.0 : cv::countNonZero(inliers) / double(rows);
     if (share >= options.min_similarity_share) {
-      shots.push_back({names[a], names[b], rows, share, false, ""});
+      shots.push_back({names[a], names[b], rows, share, ""});
       continue;
     }
     // (RANSAC stops at the first model good enough by its odds, and the
@@ -253,9 +247,9 @@ std::vector<SameShot> SameShots(const fs::path& database, const SameShotOptions&
     const double perspective_share = close / double(rows);
     if (perspective_share < options.min_perspective_share) continue;
     if (FrameInside(b_from_a, frames[a], frames[b], options.frame_margin))
-      shots.push_back({names[a], names[b], rows, perspective_share, true, names[a]});
+      shots.push_back({names[a], names[b], rows, perspective_share, names[a]});
     else if (FrameInside(b_from_a.inv(), frames[b], frames[a], options.frame_margin))
-      shots.push_back({names[a], names[b], rows, perspective_share, true, names[b]});
+      shots.push_back({names[a], names[b], rows, perspective_share, names[b]});
   }
   return shots;
 }

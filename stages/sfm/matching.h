@@ -59,10 +59,10 @@ struct SameShot {
   std::string first, second;  // image names, first before second by id
   int matches = 0;            // verified matches
   double share = 0;           // of them, the inliers of the map found
-  // The map: a similarity (either may be the copy), or a homography taking
-  // all of `copy`'s frame into the other's (a perspective-corrected copy).
-  bool perspective = false;
-  std::string copy;  // the perspective copy's name; empty for a similarity
+  // Empty when a similarity joins them (either may be the copy); else the
+  // image whose whole frame a homography takes into the other's (a
+  // perspective-corrected copy).
+  std::string copy;
 };
 
 struct SameShotOptions {

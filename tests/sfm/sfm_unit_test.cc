@@ -777,9 +777,8 @@ TEST(ExactMatchingTest, EditedAndScannedCopiesAreTheSameShotAndASecondViewIsNot)
   EXPECT_EQ(shots[0].second, "IMG_E0001.png");
   EXPECT_EQ(shots[0].matches, 200);
   EXPECT_GE(shots[0].share, 0.99);
-  EXPECT_FALSE(shots[0].perspective);
+  EXPECT_TRUE(shots[0].copy.empty()) << "a similarity";
   for (size_t i : {1, 2}) {
-    EXPECT_TRUE(shots[i].perspective);
     EXPECT_EQ(shots[i].copy, "Scan 2026-12-06.png") << shots[i].first << " " << shots[i].second;
     EXPECT_GE(shots[i].share, 0.95);
   }
