@@ -201,6 +201,7 @@ constexpr double kMissCost = 20;
 // preference, outliers, the reference's border band), +inf where the view
 // does not see the point.
 std::vector<cv::Mat1f> DataCosts(const FusionOptions& o, const std::vector<ViewRendering>& r,
+                                 const std::vector<double>& sharpness,
                                  const cv::Mat1b& on_surface) {
   const int n = int(r.size()), W = on_surface.cols, H = on_surface.rows;
   const float inf = std::numeric_limits<float>::infinity();
@@ -261,7 +262,8 @@ std::vector<cv::Mat1f> DataCosts(const FusionOptions& o, const std::vector<ViewR
         for (int v = 0; v < n; ++v) {
           const float res = r[v].resolution(y, x);
           if (!(res > 0)) continue;
-          double c = std::max(0.0, log_cap - std::log(std::min<double>(res, o.resolution_cap)));
+          double c = std::max(
+              0.0, log_cap - std::log(std::min<double>(res, o.resolution_cap) * sharpness[v]));
           if (v == 0) c = std::max(0.0, c - log_pref);
           const float b = brightness[v](y, x);
           if (seen_by >= 3 && std::abs(b - median) > o.outlier_ratio * median + 4)
@@ -442,7 +444,10 @@ FusedTexture FuseTexture(const FusionSurface& s, const std::vector<FusionView>& 
   timer.Mark("fusion_render");
   fusion_internal::LevelAndRegister(o, &r, &out.views);
   timer.Mark("fusion_level_register");
-  const std::vector<cv::Mat1f> cost = DataCosts(o, r, on_surface);
+  const std::vector<double> sharpness =
+      fusion_internal::RelativeSharpness(o, r, out.surface_pixels);
+  for (int v = 0; v < n; ++v) out.views[v].sharpness = sharpness[v];
+  const std::vector<cv::Mat1f> cost = DataCosts(o, r, sharpness, on_surface);
   timer.Mark("fusion_costs");
   int patches_across = 0;
   const std::vector<int> labels = PatchLabels(o, r, cost, &patches_across);

@@ -13,7 +13,8 @@
 //     never exact) is taken out by optical flow onto the first photo's
 //     rendering on the overlap, carried smoothly over the rest;
 //  4. a labelling of texel patches (alpha-expansion graph cuts) picks one
-//     photo per patch: resolution, a preference for the first photo (the
+//     photo per patch: resolution (scaled down for a shaken or out-of-focus
+//     photo, whose print is blurred), a preference for the first photo (the
 //     frame everything is registered to), a penalty for a photo much
 //     brighter than the others there (glare); seams cost where the photos
 //     disagree, so they run where they agree;
@@ -62,6 +63,20 @@ struct FusionOptions {
   // times better: the others are registered to it, so every switch risks a
   // seam.
   double reference_preference = 1.5;
+  // A photo blurred (shaken, out of focus) resolves less than its pixels
+  // say: its resolution is scaled by its sharpness against the sharpest
+  // photo, measured by squared grey gradients where two photos resolve the
+  // surface within this ratio of each other...
+  double sharpness_resolution_band = 1.25;
+  // ...and over which the mean squared gradient (grey levels², Sobel) is at
+  // least this (less: blank paper, whose noise says nothing)...
+  double sharpness_min_energy = 100;
+  // ...and a view within this ratio of the sharpest counts as sharp; past
+  // it, each e-fold of gradient energy it lacks costs blur_weight e-folds of
+  // resolution (the energy of upsampled print falls about as fast as the
+  // resolution, but a shaken photo's smear reads worse than a coarse one).
+  double sharpness_tolerance = 1.5;
+  double blur_weight = 2.0;
   // Side of a texel patch, output pixels (the labelling's unit).
   int patch_px = 8;
   // Weight of a seam's cost (the photos' colour difference across it, 0..1
@@ -110,6 +125,9 @@ struct FusionViewReport {
   // reference).
   cv::Vec3d gain = cv::Vec3d(1, 1, 1);
   double flow_p95 = 0;  // 95th percentile of its flow onto the reference, px
+  // Its sharpness against the sharpest photo (1: as sharp; below: blurred),
+  // the factor its resolution was scaled by.
+  double sharpness = 1;
 };
 
 // Labels in FusedTexture::label beyond view indices.

@@ -1,5 +1,5 @@
 // The steps of texture fusion (texture_fusion.cc) that bring the photos
-// together before the labelling: levelling and registration
+// together before the labelling: levelling, registration and sharpness
 // (texture_registration.cc).
 #pragma once
 
@@ -25,5 +25,14 @@ struct ViewRendering {
 // into `reports`.
 void LevelAndRegister(const FusionOptions& o, std::vector<ViewRendering>* renderings,
                       std::vector<FusionViewReport>* reports);
+
+// Per view, how sharp it is against how finely it resolves the surface (1:
+// as sharp as the sharpest; 0.3: blurred like a photo with a third of its
+// resolution), from the squared gradients of the levelled renderings where
+// two views resolve the surface about equally finely. A view shaken or out
+// of focus is what this catches; differences within
+// options.sharpness_tolerance count as 1.
+std::vector<double> RelativeSharpness(const FusionOptions& o, const std::vector<ViewRendering>& r,
+                                      long surface_pixels);
 
 }  // namespace docunfold::fusion_internal

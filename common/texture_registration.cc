@@ -1,5 +1,6 @@
-// Levelling and registration of the photos' renderings for texture fusion
+// Levelling, registration and sharpness of the photos' renderings for texture fusion
 // (texture_fusion_internal.h).
+#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 #include <opencv2/imgproc.hpp>
@@ -229,6 +230,65 @@ void LevelAndRegister(const FusionOptions& o, std::vector<ViewRendering>* render
     c.copyTo(target, add);
     target_valid |= add;
   }
+}
+
+std::vector<double> RelativeSharpness(const FusionOptions& o, const std::vector<ViewRendering>& r,
+                                      long surface_pixels) {
+  const int n = int(r.size());
+  // Squared grey gradients, after levelling: print's edges dominate them.
+  std::vector<cv::Mat1f> energy(n);
+  std::vector<cv::Mat1b> valid(n);
+  for (int v = 0; v < n; ++v) {
+    cv::Mat grey;
+    cv::Mat1f gx, gy;
+    cv::cvtColor(r[v].colour, grey, cv::COLOR_BGR2GRAY);
+    grey.convertTo(grey, CV_32F);
+    cv::Sobel(grey, gx, CV_32F, 1, 0);
+    cv::Sobel(grey, gy, CV_32F, 0, 1);
+    energy[v] = gx.mul(gx) + gy.mul(gy);
+    // Off the edge of what a view sees, the black beyond would count as print.
+    cv::erode(r[v].Valid(), valid[v], cv::Mat(), cv::Point(-1, -1), 3);
+  }
+  // log(E_j / E_k) on the pixels both resolve about equally finely: there the
+  // ratio says which photo is blurred, whatever the print.
+  const double band = std::log(o.sharpness_resolution_band);
+  const long min_pixels = std::max<long>(500, long(0.01 * surface_pixels));
+  Eigen::MatrixXd normal = Eigen::MatrixXd::Identity(n, n) * 1e-3;
+  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n);
+  for (int j = 0; j < n; ++j)
+    for (int k = j + 1; k < n; ++k) {
+      double ej = 0, ek = 0;
+      long count = 0;
+      for (int y = 0; y < valid[j].rows; ++y) {
+        const uchar* vj = valid[j].ptr<uchar>(y);
+        const uchar* vk = valid[k].ptr<uchar>(y);
+        const float* rj = r[j].resolution.ptr<float>(y);
+        const float* rk = r[k].resolution.ptr<float>(y);
+        const float* fj = energy[j].ptr<float>(y);
+        const float* fk = energy[k].ptr<float>(y);
+        for (int x = 0; x < valid[j].cols; ++x) {
+          if (!vj[x] || !vk[x]) continue;
+          const double cj = std::min<double>(rj[x], o.resolution_cap);
+          const double ck = std::min<double>(rk[x], o.resolution_cap);
+          if (std::abs(std::log(cj / ck)) > band) continue;
+          ej += fj[x];
+          ek += fk[x];
+          ++count;
+        }
+      }
+      // A blank overlap (paper noise alone) says nothing.
+      if (count < min_pixels || std::min(ej, ek) < o.sharpness_min_energy * count) continue;
+      const double m = std::log(ej / ek);
+      const double w = std::sqrt(double(count));
+      normal(j, j) += w, normal(k, k) += w, normal(j, k) -= w, normal(k, j) -= w;
+      rhs(j) += w * m, rhs(k) -= w * m;
+    }
+  const Eigen::VectorXd g = normal.ldlt().solve(rhs);
+  std::vector<double> sharpness(n, 1.0);
+  const double best = g.maxCoeff(), tolerated = std::log(o.sharpness_tolerance);
+  for (int v = 0; v < n; ++v)
+    sharpness[v] = std::exp(-o.blur_weight * std::max(0.0, best - g(v) - tolerated));
+  return sharpness;
 }
 
 }  // namespace docunfold::fusion_internal

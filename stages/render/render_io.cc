@@ -215,7 +215,8 @@ Json RenderReport(const RenderOptions& options, const RenderInputs& in, const Re
                        {"seen", v.seen},
                        {"share", v.share},
                        {"gain_bgr", {v.gain[0], v.gain[1], v.gain[2]}},
-                       {"flow_p95_px", v.flow_p95}});
+                       {"flow_p95_px", v.flow_p95},
+                       {"sharpness", v.sharpness}});
     texture["views"] = views;
     texture["unseen_fraction"] = r.texture_unseen;
     Json steps = Json::object();

@@ -2,7 +2,8 @@
 // (it resolves the page coarsely), a second photo close up over the lower
 // part of the page, 30 % darker, with a glare spot. The close photo colours
 // what it sees; levelled, it meets the reference without a step; the glare
-// is taken from the reference instead.
+// is taken from the reference instead. And two photos that resolve the
+// page equally finely, one of them shaken.
 #include "common/texture_fusion.h"
 
 #include <gtest/gtest.h>
@@ -200,6 +201,65 @@ TEST(TextureFusion, PartsNoPhotoSeesAreCountedUnseen) {
   EXPECT_LT(fused.unseen, 0.6);
   EXPECT_EQ(cv::countNonZero(fused.label == kFusionUnseen),
             long(std::lround(fused.unseen * fused.surface_pixels)));
+}
+
+// A photo smeared by a hand's shake: a 13-pixel line at 30 degrees.
+cv::Mat3b Shaken(const cv::Mat3b& photo) {
+  cv::Mat1f kernel(15, 15, 0.f);
+  cv::line(kernel, cv::Point(1, 10), cv::Point(13, 4), cv::Scalar(1), 1, cv::LINE_AA);
+  kernel /= cv::sum(kernel)[0];
+  cv::Mat3b out;
+  cv::filter2D(photo, out, -1, kernel);
+  return out;
+}
+
+// Two photos that resolve the page equally finely (both at 1 photo pixel per
+// page pixel or finer), one of them shaken.
+Scene MakeEqualScene(bool shake_reference, bool shake_other) {
+  Scene s = MakeScene();
+  s.views[0].camera = Camera({0.3, 0.4, -1.0});
+  s.views[0].photo = Photograph(s.page, s.views[0].camera, 1.0, 5);
+  // 0.9 m away over the lower part: it sees y >= 100.
+  s.views[1].camera = Camera({0.3, 0.55, -0.9});
+  s.views[1].photo = Photograph(s.page, s.views[1].camera, 0.8, 6);
+  if (shake_reference) s.views[0].photo = Shaken(s.views[0].photo);
+  if (shake_other) s.views[1].photo = Shaken(s.views[1].photo);
+  return s;
+}
+
+TEST(TextureFusion, AShakenPhotoColoursOnlyWhatNoSharpOneSees) {
+  {
+    const Scene s = MakeEqualScene(false, false);
+    const FusedTexture fused = FuseTexture(s.surface, s.views);
+    EXPECT_EQ(fused.views[0].sharpness, 1);
+    EXPECT_EQ(fused.views[1].sharpness, 1);
+    EXPECT_GT(fused.views[0].share, 0.95);  // the reference's preference
+  }
+  {
+    const Scene s = MakeEqualScene(false, true);
+    const FusedTexture fused = FuseTexture(s.surface, s.views);
+    EXPECT_EQ(fused.views[0].sharpness, 1);
+    EXPECT_LT(fused.views[1].sharpness, 0.5);
+    EXPECT_GT(fused.views[0].share, 0.95);
+  }
+  {
+    // The reference shaken: the other photo colours all it sees (7/8 of the
+    // page) but the reference's border band.
+    const Scene s = MakeEqualScene(true, false);
+    const FusedTexture fused = FuseTexture(s.surface, s.views);
+    EXPECT_LT(fused.views[0].sharpness, 0.5);
+    EXPECT_EQ(fused.views[1].sharpness, 1);
+    EXPECT_GT(fused.views[1].share, 0.8);
+    // Its print is sharp: the fused page is nearer the truth than the
+    // shaken reference's rendering of it.
+    const FusedTexture shaken_only = FuseTexture(s.surface, {s.views[0]});
+    cv::Mat1b seen_by_other(s.page.size(), uchar(0));
+    seen_by_other(cv::Rect(40, 200, kPageW - 80, kPageH - 240)).setTo(255);
+    const double fused_error = cv::mean(cv::abs(Difference(fused.image, s.page)), seen_by_other)[0];
+    const double shaken_error =
+        cv::mean(cv::abs(Difference(shaken_only.image, s.page)), seen_by_other)[0];
+    EXPECT_LT(fused_error, 0.7 * shaken_error) << fused_error << " vs " << shaken_error;
+  }
 }
 
 }  // namespace
