@@ -431,11 +431,14 @@ MapperAttempt RunMapper(const Colmap& colmap, const PhotoSet& photos, const Mapp
   std::vector<std::string> image_list;
   if (!colmap.mapped.empty())
     image_list = {"--image_list_path", (colmap.dir / "mapped_images.txt").string()};
+  // The mapper runs on one thread: on more, its bundle adjustment sums in a
+  // different order on each run, the cameras differ in their last bits, and
+  // some pages' results follow them. On 4-6 photos one thread is faster too.
   const SubprocessResult run = colmap.Run(
       "mapper",
       Joined({"--database_path", colmap.database.string(), "--image_path",
-              colmap.image_dir.string(), "--output_path", dir.string(), "--Mapper.num_threads",
-              colmap.threads, "--Mapper.ba_refine_extra_params", s.refine ? "1" : "0",
+              colmap.image_dir.string(), "--output_path", dir.string(), "--Mapper.num_threads", "1",
+              "--Mapper.ba_refine_extra_params", s.refine ? "1" : "0",
               "--Mapper.ba_refine_focal_length", s.refine_focal ? "1" : "0",
               "--Mapper.filter_max_reproj_error", Fixed(s.filter, 3),
               "--Mapper.tri_ignore_two_view_tracks", o.two_view_tracks ? "0" : "1"},

@@ -66,7 +66,9 @@ void DeclareOptions(OptionTable& table, SfmOptions* o) {
                "missing, focal length off, too few points)");
   table.Value("min-points", &o->min_points, 0, 100000000,
               "fewer 3D points than this is an error (exit 3)");
-  table.Value("threads", &o->threads, -1, 1024, "threads COLMAP may use; -1 = all cores");
+  table.Value("threads", &o->threads, -1, 1024,
+              "threads COLMAP's feature extraction and matching may use (its mapper runs on "
+              "one, so that a run repeats to the last bit); -1 = all cores");
   table.Value("timeout", &o->timeout_seconds, 1.0, 1e6,
               "seconds each COLMAP command may take before it is stopped");
   table.Value("colmap", &o->colmap, "COLMAP executable (name in PATH or a path)");

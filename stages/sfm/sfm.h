@@ -81,7 +81,7 @@ struct SfmOptions {
   std::string matcher = "exact";
 
   int min_points = 100;           // fewer 3D points: bad input (exit 3)
-  int threads = -1;               // COLMAP threads; -1 = all cores
+  int threads = -1;               // COLMAP threads (not the mapper's); -1 = all cores
   double timeout_seconds = 900;   // per COLMAP command
   std::string colmap = "colmap";  // COLMAP executable (name in PATH or path)
   bool verbose = false;           // echo COLMAP's output lines on stderr

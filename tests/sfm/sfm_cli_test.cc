@@ -325,14 +325,23 @@ TEST_F(SfmCli, GoodRunThenRefThenFailedRunKeepsTheOutput) {
   EXPECT_TRUE(second.Find(other)->t.isZero(0));
   EXPECT_EQ(Listing(out.parent_path()), std::set<std::string>{"10_sfm"});
 
-  // Exact matching: the same photos give the same points, byte for byte.
+  // Exact matching and a mapper on one thread: the same photos give the same
+  // points byte for byte, and the same cameras to the last bit.
   auto read_bytes = [](const fs::path& f) {
     std::ifstream in(f, std::ios::binary);
     return std::string((std::istreambuf_iterator<char>(in)), {});
   };
+  auto cameras_without_times = [](const fs::path& f) {
+    Json cameras = ReadJsonFile(f);
+    cameras.erase("seconds");
+    for (Json& attempt : cameras["colmap"]["mapper_attempts"]) attempt.erase("seconds");
+    return cameras;
+  };
   const std::string points = read_bytes(out / "points.ply");
+  const Json cameras = cameras_without_times(out / "cameras.json");
   ASSERT_EQ(Sfm(Args(data, out, "--threads 2 --ref " + other)).exit_code, 0);
   EXPECT_EQ(read_bytes(out / "points.ply"), points);
+  EXPECT_EQ(cameras_without_times(out / "cameras.json"), cameras);
   // COLMAP's own matcher stays available.
   const CommandResult r3 = Sfm(Args(data, out, "--threads 2 --matcher colmap"));
   ASSERT_EQ(r3.exit_code, 0) << r3.output;
