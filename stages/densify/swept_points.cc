@@ -95,7 +95,10 @@ std::vector<Candidate> Candidates(const View& ref, const cv::Mat1b& page,
   cv::distanceTransform(free_of_points, gap, cv::DIST_L2, 5);
   cv::Mat1b inner;
   const int margin = 2 * (r + int(o.edge_gap_px)) + 1;
-  cv::erode(page, inner, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(margin, margin)));
+  // Past the photo's edge is not page (erode's default border is): where the
+  // photo cuts the page off, a patch must still lie inside the photo.
+  cv::erode(page, inner, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(margin, margin)),
+            cv::Point(-1, -1), 1, cv::BORDER_CONSTANT, cv::Scalar(0));
 
   cv::Mat1f grey, mean, mean_sq;
   ref.grey.convertTo(grey, CV_32F);
