@@ -325,14 +325,13 @@ struct StripMesh {
   std::vector<Triangle> triangles;
 };
 
-StripMesh JoinStrips(const std::vector<const ExtensionStrip*>& strips, double x0, double y0,
-                     double scale) {
+StripMesh JoinStrips(const std::vector<const ExtensionStrip*>& strips, const PixelFrame& frame) {
   StripMesh m;
   for (const ExtensionStrip* strip : strips) {
     const int base = int(m.screen.size());
     for (size_t i = 0; i < strip->flat.size(); ++i) {
-      m.screen.emplace_back((strip->flat[i].x() - x0) * scale - 0.5,
-                            (strip->flat[i].y() - y0) * scale - 0.5, 1.0);
+      const Eigen::Vector2d px = frame.ToPixel(strip->flat[i]);
+      m.screen.emplace_back(px.x(), px.y(), 1.0);
       m.world.push_back(strip->mesh3d[i]);
     }
     for (int j = 0; j + 1 < strip->rows; ++j)
@@ -535,13 +534,13 @@ ViewRegistration RegisterWithReference(const ReferenceRendering& reference, int 
 
 cv::Mat1b TextureStrips(const std::vector<const ExtensionStrip*>& strips,
                         const std::vector<ViewMask>& views, const std::vector<cv::Mat>& photos,
-                        double x0, double y0, double scale, bool antialias,
-                        const cv::Mat3b& reference_render, const cv::Mat1b& reference_valid,
-                        const cv::Mat1b& fillable, cv::Mat3b* image,
-                        std::vector<ViewRegistration>* registrations, bool own_photo) {
+                        const PixelFrame& frame, bool antialias, const cv::Mat3b& reference_render,
+                        const cv::Mat1b& reference_valid, const cv::Mat1b& fillable,
+                        cv::Mat3b* image, std::vector<ViewRegistration>* registrations,
+                        bool own_photo) {
   const int W = image->cols, H = image->rows;
   cv::Mat1b done(H, W, uchar(0));
-  const StripMesh m = JoinStrips(strips, x0, y0, scale);
+  const StripMesh m = JoinStrips(strips, frame);
   if (m.triangles.empty()) return done;
   const ReferenceRendering reference = PrepareReference(reference_render, reference_valid);
   cv::Mat1f best(H, W, 0.0f);

@@ -21,6 +21,18 @@ namespace docunfold::render {
 
 namespace fs = std::filesystem;
 
+// Where the output's pixels lie on M' (turned): pixel (x, y)'s centre is the
+// point origin + ((x + 0.5) / scale.x(), (y + 0.5) / scale.y()). The two
+// scales differ by under half a pixel over the crop, so that the crop's
+// edges are the image's edges.
+struct PixelFrame {
+  Eigen::Vector2d origin = Eigen::Vector2d::Zero();
+  Eigen::Vector2d scale = Eigen::Vector2d::Ones();  // output pixels per unit of M', along x and y
+  Eigen::Vector2d ToPixel(const Eigen::Vector2d& p) const {
+    return (p - origin).cwiseProduct(scale) - Eigen::Vector2d(0.5, 0.5);
+  }
+};
+
 // The page region found in another view (20_boundary/views/<name>/mask.png).
 struct ViewMask {
   PinholeCamera camera;
@@ -138,8 +150,7 @@ std::array<CutSideEdge, 4> FindCutSideEdges(const MeshPair& meshes,
                                             const CutSideOptions& options = {});
 
 // Textures the extension strips from the other views' photos. For every
-// pixel of `image` (output pixel (x, y) is the point (x0 + (x + 0.5) /
-// scale, y0 + (y + 0.5) / scale) of M') where `fillable` is set and a strip
+// pixel of `image` (placed on M' by `frame`) where `fillable` is set and a strip
 // lies, the colour of the view that resolves it best among those whose page
 // mask holds the whole strip triangle. Each view's rendering is first
 // moved onto `reference_render` where the two overlap (`reference_valid`;
@@ -150,9 +161,9 @@ std::array<CutSideEdge, 4> FindCutSideEdges(const MeshPair& meshes,
 // belongs to `views[v]` (empty: not used). Returns the pixels textured (255).
 cv::Mat1b TextureStrips(const std::vector<const ExtensionStrip*>& strips,
                         const std::vector<ViewMask>& views, const std::vector<cv::Mat>& photos,
-                        double x0, double y0, double scale, bool antialias,
-                        const cv::Mat3b& reference_render, const cv::Mat1b& reference_valid,
-                        const cv::Mat1b& fillable, cv::Mat3b* image,
-                        std::vector<ViewRegistration>* registrations, bool own_photo = false);
+                        const PixelFrame& frame, bool antialias, const cv::Mat3b& reference_render,
+                        const cv::Mat1b& reference_valid, const cv::Mat1b& fillable,
+                        cv::Mat3b* image, std::vector<ViewRegistration>* registrations,
+                        bool own_photo = false);
 
 }  // namespace docunfold::render

@@ -111,10 +111,11 @@ OrientationOptions OrientationHint(const std::vector<DirectionVote>& text_lines,
   return o;
 }
 
-// The output frame: the crop re-centred to a whole number of pixels
-// (r->crop_*, r->pixels_per_unit, r->size_rule) and M' rasterized in it.
+// The output frame: the crop in a whole number of pixels (r->crop_*,
+// r->pixels_per_unit(_y), r->size_rule) and M' rasterized in it.
 struct OutputFrame {
   SizeChoice size;
+  PixelFrame pixels;
   std::vector<Eigen::Vector2d> pixel;  // M''s vertices in output pixels
   RasterResult raster;
 };
@@ -123,26 +124,27 @@ OutputFrame FrameOutput(const RenderOptions& options, const CropRect& crop,
                         const std::vector<Eigen::Vector2d>& flat, const ProjectedMesh& pm,
                         RenderResult* r) {
   OutputFrame frame;
-  // Output size; the crop is re-centred to a whole number of pixels.
   const SizeChoice size = ChooseSize(options, crop.Width(), crop.Height(), pm.density);
   if (size.capped)
     Log("output reduced to " + std::to_string(size.width) + "x" + std::to_string(size.height) +
         " by --max-pixels");
-  const double cx = 0.5 * (crop.x0 + crop.x1), cy = 0.5 * (crop.y0 + crop.y1);
-  r->crop_x0 = cx - 0.5 * size.width / size.scale;
-  r->crop_x1 = cx + 0.5 * size.width / size.scale;
-  r->crop_y0 = cy - 0.5 * size.height / size.scale;
-  r->crop_y1 = cy + 0.5 * size.height / size.scale;
-  r->pixels_per_unit = size.scale;
+  // The size rounds the crop to whole pixels; the crop is kept and each axis
+  // gets its own scale, so that the page's sides stay the image's edges (half
+  // a pixel off there is worth more than square pixels to 0.1 %).
+  r->crop_x0 = crop.x0;
+  r->crop_x1 = crop.x1;
+  r->crop_y0 = crop.y0;
+  r->crop_y1 = crop.y1;
+  frame.pixels.origin = Eigen::Vector2d(crop.x0, crop.y0);
+  frame.pixels.scale = Eigen::Vector2d(size.width / crop.Width(), size.height / crop.Height());
+  r->pixels_per_unit = frame.pixels.scale.x();
+  r->pixels_per_unit_y = frame.pixels.scale.y();
   r->size_rule = size.rule;
   r->capped = size.capped;
 
-  // Flat rasterization of M': output pixel centre (x, y) is the point
-  // (crop_x0 + (x + 0.5) / s, crop_y0 + (y + 0.5) / s) of M'.
   std::vector<Eigen::Vector3d> screen(flat.size());
   for (size_t i = 0; i < flat.size(); ++i) {
-    frame.pixel.emplace_back((flat[i].x() - r->crop_x0) * size.scale - 0.5,
-                             (flat[i].y() - r->crop_y0) * size.scale - 0.5);
+    frame.pixel.push_back(frame.pixels.ToPixel(flat[i]));
     screen[i] = {frame.pixel[i].x(), frame.pixel[i].y(), 1.0};
   }
   frame.raster = Rasterize(screen, pm.triangles, size.width, size.height);
@@ -155,7 +157,7 @@ OutputFrame FrameOutput(const RenderOptions& options, const CropRect& crop,
 // cuts off from the photos that see it (r->registrations,
 // r->other_view_fraction).
 void TexturePastMesh(const RenderOptions& options, const RenderInputs& in,
-                     const std::vector<ViewMask>& self_view, const SizeChoice& size,
+                     const std::vector<ViewMask>& self_view, const OutputFrame& frame,
                      const TexturePhotos& photos, cv::Mat3b* image_io, cv::Mat1b* state_io,
                      RenderResult* r, StepTimer* timer) {
   cv::Mat3b& image = *image_io;
@@ -168,20 +170,20 @@ void TexturePastMesh(const RenderOptions& options, const RenderInputs& in,
   for (const CutSideEdge& e : r->reached_sides)
     if (!e.strip.flat.empty()) reached_strips.push_back(&e.strip);
   if (!reached_strips.empty()) {
-    const cv::Mat1b textured = TextureStrips(
-        reached_strips, self_view, {photos.reference}, r->crop_x0, r->crop_y0, size.scale,
-        options.antialias, image.clone(), state == kPage, state == kOutside, &image, nullptr,
-        /*own_photo=*/true);
+    const cv::Mat1b textured = TextureStrips(reached_strips, self_view, {photos.reference},
+                                             frame.pixels, options.antialias, image.clone(),
+                                             state == kPage, state == kOutside, &image, nullptr,
+                                             /*own_photo=*/true);
     state.setTo(kPage, textured);
     timer->Mark("reached_sides");
   }
   if (!strips.empty() && options.texture_cut_sides) {
     const cv::Mat3b reference_render = image.clone();
-    const cv::Mat1b textured = TextureStrips(
-        strips, in.views, photos.views, r->crop_x0, r->crop_y0, size.scale, options.antialias,
-        reference_render, state == kPage, state == kOutside, &image, &r->registrations);
+    const cv::Mat1b textured = TextureStrips(strips, in.views, photos.views, frame.pixels,
+                                             options.antialias, reference_render, state == kPage,
+                                             state == kOutside, &image, &r->registrations);
     state.setTo(kOtherView, textured);
-    r->other_view_fraction = cv::countNonZero(textured) / (double(size.width) * size.height);
+    r->other_view_fraction = cv::countNonZero(textured) / double(image.total());
     timer->Mark("other_views");
   }
 }
@@ -190,7 +192,7 @@ void TexturePastMesh(const RenderOptions& options, const RenderInputs& in,
 // (kRemove), the fractions of the output and the grid overlay: r->rectified,
 // r->page_mask, r->rectified_grid.
 void FillAndDrawGrid(const RenderOptions& options, const RenderInputs& in,
-                     const std::vector<Eigen::Vector2d>& flat, const SizeChoice& size,
+                     const std::vector<Eigen::Vector2d>& flat, const OutputFrame& frame,
                      const SampleStats& stats, bool paper_fill, const cv::Vec3b& fixed_fill,
                      cv::Mat3b image, const cv::Mat1b& state, RenderResult* r, StepTimer* timer) {
   r->fill = paper_fill ? MedianColour(image, state) : fixed_fill;
@@ -203,14 +205,14 @@ void FillAndDrawGrid(const RenderOptions& options, const RenderInputs& in,
     r->shading_paper_fraction = removal.paper_fraction;
     timer->Mark("shading");
   }
-  const double n = double(size.width) * size.height;
+  const double n = double(image.total());
   r->page_fraction = stats.page / n;
   r->hidden_fraction = stats.hidden / n;
   r->minified_fraction = stats.minified / n;
   r->rectified = image;
   r->page_mask = ~unfilled;
-  r->rectified_grid = DrawGrid(image, state, in.meshes, flat, r->crop_x0, r->crop_y0, size.scale,
-                               options.grid_color, options.grid_min_spacing_px, &r->grid_line_step);
+  r->rectified_grid = DrawGrid(image, state, in.meshes, flat, frame.pixels, options.grid_color,
+                               options.grid_min_spacing_px, &r->grid_line_step);
 }
 
 // Turns the images by quarter turns so that the page's text reads upright
@@ -330,9 +332,9 @@ RenderResult Run(const RenderOptions& options, const RenderInputs& in) {
                             frame.size.scale, &image, &state);
   timer.Mark("sample");
 
-  TexturePastMesh(options, in, crop.self_view, frame.size, photos, &image, &state, &r, &timer);
-  FillAndDrawGrid(options, in, crop.flat, frame.size, stats, paper_fill, fixed_fill, image, state,
-                  &r, &timer);
+  TexturePastMesh(options, in, crop.self_view, frame, photos, &image, &state, &r, &timer);
+  FillAndDrawGrid(options, in, crop.flat, frame, stats, paper_fill, fixed_fill, image, state, &r,
+                  &timer);
   timer.Mark("fill_and_grid");
   r.orientation = Orient(options, in, lookup, angle, &r, &timer);
   Straighten(options, &r, &timer);

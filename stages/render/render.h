@@ -231,7 +231,8 @@ struct RenderResult {
   cv::Mat1b page_mask;     // 255 where `rectified` shows the page (not fill)
   // Crop rectangle in M' units (after the deskew rotation) and the scale.
   double crop_x0 = 0, crop_y0 = 0, crop_x1 = 0, crop_y1 = 0;
-  double pixels_per_unit = 0;
+  double pixels_per_unit = 0;            // output pixels per unit of M' along x
+  double pixels_per_unit_y = 0;          // and along y (within half a pixel of it over the crop)
   double reference_pixels_per_unit = 0;  // the reference image's density
   double rotation_deg = 0;               // deskew applied to M'
   std::string deskew_source = "none";    // what it was taken from: lines, sides, none

@@ -110,7 +110,7 @@ cv::Vec3b MedianColour(const cv::Mat3b& image, const cv::Mat1b& state);
 // at least `min_spacing` pixels apart) and always the border rows/columns;
 // points of M' that the reference view does not see are tinted.
 cv::Mat3b DrawGrid(const cv::Mat3b& image, const cv::Mat1b& state, const MeshPair& m,
-                   const std::vector<Eigen::Vector2d>& flat, double x0, double y0, double scale,
+                   const std::vector<Eigen::Vector2d>& flat, const PixelFrame& frame,
                    const cv::Scalar& colour, double min_spacing, int* step);
 
 // The boundary's sides mapped onto M' and their lines fitted (r->sides);

@@ -158,6 +158,7 @@ Json RenderReport(const RenderOptions& options, const RenderInputs& in, const Re
   doc["width"] = r.rectified.cols;
   doc["height"] = r.rectified.rows;
   doc["pixels_per_unit"] = r.pixels_per_unit;
+  doc["pixels_per_unit_y"] = r.pixels_per_unit_y;
   doc["reference_pixels_per_unit"] = r.reference_pixels_per_unit;
   doc["size_rule"] = r.size_rule;
   doc["capped"] = r.capped;

@@ -250,7 +250,7 @@ cv::Vec3b MedianColour(const cv::Mat3b& image, const cv::Mat1b& state) {
 // at least `min_spacing` pixels apart) and always the border rows/columns;
 // points of M' that the reference view does not see are tinted.
 cv::Mat3b DrawGrid(const cv::Mat3b& image, const cv::Mat1b& state, const MeshPair& m,
-                   const std::vector<Eigen::Vector2d>& flat, double x0, double y0, double scale,
+                   const std::vector<Eigen::Vector2d>& flat, const PixelFrame& frame,
                    const cv::Scalar& colour, double min_spacing, int* step) {
   cv::Mat3b out = image.clone();
   for (int y = 0; y < out.rows; ++y)
@@ -264,16 +264,17 @@ cv::Mat3b DrawGrid(const cv::Mat3b& image, const cv::Mat1b& state, const MeshPai
   std::vector<double> lengths;
   for (int r = 0; r < g.ny; ++r)
     for (int c = 0; c + 1 < g.nx; ++c)
-      lengths.push_back((flat[g.Index(r, c + 1)] - flat[g.Index(r, c)]).norm() * scale);
+      lengths.push_back(
+          (frame.ToPixel(flat[g.Index(r, c + 1)]) - frame.ToPixel(flat[g.Index(r, c)])).norm());
   for (int r = 0; r + 1 < g.ny; ++r)
     for (int c = 0; c < g.nx; ++c)
-      lengths.push_back((flat[g.Index(r + 1, c)] - flat[g.Index(r, c)]).norm() * scale);
+      lengths.push_back(
+          (frame.ToPixel(flat[g.Index(r + 1, c)]) - frame.ToPixel(flat[g.Index(r, c)])).norm());
   const double spacing = Median(lengths);
   *step = spacing > 0 ? std::max(1, int(std::ceil(min_spacing / spacing))) : 1;
   constexpr int kShift = 4;  // sub-pixel vertex positions
   auto to_px = [&](int i) {
-    const Eigen::Vector2d p =
-        (flat[i] - Eigen::Vector2d(x0, y0)) * scale - Eigen::Vector2d(0.5, 0.5);
+    const Eigen::Vector2d p = frame.ToPixel(flat[i]);
     return cv::Point(int(std::lround(p.x() * (1 << kShift))),
                      int(std::lround(p.y() * (1 << kShift))));
   };

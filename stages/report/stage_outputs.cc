@@ -26,6 +26,7 @@ cv::Mat DrawFeatureLines(const cv::Mat& rectified, const Json& render, const Jso
   if (fs::path(meshes).filename() != "50_optimize") return {};
   const double angle = render.value("rotation_deg", 0.0) * CV_PI / 180;
   const double scale = render.value("pixels_per_unit", 0.0);
+  const double scale_y = render.value("pixels_per_unit_y", scale);  // absent: square pixels
   const double x0 = render["crop"].value("x0", 0.0), y0 = render["crop"].value("y0", 0.0);
   // Checked before the conversion: a float too large for an int has none.
   const Json quarter_turns =
@@ -35,7 +36,7 @@ cv::Mat DrawFeatureLines(const cv::Mat& rectified, const Json& render, const Jso
         "60_render/render.json:/orientation/quarter_turns_clockwise: expected an "
         "integer");
   const int turns = int(((quarter_turns.get<long long>() % 4) + 4) % 4);
-  if (!(scale > 0)) return {};
+  if (!(scale > 0 && scale_y > 0)) return {};
   // Size before the quarter turns.
   const int w = turns % 2 ? rectified.rows : rectified.cols;
   const int h = turns % 2 ? rectified.cols : rectified.rows;
@@ -71,7 +72,7 @@ cv::Mat DrawFeatureLines(const cv::Mat& rectified, const Json& render, const Jso
     const double wx = wx0 + (tx - left) / (right - left) * (wx1 - wx0);
     const double wy = wy0 + (ty - top) / (bottom - top) * (wy1 - wy0);
     const double u = (wx - x0) * scale - 0.5;
-    const double v = (wy - y0) * scale - 0.5;
+    const double v = (wy - y0) * scale_y - 0.5;
     switch (turns) {  // as cv::rotate turns the image clockwise
       case 1:
         return cv::Point2d(h - 1 - v, u);

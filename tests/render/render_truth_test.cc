@@ -17,20 +17,22 @@ namespace {
 class RenderTruth : public ::testing::TestWithParam<fs::path> {};
 
 // flat.png in the frame of the rendered image: render pixel (i, j) shows the
-// point (x0 + (i + 0.5) / s, y0 + (j + 0.5) / s) of M', and the true M' is
+// point (x0 + (i + 0.5) / sx, y0 + (j + 0.5) / sy) of M', and the true M' is
 // flat.png scaled by `units_per_flat_px`.
 cv::Mat FlatInRenderFrame(const cv::Mat& flat, double units_per_flat_px,
                           const render::RenderResult& r) {
-  const double f = r.pixels_per_unit * units_per_flat_px;  // render px per flat px
+  // render px per flat px
+  const double fx = r.pixels_per_unit * units_per_flat_px;
+  const double fy = r.pixels_per_unit_y * units_per_flat_px;
   cv::Mat small;
-  cv::resize(flat, small, cv::Size(), f, f, f < 1 ? cv::INTER_AREA : cv::INTER_CUBIC);
+  cv::resize(flat, small, cv::Size(), fx, fy, fx < 1 ? cv::INTER_AREA : cv::INTER_CUBIC);
   // Pixel k of `small` is centred on flat coordinate (k + 0.5) / sx - 0.5
   // (resize's convention), i.e. on M' x = (k + 0.5) / sx * units_per_flat_px;
   // render pixel i on x0 + (i + 0.5) / s. Solved for k:
   const double sx = double(small.cols) / flat.cols, sy = double(small.rows) / flat.rows;
-  const double ax = sx / f, ay = sy / f;
+  const double ax = sx / fx, ay = sy / fy;
   const cv::Matx23d render_to_small(ax, 0, 0.5 * ax - 0.5 + ax * r.pixels_per_unit * r.crop_x0, 0,
-                                    ay, 0.5 * ay - 0.5 + ay * r.pixels_per_unit * r.crop_y0);
+                                    ay, 0.5 * ay - 0.5 + ay * r.pixels_per_unit_y * r.crop_y0);
   cv::Mat out;
   cv::warpAffine(small, out, render_to_small, r.rectified.size(),
                  cv::INTER_LINEAR | cv::WARP_INVERSE_MAP, cv::BORDER_CONSTANT, cv::Scalar::all(0));

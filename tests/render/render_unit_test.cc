@@ -187,6 +187,29 @@ TEST(RenderScene, DefaultSizeKeepsTheReferenceDensity) {
   EXPECT_LT(r.minified_fraction, 0.01);
 }
 
+// The output size rounds the crop to whole pixels; the crop itself stays
+// where the page's sides put it, so whatever the size, the image's edges are
+// the same lines of M'.
+TEST(RenderScene, TheCropDoesNotMoveWithTheOutputSize) {
+  const SyntheticScene s = MakeScene({});
+  const render::RenderInputs in = InputsOf(s);
+  const render::RenderResult plain = render::Run({}, in);
+  for (const int width : {101, 250, 333}) {
+    render::RenderOptions o;
+    o.width = width;
+    const render::RenderResult r = render::Run(o, in);
+    ASSERT_EQ(r.rectified.cols, width);
+    EXPECT_NEAR(r.crop_x0, plain.crop_x0, 1e-9) << width;
+    EXPECT_NEAR(r.crop_x1, plain.crop_x1, 1e-9) << width;
+    EXPECT_NEAR(r.crop_y0, plain.crop_y0, 1e-9) << width;
+    EXPECT_NEAR(r.crop_y1, plain.crop_y1, 1e-9) << width;
+    EXPECT_NEAR((r.crop_x1 - r.crop_x0) * r.pixels_per_unit, r.rectified.cols, 1e-6);
+    EXPECT_NEAR((r.crop_y1 - r.crop_y0) * r.pixels_per_unit_y, r.rectified.rows, 1e-6);
+    // Pixels square to within the half pixel the height was rounded by.
+    EXPECT_NEAR(r.pixels_per_unit_y, r.pixels_per_unit, r.pixels_per_unit / r.rectified.rows);
+  }
+}
+
 TEST(RenderScene, SizeOptions) {
   const SyntheticScene s = MakeScene({});
   const render::RenderInputs in = InputsOf(s);
@@ -218,7 +241,11 @@ TEST(RenderScene, SizeOptions) {
     render::RenderOptions o;
     o.scale = 0.5;
     const auto r = render::Run(o, in);
-    EXPECT_NEAR(r.pixels_per_unit, 0.5 * r.reference_pixels_per_unit, 1e-6);
+    // Within the half pixel the crop's width is rounded by.
+    EXPECT_NEAR(r.pixels_per_unit, 0.5 * r.reference_pixels_per_unit,
+                r.pixels_per_unit / r.rectified.cols);
+    EXPECT_NEAR(r.pixels_per_unit_y, 0.5 * r.reference_pixels_per_unit,
+                r.pixels_per_unit_y / r.rectified.rows);
   }
   {
     render::RenderOptions o;
