@@ -77,8 +77,9 @@ Json RegistrationJson(const EvaluationPair& pair, const cv::Mat2f& flow, Metrics
   return {{"method",
            "the best affine map by MS-SSIM of those fitted to the DeepFlow field where "
            "flat.png has ink (RANSAC at 1 px of the flow size, then refined on its inliers; "
-           "least squares over every such vector; RANSAC over the vectors the first left "
-           "out) and the identity; the result resampled through it, MS-SSIM as above"},
+           "least squares over every such vector; RANSAC over the vectors no fit before took, "
+           "up to three times) and the identity; the result resampled through it, MS-SSIM "
+           "as above"},
           {"fit", reg->fit},
           {"result_from_truth", page_map(reg->result_from_truth)},
           {"units", "fractions of the page's width (x) and height (y)"},

@@ -17,6 +17,7 @@ constexpr int kStride = 2;
 constexpr double kMinGradient = 12;
 constexpr double kRansacPx = 1.0;  // half-size pixels
 constexpr int kMinSamples = 50;
+constexpr int kMaxRest = 3;  // RANSAC fits over what earlier fits left out
 
 }  // namespace
 
@@ -90,24 +91,31 @@ std::optional<AffineRegistration> RegisterAffine(const cv::Mat1b& ground_truth,
                         solution(1, 1), solution(2, 1));
     reg.candidates.push_back(candidate("least-squares", a, all));
   }
-  // The vectors that map left out: the page's other side across a fold.
-  std::vector<cv::Point2f> rest_from, rest_to;
-  std::vector<size_t> rest_index;
-  for (size_t i = 0; i < from.size(); ++i)
-    if (!inlier[i]) {
-      rest_from.push_back(from[i]);
-      rest_to.push_back(to[i]);
-      rest_index.push_back(i);
-    }
-  if (int(rest_from.size()) >= kMinSamples) {
+  // The vectors no fit so far took: the page's other side across a fold, or
+  // the page where a consensus was a patch of it. Peeled up to kMaxRest times,
+  // since which part a fit locks onto first changes with small changes of
+  // the result.
+  std::vector<uchar> taken = inlier;
+  for (int round = 1; round <= kMaxRest; ++round) {
+    std::vector<cv::Point2f> rest_from, rest_to;
+    std::vector<size_t> rest_index;
+    for (size_t i = 0; i < from.size(); ++i)
+      if (!taken[i]) {
+        rest_from.push_back(from[i]);
+        rest_to.push_back(to[i]);
+        rest_index.push_back(i);
+      }
+    if (int(rest_from.size()) < kMinSamples) break;
     std::vector<uchar> rest_inlier;
     const cv::Mat rest_map =
         cv::estimateAffine2D(rest_from, rest_to, rest_inlier, cv::RANSAC, kRansacPx);
-    if (!rest_map.empty() && cv::countNonZero(rest_inlier) >= kMinSamples) {
-      std::vector<uchar> used(from.size(), 0);
-      for (size_t k = 0; k < rest_index.size(); ++k) used[rest_index[k]] = rest_inlier[k];
-      reg.candidates.push_back(candidate("ransac-rest", cv::Matx23d(rest_map), used));
-    }
+    if (rest_map.empty() || cv::countNonZero(rest_inlier) < kMinSamples) break;
+    std::vector<uchar> used(from.size(), 0);
+    for (size_t k = 0; k < rest_index.size(); ++k) used[rest_index[k]] = rest_inlier[k];
+    for (size_t i = 0; i < from.size(); ++i) taken[i] |= used[i];
+    reg.candidates.push_back(
+        candidate(round == 1 ? "ransac-rest" : "ransac-rest-" + std::to_string(round),
+                  cv::Matx23d(rest_map), used));
   }
   reg.candidates.push_back(candidate("identity", cv::Matx23d(1, 0, 0, 0, 1, 0), all));
   const AffineCandidate* best = &reg.candidates.front();

@@ -15,7 +15,7 @@ namespace docunfold::evaluate {
 
 // One map tried: how it was found and what the result scores through it.
 struct AffineCandidate {
-  std::string fit;  // "ransac", "least-squares", "ransac-rest" or "identity"
+  std::string fit;  // "ransac", "least-squares", "ransac-rest", "ransac-rest-2" or -3, "identity"
   cv::Matx23d result_from_truth;
   int samples = 0;         // flow vectors on the truth's ink the fit used
   double residual_px = 0;  // their rms distance from the map, evaluation pixels

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 
@@ -113,6 +114,42 @@ TEST(RegisterAffine, NeverScoresBelowTheResultAsItIs) {
   EXPECT_NEAR(reg->candidates.back().ms_ssim, plain, 1e-9);
   for (const AffineCandidate& c : reg->candidates) EXPECT_GE(reg->ms_ssim, c.ms_ssim);
   EXPECT_GE(reg->ms_ssim, plain);
+}
+
+TEST(RegisterAffine, FindsTheMapOfEachOfThreeBands) {
+  // Three bands of the page each moved its own way (as a page creased twice
+  // that M got wrong twice), no two of them one affine map: one fit and one
+  // over what it left out cannot find all three maps; fits peeled off in turn
+  // do.
+  const cv::Mat1b page = TextPage({480, 680}, 11);
+  const std::array<float, 3> ends = {0.4f * page.rows, 0.7f * page.rows, float(page.rows)};
+  // Where each band shows in the result, relative to the truth (pixels).
+  const std::array<cv::Point2f, 3> shifts = {cv::Point2f(0, 0), cv::Point2f(0, 8),
+                                             cv::Point2f(14, -5)};
+  cv::Mat1f map_x(page.size()), map_y(page.size());
+  for (int r = 0; r < page.rows; ++r)
+    for (int c = 0; c < page.cols; ++c) {
+      const size_t band = r < ends[0] ? 0 : r < ends[1] ? 1 : 2;
+      map_x(r, c) = float(c) - shifts[band].x;
+      map_y(r, c) = float(r) - shifts[band].y;
+    }
+  cv::Mat1b result;
+  cv::remap(page, result, map_x, map_y, cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+  const auto reg = RegisterAffine(page, result, HalfSizeFlow(page, result));
+  ASSERT_TRUE(reg.has_value());
+  for (size_t band = 0; band < 3; ++band) {
+    // The band's middle and where it shows, in pixels.
+    const cv::Point2d middle(0.5 * page.cols, 0.5 * ((band ? ends[band - 1] : 0) + ends[band]));
+    const cv::Point2d shown = middle + cv::Point2d(shifts[band]);
+    bool found = false;
+    for (const AffineCandidate& c : reg->candidates) {
+      const cv::Matx23d& a = c.result_from_truth;
+      const cv::Point2d q(a(0, 0) * middle.x + a(0, 1) * middle.y + a(0, 2),
+                          a(1, 0) * middle.x + a(1, 1) * middle.y + a(1, 2));
+      found |= cv::norm(q - shown) < 1.0;
+    }
+    EXPECT_TRUE(found) << "no map of band " << band;
+  }
 }
 
 TEST(RegisterAffine, ABlankPageHasNothingToRegister) {
