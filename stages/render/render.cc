@@ -129,8 +129,10 @@ OutputFrame FrameOutput(const RenderOptions& options, const CropRect& crop,
     Log("output reduced to " + std::to_string(size.width) + "x" + std::to_string(size.height) +
         " by --max-pixels");
   // The size rounds the crop to whole pixels; the crop is kept and each axis
-  // gets its own scale, so that the page's sides stay the image's edges (half
-  // a pixel off there is worth more than square pixels to 0.1 %).
+  // gets its own scale, so that the page's sides stay the image's edges (a
+  // re-centred crop moves them by up to a quarter pixel; pixels square to
+  // 0.1 % matter less). docs/decisions/render.md, "The crop kept whole: a
+  // scale per axis".
   r->crop_x0 = crop.x0;
   r->crop_x1 = crop.x1;
   r->crop_y0 = crop.y0;
