@@ -42,6 +42,23 @@ TEST(DrawFeatureLines, FollowsRendersWarpOntoTheSides) {
   EXPECT_FALSE(drawn_in_column(63));  // where the line's top end is without the warp
 }
 
+// render gives each axis its own scale (the crop kept whole): a line across
+// the page at y = 0.9 of M' lies on row 0.9 * 40 - 0.5, not 0.9 * 60 - 0.5
+// (past the image's 48 rows).
+TEST(DrawFeatureLines, TakesTheScaleDownTheRowsFromPixelsPerUnitY) {
+  const cv::Mat rectified(48, 64, CV_8UC3, cv::Scalar(255, 255, 255));
+  Json render = kRender;
+  render["pixels_per_unit_y"] = 40;
+  const Json lines =
+      Json::parse(R"({"lines": [{"kind": "text", "flat": [[0.1, 0.9], [0.9, 0.9]]}]})");
+  const cv::Mat out = DrawFeatureLines(rectified, render, lines);
+  auto drawn_in_row = [&](int row) {
+    return cv::norm(out.row(row), rectified.row(row), cv::NORM_L1) > 0;
+  };
+  EXPECT_TRUE(drawn_in_row(35) || drawn_in_row(36));
+  EXPECT_FALSE(drawn_in_row(20));
+}
+
 // The fuzzer's input (fuzz/lines_fuzzer.cc): a point of a line that is not
 // [x, y] was read past the end of its array.
 TEST(DrawFeatureLines, RejectsAPointThatIsNotXY) {
