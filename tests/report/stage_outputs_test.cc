@@ -13,6 +13,11 @@ const Json kRender = Json::parse(R"({
   "inputs": {"meshes": "work/set01/50_optimize"}, "rotation_deg": 0,
   "pixels_per_unit": 60, "crop": {"x0": 0, "y0": 0}})");
 
+// Whether DrawFeatureLines drew anything in this row or column of the image.
+bool Drawn(const cv::Mat& out_part, const cv::Mat& rectified_part) {
+  return cv::norm(out_part, rectified_part, cv::NORM_L1) > 0;
+}
+
 TEST(DrawFeatureLines, DrawsOptimizesLines) {
   const cv::Mat rectified(48, 64, CV_8UC3, cv::Scalar(255, 255, 255));
   const Json lines =
@@ -35,9 +40,7 @@ TEST(DrawFeatureLines, FollowsRendersWarpOntoTheSides) {
   const Json lines =
       Json::parse(R"({"lines": [{"kind": "edge", "flat": [[1.065, 0.1], [1.035, 0.7]]}]})");
   const cv::Mat out = DrawFeatureLines(rectified, render, lines);
-  auto drawn_in_column = [&](int col) {
-    return cv::norm(out.col(col), rectified.col(col), cv::NORM_L1) > 0;
-  };
+  auto drawn_in_column = [&](int col) { return Drawn(out.col(col), rectified.col(col)); };
   EXPECT_TRUE(drawn_in_column(59) || drawn_in_column(60));
   EXPECT_FALSE(drawn_in_column(63));  // where the line's top end is without the warp
 }
@@ -52,9 +55,7 @@ TEST(DrawFeatureLines, TakesTheScaleDownTheRowsFromPixelsPerUnitY) {
   const Json lines =
       Json::parse(R"({"lines": [{"kind": "text", "flat": [[0.1, 0.9], [0.9, 0.9]]}]})");
   const cv::Mat out = DrawFeatureLines(rectified, render, lines);
-  auto drawn_in_row = [&](int row) {
-    return cv::norm(out.row(row), rectified.row(row), cv::NORM_L1) > 0;
-  };
+  auto drawn_in_row = [&](int row) { return Drawn(out.row(row), rectified.row(row)); };
   EXPECT_TRUE(drawn_in_row(35) || drawn_in_row(36));
   EXPECT_FALSE(drawn_in_row(20));
 }
