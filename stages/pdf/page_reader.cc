@@ -111,25 +111,27 @@ PageReader::Page PageReader::Read(const cv::Mat& image) {
   std::unique_ptr<tesseract::ResultIterator> it(api_->GetIterator());
   if (!it) return page;
   int block = -1;
+  int line = -1;  // index in page.lines of the line being read (-1: it has no baseline)
   do {
     if (it->Empty(tesseract::RIL_WORD)) continue;
     if (it->IsAtBeginningOf(tesseract::RIL_BLOCK)) ++block;
-    int x0, y0, x1, y1;
-    if (it->IsAtBeginningOf(tesseract::RIL_TEXTLINE) &&
-        it->BoundingBox(tesseract::RIL_TEXTLINE, &x0, &y0, &x1, &y1)) {
-      TextLine line{std::max(block, 0), cv::Rect(x0, y0, x1 - x0, y1 - y0), {}, {}};
-      int bx0, by0, bx1, by1;
-      if (it->Baseline(tesseract::RIL_TEXTLINE, &bx0, &by0, &bx1, &by1)) {
-        line.baseline_start = {double(bx0), double(by0)};
-        line.baseline_end = {double(bx1), double(by1)};
-        page.lines.push_back(line);
+    int x0, y0, x1, y1, bx0, by0, bx1, by1;
+    if (it->IsAtBeginningOf(tesseract::RIL_TEXTLINE)) {
+      line = -1;
+      if (it->BoundingBox(tesseract::RIL_TEXTLINE, &x0, &y0, &x1, &y1) &&
+          it->Baseline(tesseract::RIL_TEXTLINE, &bx0, &by0, &bx1, &by1)) {
+        page.lines.push_back({std::max(block, 0),
+                              cv::Rect(x0, y0, x1 - x0, y1 - y0),
+                              {double(bx0), double(by0)},
+                              {double(bx1), double(by1)}});
+        line = int(page.lines.size()) - 1;
       }
     }
     if (!it->BoundingBox(tesseract::RIL_WORD, &x0, &y0, &x1, &y1)) continue;
     std::unique_ptr<char[]> text(it->GetUTF8Text(tesseract::RIL_WORD));
     if (!text || !*text.get()) continue;
     page.words.push_back({cv::Rect(x0, y0, x1 - x0, y1 - y0),
-                          it->Confidence(tesseract::RIL_WORD) / 100.0, text.get()});
+                          it->Confidence(tesseract::RIL_WORD) / 100.0, text.get(), line});
   } while (it->Next(tesseract::RIL_WORD));
   return page;
 }

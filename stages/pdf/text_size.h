@@ -1,7 +1,8 @@
 // How large the page's body text is, in pixels to the em, from what
-// Tesseract read: the height of confidently read words, or, where Tesseract
-// boxes a small print's words taller than its lines are apart (it does on
-// pages whose lines are ~15 px apart), the distance between lines.
+// Tesseract read: the height of confidently read words, leaving out those
+// it boxed taller than their lines are apart (it does so with small print,
+// and with a paragraph here and there of a larger one); where too few are
+// left, the distance between lines.
 #pragma once
 
 #include <opencv2/core.hpp>
@@ -14,6 +15,7 @@ struct Word {
   cv::Rect box;           // image pixels
   double confidence = 0;  // 0..1
   std::string text;       // UTF-8
+  int line = -1;          // index of the TextLine it was read in (-1: none known)
 };
 
 struct TextLine {
@@ -32,7 +34,10 @@ struct TextSizeOptions {
   // baselines, as multiples of the font size.
   double word_height_em = 0.75;
   double line_pitch_em = 1.35;
-  // Word boxes this close to the line pitch or taller span more than a line.
+  // A word boxed this close to its line's pitch (the distance to the nearer
+  // neighbouring line of its block; the page's median pitch for a word of
+  // no known line) or taller spans more than a line: its height is not the
+  // text's. Too few words left and the text's size is the line pitch's.
   double max_word_height_of_pitch = 0.9;
   size_t min_line_pairs = 5;
 };
@@ -41,7 +46,7 @@ struct TextSize {
   double em_px = 0;           // 0: not measured
   std::string cue;            // "word height", "line pitch" or why not measured
   size_t words = 0;           // body words
-  double word_height_px = 0;  // median
+  double word_height_px = 0;  // median over the body words within their line (0: none)
   double line_pitch_px = 0;   // median over neighbouring lines of a block (0: too few)
 };
 

@@ -127,6 +127,34 @@ TEST(TextSize, FromLinePitchWhenWordBoxesSpanLines) {
   EXPECT_NEAR(s.em_px, 16 / 1.35, 1e-9);
 }
 
+TEST(TextSize, WordsBoxedTallerThanTheirLinesAreApartAreLeftOut) {
+  // A table of 10 rows 40 px apart with 25 words 24 px high, and a paragraph
+  // of 4 lines 16 px apart whose 30 words Tesseract boxed 28 px high: the
+  // paragraph's words say nothing of the text's height, though the median
+  // over all words and lines would take them.
+  std::vector<TextLine> lines = Lines(10, 40);
+  for (TextLine& l : Lines(4, 16)) {
+    l.block = 1;
+    l.box.y += 500;
+    l.baseline_start.y += 500;
+    l.baseline_end.y += 500;
+    lines.push_back(l);
+  }
+  std::vector<Word> words = BodyWords(25, 24);
+  for (size_t i = 0; i < words.size(); ++i) words[i].line = int(i % 10);
+  for (Word w : BodyWords(30, 28)) {
+    w.line = 10 + int(words.size() % 4);
+    words.push_back(w);
+  }
+  const TextSize s = EstimateTextSize(words, lines);
+  EXPECT_EQ(s.cue, "word height");
+  EXPECT_DOUBLE_EQ(s.em_px, 24 / 0.75);
+  EXPECT_EQ(s.words, 55u);
+  // Too few words left within their lines: the line pitch.
+  words.erase(words.begin(), words.begin() + 10);
+  EXPECT_EQ(EstimateTextSize(words, lines).cue, "line pitch");
+}
+
 TEST(TextSize, NotMeasuredFromFewOrDoubtfulWords) {
   EXPECT_EQ(EstimateTextSize(BodyWords(10, 24), Lines(10, 40)).em_px, 0);
   std::vector<Word> doubtful = BodyWords(30, 24);
