@@ -1,8 +1,9 @@
 // The pipeline's PDFs (e2e run, tests/pipeline/run_e2e.sh) on the sample with
-// phone-sized photos and the independently rendered text pages: the true
-// paper format, a text layer that reads as well as Tesseract reads the
-// rectified image, the image itself, a valid ALTO file on the words; and a
-// book of three samples made with -j2.
+// phone-sized photos, a sample whose small print Tesseract boxes across its
+// lines (its text size is not measured), the independently rendered text
+// pages and a receipt: the true paper format, a text layer that reads as well
+// as Tesseract reads the rectified image, the image itself, a valid ALTO file
+// on the words; and a book of three samples made with -j2.
 #include <gtest/gtest.h>
 
 #include <opencv2/imgcodecs.hpp>
@@ -77,7 +78,7 @@ TEST_P(PdfE2e, AltoIsValidAndItsWordsLieOnPrint) {
   EXPECT_LE(bare.size(), words.size() / 100) << bare.size() << " of " << words.size();
 }
 
-INSTANTIATE_TEST_SUITE_P(Sets, PdfE2e, ::testing::Values("set06", "r01", "r02", "r04"));
+INSTANTIATE_TEST_SUITE_P(Sets, PdfE2e, ::testing::Values("set02", "set06", "r01", "r02", "r03", "r04"));
 
 TEST(PdfBook, ThreeSamplesInTheOrderGiven) {
   const std::vector<std::string> order = {"set06", "set01", "set04"};
