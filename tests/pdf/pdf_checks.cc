@@ -3,7 +3,9 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <fstream>
+#include <map>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <regex>
@@ -135,6 +137,36 @@ double CharacterErrorRate(const std::string& reference, const std::string& text)
   return CompareTexts(CodePointsToUtf8(CollapseWhitespace(Utf8ToCodePoints(reference))),
                       CodePointsToUtf8(CollapseWhitespace(Utf8ToCodePoints(text))))
       .cer;
+}
+
+namespace {
+
+std::map<std::string, int> WordCounts(const std::string& text) {
+  std::map<std::string, int> counts;
+  std::string word;
+  for (size_t i = 0; i <= text.size(); ++i) {
+    const unsigned char c = i < text.size() ? text[i] : ' ';
+    if (c < 128 && std::isalnum(c)) {
+      word += char(std::tolower(c));
+    } else if (!word.empty()) {
+      ++counts[word];
+      word.clear();
+    }
+  }
+  return counts;
+}
+
+}  // namespace
+
+double WordsFound(const std::string& reference, const std::string& text) {
+  const std::map<std::string, int> wanted = WordCounts(reference), found = WordCounts(text);
+  int total = 0, matched = 0;
+  for (const auto& [word, n] : wanted) {
+    total += n;
+    const auto it = found.find(word);
+    if (it != found.end()) matched += std::min(n, it->second);
+  }
+  return total ? double(matched) / total : 1;
 }
 
 std::string TesseractText(const fs::path& image) {

@@ -51,6 +51,11 @@ std::vector<AltoWord> WordsWithoutPrint(const cv::Mat& page, const std::vector<A
 // Character error rate of `text` against `reference`, whitespace collapsed.
 double CharacterErrorRate(const std::string& reference, const std::string& text);
 
+// The share of `reference`'s words (runs of ASCII letters and digits, any
+// case, counted with repeats) that `text` holds too, in any order: what a
+// search of the page finds, whatever order its text comes out in.
+double WordsFound(const std::string& reference, const std::string& text);
+
 // Tesseract's text of an image file (English, automatic segmentation).
 std::string TesseractText(const fs::path& image);
 
