@@ -1,5 +1,6 @@
 #include "stages/pdf/pdf_file.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <qpdf/QPDF.hh>
 #include <qpdf/QPDFPageDocumentHelper.hh>
@@ -7,6 +8,7 @@
 #include <qpdf/QPDFWriter.hh>
 #include <qpdf/QUtil.hh>
 #include <stdexcept>
+#include <vector>
 
 namespace docunfold::pdf {
 namespace {
@@ -16,6 +18,99 @@ std::string Number(double v) {
   std::snprintf(buf, sizeof buf, "%.6f", v);
   return buf;
 }
+
+// Tesseract's text layer shows each word with its trailing space, `w Tz
+// [<word+space>] TJ`, stretched so that word and space together span the
+// word's box: the glyphs stop one character short of its right edge, and a
+// short word's gap to the next grows past an em, where pdftotext and viewers
+// see a new column (r04's small print came out one word per line). This
+// filter stretches the glyphs of the word alone over its box (the space,
+// which readers do not box, goes past it), ending at least kWordGapEm before
+// the next word on the line starts: readers join glyphs less than 0.1 em
+// apart into one word ("Session3" where Tesseract's boxes of "Session" and
+// "3" overlap). Positions are kept: Tesseract places every word with Td.
+constexpr double kWordGapEm = 0.15;
+// Tesseract's glyph-less font draws every glyph half an em wide.
+constexpr double kGlyphEm = 0.5;
+
+class WordGlyphsFillTheirBoxes : public QPDFObjectHandle::TokenFilter {
+ public:
+  void handleToken(const QPDFTokenizer::Token& token) override {
+    held_.push_back(token);
+    switch (token.getType()) {
+      case QPDFTokenizer::tt_integer:
+      case QPDFTokenizer::tt_real:
+        operands_.push_back({std::stod(token.getValue()), int(held_.size()) - 1});
+        return;
+      case QPDFTokenizer::tt_string:
+        shown_ = token.getValue();
+        ++strings_;
+        return;
+      case QPDFTokenizer::tt_word:
+        break;
+      default:
+        return;
+    }
+    const std::string& op = token.getValue();
+    if (op == "Tf" && !operands_.empty()) font_size_ = operands_.back().value;
+    if (codes_ > 0) {
+      // The word shown waits for where the next one starts.
+      const bool next_on_line = op == "Td" && operands_.size() == 2 && operands_[1].value == 0;
+      Stretch(next_on_line ? operands_[0].value : 0);
+    } else if (op == "Tz" && operands_.size() == 1 && tz_at_ < 0) {
+      tz_at_ = operands_[0].at;
+      tz_ = operands_[0].value;
+      Expect();
+      return;  // held until the word is shown
+    } else if (tz_at_ >= 0 && (op == "TJ" || op == "Tj") && strings_ == 1 && operands_.empty() &&
+               shown_.size() % 2 == 0 && shown_.size() >= 4 &&
+               shown_.compare(shown_.size() - 2, 2, std::string("\0 ", 2)) == 0) {
+      codes_ = int(shown_.size() / 2);  // two bytes a glyph (Identity-H)
+      Expect();
+      return;
+    }
+    Flush();
+  }
+  void handleEOF() override { Flush(); }
+
+ private:
+  struct Operand {
+    double value;
+    int at;  // index in held_
+  };
+
+  // n codes span n * kGlyphEm * tz/100 em: the n - 1 of the word are
+  // stretched over that, ending kWordGapEm before `next_start` (text space
+  // units from the word's start; 0: none on the line), never narrower than
+  // Tesseract drew them.
+  void Stretch(double next_start) {
+    double stretch = tz_ * codes_ / (codes_ - 1);
+    if (next_start > 0 && font_size_ > 0)
+      stretch = std::min(stretch,
+                         100 * (next_start / font_size_ - kWordGapEm) / (kGlyphEm * (codes_ - 1)));
+    held_[tz_at_] = QPDFTokenizer::Token(QPDFTokenizer::tt_real, Number(std::max(tz_, stretch)));
+  }
+  void Expect() {
+    operands_.clear();
+    strings_ = 0;
+  }
+  void Flush() {
+    for (const QPDFTokenizer::Token& t : held_) writeToken(t);
+    held_.clear();
+    Expect();
+    tz_at_ = -1;
+    codes_ = 0;
+  }
+
+  std::vector<QPDFTokenizer::Token> held_;  // since the last operator written
+  std::vector<Operand> operands_;           // since the last operator
+  int strings_ = 0;                         // strings since the last operator
+  std::string shown_;                       // the last of them
+  double font_size_ = 0;                    // the last Tf's
+  int tz_at_ = -1;                          // a held Tz operand's index, or -1
+  double tz_ = 100;                         // its value
+  int codes_ = 0;                           // glyphs of a word shown, held
+};
 
 }  // namespace
 
@@ -86,6 +181,7 @@ FittedPage FitPage(const fs::path& in, const fs::path& out, double width_pt, dou
     page.getObjectHandle().replaceKey(
         "/MediaBox",
         QPDFObjectHandle::newFromRectangle(QPDFObjectHandle::Rectangle(0, 0, width_pt, height_pt)));
+    page.addContentTokenFilter(std::make_shared<WordGlyphsFillTheirBoxes>());
 
     QPDFObjectHandle dict = QPDFObjectHandle::newDictionary();
     dict.replaceKey("/Title", QPDFObjectHandle::newUnicodeString(info.title));

@@ -1,7 +1,7 @@
 // Finishing Tesseract's one-page text-layer PDF with qpdf: the page set to its
 // paper size with the text layer scaled onto it, the page image embedded as
-// compressed (its pixels are placed by a PDF transform, never resampled), and
-// the document's own description.
+// compressed (its pixels are placed by a PDF transform, never resampled), each
+// word's glyphs stretched over its box, and the document's own description.
 #pragma once
 
 #include <filesystem>
@@ -34,8 +34,9 @@ struct FittedPage {
 };
 
 // Reads the one-page PDF `in` (Tesseract's text layer), sets its page to
-// width_pt x height_pt with the text stretched to fill it, draws `image`
-// under it over the whole page, replaces the document information and writes
+// width_pt x height_pt with the text stretched to fill it, each word's glyphs
+// spanning its box (without the trailing space), draws `image` under it over
+// the whole page, replaces the document information and writes
 // `out` (the same bytes for the same input). Throws std::runtime_error when
 // qpdf cannot read or write.
 FittedPage FitPage(const fs::path& in, const fs::path& out, double width_pt, double height_pt,

@@ -36,6 +36,24 @@ std::string PdfText(const fs::path& pdf, int page) {
       .output;
 }
 
+std::string PdfTextInReadingOrder(const fs::path& pdf) {
+  return RunCommand("pdftotext " + Quote(pdf.string()) + " - 2>/dev/null").output;
+}
+
+std::vector<PdfWord> PdfWords(const fs::path& pdf) {
+  const std::string html =
+      RunCommand("pdftotext -bbox -f 1 -l 1 " + Quote(pdf.string()) + " - 2>/dev/null").output;
+  static const std::regex element(
+      R"re(<word xMin="([-0-9.]+)" yMin="([-0-9.]+)" xMax="([-0-9.]+)" yMax="([-0-9.]+)">([^<]*)</word>)re");
+  std::vector<PdfWord> words;
+  for (std::sregex_iterator it(html.begin(), html.end(), element), end; it != end; ++it) {
+    const double x0 = std::stod((*it)[1]), y0 = std::stod((*it)[2]);
+    words.push_back(
+        {cv::Rect2d(x0, y0, std::stod((*it)[3]) - x0, std::stod((*it)[4]) - y0), (*it)[5]});
+  }
+  return words;
+}
+
 cv::Mat RenderPdfPage(const fs::path& pdf, int page, cv::Size size) {
   // pdftoppm draws an image at its own pixel size half a pixel off (MS-SSIM
   // 0.987 against the image even for a page of exactly its pixels at its

@@ -23,6 +23,17 @@ std::vector<PdfPage> PdfPages(const fs::path& pdf);
 // pdftotext -layout of page `page` (1-based; 0: all pages).
 std::string PdfText(const fs::path& pdf, int page = 0);
 
+// pdftotext's text in its reading order (no -layout): what a viewer's
+// select-all and copy gives.
+std::string PdfTextInReadingOrder(const fs::path& pdf);
+
+struct PdfWord {
+  cv::Rect2d box;  // points, from the page's top left
+  std::string text;
+};
+// The words of the first page as pdftotext -bbox boxes them.
+std::vector<PdfWord> PdfWords(const fs::path& pdf);
+
 // Page `page` rendered by pdftoppm at `size` pixels (BGR).
 cv::Mat RenderPdfPage(const fs::path& pdf, int page, cv::Size size);
 

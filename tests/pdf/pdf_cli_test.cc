@@ -97,6 +97,37 @@ TEST_F(PdfCli, TextLayerReadsAsWellAsTesseractOnTheImage) {
   EXPECT_LE(pdf_cer, image_cer + 0.02) << "pdftotext " << pdf_cer << ", image " << image_cer;
 }
 
+// What a viewer highlights for a word found or selected is the word's print:
+// each word of the text layer spans the box Tesseract read it in (its
+// ALTO box), not, as Tesseract's renderer writes it, that box less one
+// character's width (a word of n letters stretched as n + 1 with its space).
+TEST_F(PdfCli, EachWordOfTheTextLayerSpansItsPrint) {
+  ASSERT_EQ(run_->exit_code, 0) << run_->output;
+  const std::vector<AltoWord> alto = AltoWords(Out() / "letter.alto.xml");
+  const std::vector<PdfWord> words = PdfWords(Out() / "letter.pdf");
+  const double pt_per_px = 210 / 25.4 * 72 / page_.cols;
+  int paired = 0, spanning = 0;
+  for (const PdfWord& w : words) {
+    const AltoWord* same = nullptr;
+    for (const AltoWord& a : alto) {
+      const double dx = std::abs(a.box.x * pt_per_px - w.box.x);
+      const double dy = std::abs((a.box.y + a.box.height) * pt_per_px - w.box.br().y);
+      if (a.text == w.text && dx < 5 && dy < 5 &&
+          (!same || dx < std::abs(same->box.x * pt_per_px - w.box.x)))
+        same = &a;
+    }
+    if (!same) continue;
+    ++paired;
+    const double ratio = w.box.width / (same->box.width * pt_per_px);
+    if (ratio > 0.9 && ratio < 1.1) ++spanning;
+  }
+  RecordProperty("words_spanning_their_box",
+                 std::to_string(spanning) + "/" + std::to_string(paired));
+  ASSERT_GT(paired, 150) << words.size() << " words in the text layer, " << alto.size()
+                         << " in ALTO";
+  EXPECT_GE(spanning, 0.95 * paired) << spanning << " of " << paired << " words span their box";
+}
+
 TEST_F(PdfCli, RenderedBackTheImageIsThePage) {
   ASSERT_EQ(run_->exit_code, 0) << run_->output;
   const cv::Mat back = RenderPdfPage(Out() / "letter.pdf", 1, page_.size());
