@@ -89,7 +89,6 @@ PageReader::PageReader(const std::string& language)
   // Tesseract's diagnostics ("Line cannot be recognized!!") go nowhere: our
   // log is one plain line at a time.
   api_->SetVariable("debug_file", "/dev/null");
-  api_->SetPageSegMode(tesseract::PSM_AUTO);
   setMsgSeverity(L_SEVERITY_NONE);
 }
 
@@ -97,7 +96,9 @@ PageReader::~PageReader() {
   if (api_) api_->End();
 }
 
-PageReader::Page PageReader::Read(const cv::Mat& image) {
+PageReader::Page PageReader::Read(const cv::Mat& image, Segmentation segmentation) {
+  api_->SetPageSegMode(segmentation == Segmentation::kSingleColumn ? tesseract::PSM_SINGLE_COLUMN
+                                                                   : tesseract::PSM_AUTO);
   // Through a PNG, so that Leptonica reads it exactly as it reads the file.
   std::vector<uchar> png;
   if (!cv::imencode(".png", image, png)) throw std::runtime_error("cannot encode the page for OCR");

@@ -28,14 +28,18 @@ class PageReader {
   PageReader(const PageReader&) = delete;
   PageReader& operator=(const PageReader&) = delete;
 
+  // How Tesseract finds the text: its automatic page segmentation (blocks,
+  // columns, pictures), or the page as one column of text of any size.
+  enum class Segmentation { kAuto, kSingleColumn };
+
   // Reads `image` (8-bit BGR or grey) as the tesseract command reads a PNG
-  // of it (automatic page segmentation, the resolution estimated from the
-  // text), and returns its words and lines.
+  // of it (the resolution estimated from the text), and returns its words
+  // and lines.
   struct Page {
     std::vector<Word> words;
     std::vector<TextLine> lines;
   };
-  Page Read(const cv::Mat& image);
+  Page Read(const cv::Mat& image, Segmentation segmentation = Segmentation::kAuto);
 
   // Writes <base>.pdf (the text layer alone, the page as large as the image
   // read at `ppi` pixels per inch), <base>.xml (ALTO) and <base>.hocr for the

@@ -18,6 +18,7 @@
 #include "common/statistics.h"
 #include "stages/pdf/markup_scale.h"
 #include "stages/pdf/pdf_file.h"
+#include "stages/pdf/unread_print.h"
 
 namespace docunfold::pdf {
 namespace {
@@ -35,6 +36,12 @@ constexpr int kSpeckPasses = 2;
 constexpr double kMinReadEmPx = 20;
 constexpr double kReadEmPx = 30;
 constexpr double kMaxReadLongSide = 6000;
+// Where Tesseract's automatic segmentation leaves more than this share of the
+// print unread (set07's receipt: its column of prices, 51 %; every text page
+// of the bench below 10 %), the page is read again as one column of text,
+// kept when that leaves at least kMinUnreadGain less unread.
+constexpr double kMaxUnreadPrint = 0.3;
+constexpr double kMinUnreadGain = 0.1;
 
 // A folder inside `out` for what Tesseract and qpdf write before it is
 // renamed into place; removed however Run ends.
@@ -199,50 +206,89 @@ cv::Mat WithoutSpecks(const cv::Mat& image, const std::vector<cv::Rect>& specks,
 // read as '-', 'g' or ':' too: those are painted out and the page read
 // again (18 of 4,399 words on the 15 bench pages were such specks).
 PageReader::Page ReadWithoutSpecks(PageReader& reader, cv::Mat image, TextSize* size,
-                                   size_t* erased) {
-  PageReader::Page read = reader.Read(image);
+                                   size_t* erased, PageReader::Segmentation segmentation) {
+  PageReader::Page read = reader.Read(image, segmentation);
   *size = EstimateTextSize(read.words, read.lines);
   for (int pass = 0; pass < kSpeckPasses; ++pass) {
     const std::vector<cv::Rect> specks = SpeckBoxes(read.words, kSpeckSideEm * size->em_px);
     if (specks.empty()) break;
     image = WithoutSpecks(image, specks, std::max(2, int(std::ceil(kSpeckMarginEm * size->em_px))));
     *erased += specks.size();
-    read = reader.Read(image);
+    read = reader.Read(image, segmentation);
     *size = EstimateTextSize(read.words, read.lines);
   }
   return read;
 }
 
+// What ReadPage read; Tesseract's renderers write the same reading.
+struct PageReading {
+  PageReader::Page page;     // words and lines in the pixels of the copy read
+  double scale = 1;          // that copy's enlargement of the page
+  TextSize size;             // the text's, in the page's pixels
+  size_t specks_erased = 0;  // before the reading kept
+  bool single_column = false;
+  double unread_print = 0;       // share of the print no word kept covers
+  double unread_print_auto = 0;  // the same, of the automatic segmentation's words
+};
+
+// The share of `page`'s print that none of `read`'s words (in the pixels of
+// `page` enlarged by `scale`) covers.
+double UnreadPrintOf(const cv::Mat& page, PageReader::Page read, double scale) {
+  ScaleToPage(1 / scale, &read);
+  return UnreadPrint(page, read.words);
+}
+
 // Reads `even_page` enlarged so that its long side has at least
 // `min_long_side` pixels (0: as it is), then, where its print is smaller
-// there than kMinReadEmPx, again enlarged to kReadEmPx to the em. `*size` is the text's
-// size in the page's pixels as measured at the first enlargement: read
-// larger, Tesseract boxes small print's words differently (set01's median
-// word came out 60 % taller). `*scale` is the enlargement of the words
-// returned, which are still in its pixels.
-PageReader::Page ReadPage(PageReader& reader, const cv::Mat& even_page, int min_long_side,
-                          TextSize* size, size_t* specks_erased, double* scale) {
+// there than kMinReadEmPx, again enlarged to kReadEmPx to the em; where the
+// automatic segmentation leaves much print unread, again as one column. The
+// text's size is the one measured at the first enlargement: read larger,
+// Tesseract boxes small print's words differently (set01's median word came
+// out 60 % taller).
+PageReading ReadPage(PageReader& reader, const cv::Mat& even_page, int min_long_side) {
+  using Segmentation = PageReader::Segmentation;
+  PageReading r;
   const double long_side = std::max(even_page.cols, even_page.rows);
-  *scale = std::max(1.0, min_long_side / long_side);
+  r.scale = std::max(1.0, min_long_side / long_side);
   // Text size measured on the enlarged copy, where word boxes are not
   // rounded to a few pixels.
-  PageReader::Page read =
-      ReadWithoutSpecks(reader, Enlarged(even_page, *scale), size, specks_erased);
-  const double size_scale = *scale;
-  if (min_long_side > 0 && size->em_px > 0 && size->em_px < kMinReadEmPx) {
-    const double again = std::min(*scale * kReadEmPx / size->em_px, kMaxReadLongSide / long_side);
-    if (again > *scale) {
-      *scale = again;
-      *specks_erased = 0;
+  r.page = ReadWithoutSpecks(reader, Enlarged(even_page, r.scale), &r.size, &r.specks_erased,
+                             Segmentation::kAuto);
+  const double size_scale = r.scale;
+  if (min_long_side > 0 && r.size.em_px > 0 && r.size.em_px < kMinReadEmPx) {
+    const double again = std::min(r.scale * kReadEmPx / r.size.em_px, kMaxReadLongSide / long_side);
+    if (again > r.scale) {
+      r.scale = again;
+      r.specks_erased = 0;
       TextSize size_read_again;
-      read =
-          ReadWithoutSpecks(reader, Enlarged(even_page, *scale), &size_read_again, specks_erased);
+      r.page = ReadWithoutSpecks(reader, Enlarged(even_page, r.scale), &size_read_again,
+                                 &r.specks_erased, Segmentation::kAuto);
     }
   }
-  size->em_px /= size_scale;
-  size->word_height_px /= size_scale;
-  size->line_pitch_px /= size_scale;
-  return read;
+  r.size.em_px /= size_scale;
+  r.size.word_height_px /= size_scale;
+  r.size.line_pitch_px /= size_scale;
+
+  r.unread_print = r.unread_print_auto = UnreadPrintOf(even_page, r.page, r.scale);
+  if (r.unread_print <= kMaxUnreadPrint) return r;
+  const cv::Mat copy = Enlarged(even_page, r.scale);
+  TextSize size_read_again;
+  size_t specks = 0;
+  PageReader::Page column =
+      ReadWithoutSpecks(reader, copy, &size_read_again, &specks, Segmentation::kSingleColumn);
+  const double unread = UnreadPrintOf(even_page, column, r.scale);
+  if (unread <= r.unread_print - kMinUnreadGain) {
+    r.page = std::move(column);
+    r.single_column = true;
+    r.unread_print = unread;
+    r.specks_erased = specks;
+  } else {
+    // Read as before once more: the renderers write the reading last made.
+    r.specks_erased = 0;
+    r.page =
+        ReadWithoutSpecks(reader, copy, &size_read_again, &r.specks_erased, Segmentation::kAuto);
+  }
+  return r;
 }
 
 Json WordsJson(const std::vector<Word>& words) {
@@ -315,11 +361,12 @@ PdfResult Run(const PdfOptions& o, const PdfInputs& in, const fs::path& out,
   timer.Mark("enhance");
 
   PdfResult r;
-  double ocr_scale = 1;
-  PageReader::Page read =
-      ReadPage(reader, even_page, o.ocr_min_long_side, &r.text_size, &r.specks_erased, &ocr_scale);
-  ScaleToPage(1 / ocr_scale, &read);
-  r.words = std::move(read.words);
+  PageReading read = ReadPage(reader, even_page, o.ocr_min_long_side);
+  const double ocr_scale = read.scale;
+  ScaleToPage(1 / ocr_scale, &read.page);
+  r.words = std::move(read.page.words);
+  r.text_size = read.size;
+  r.specks_erased = read.specks_erased;
   for (const Word& w : r.words) r.mean_confidence += w.confidence / r.words.size();
   r.size = ChoosePageSize(in.page.cols, in.page.rows, r.text_size.em_px, o.page);
   timer.Mark("ocr");
@@ -383,6 +430,9 @@ PdfResult Run(const PdfOptions& o, const PdfInputs& in, const fs::path& out,
                {"language", o.language},
                {"read_from", "the page with the light's shading divided out"},
                {"read_scale", ocr_scale},
+               {"segmentation", read.single_column ? "single column" : "auto"},
+               {"unread_print", read.unread_print},
+               {"unread_print_auto", read.unread_print_auto},
                {"words", r.words.size()},
                {"mean_confidence", r.mean_confidence},
                {"specks_erased", r.specks_erased},

@@ -1,12 +1,15 @@
 // The pdf stage's pure parts: paper size from shape and print size, the
-// print's size from what Tesseract read, ALTO and hOCR mapped back onto the
-// page's pixels.
+// print's size from what Tesseract read, how much print no word covers, ALTO
+// and hOCR mapped back onto the page's pixels.
 #include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
 
 #include "common/errors.h"
 #include "stages/pdf/markup_scale.h"
 #include "stages/pdf/page_size.h"
 #include "stages/pdf/text_size.h"
+#include "stages/pdf/unread_print.h"
 
 namespace docunfold::pdf {
 namespace {
@@ -187,6 +190,34 @@ TEST(TextSize, SpecksAreWordsSmallerThanAQuarterEmEveryWay) {
   EXPECT_EQ(specks[0], cv::Rect(5, 5, 1, 1));
   EXPECT_EQ(specks[1], cv::Rect(9, 9, 2, 2));
   EXPECT_TRUE(SpeckBoxes(words, 0).empty());
+}
+
+// A receipt's two columns, items on the left and prices on the right, under
+// a shadow across its lower half and a frame round the page.
+TEST(UnreadPrint, TheShareOfPrintNoWordCovers) {
+  cv::Mat page(600, 400, CV_8UC3, cv::Scalar(235, 235, 235));
+  page(cv::Rect(0, 300, 400, 300)) *= 0.55;
+  cv::rectangle(page, cv::Rect(20, 20, 360, 560), cv::Scalar(40, 40, 40), 2);
+  std::vector<Word> items, prices;
+  for (int row = 0; row < 10; ++row) {
+    const int y = 60 + row * 50;
+    cv::putText(page, "Butter", {40, y}, cv::FONT_HERSHEY_SIMPLEX, 0.8, cv::Scalar(20, 20, 20), 2);
+    cv::putText(page, "15.54", {260, y}, cv::FONT_HERSHEY_SIMPLEX, 0.8, cv::Scalar(20, 20, 20), 2);
+    items.push_back({cv::Rect(36, y - 22, 104, 30), 0.9, "Butter"});
+    prices.push_back({cv::Rect(256, y - 22, 84, 30), 0.9, "15.54"});
+  }
+  std::vector<Word> both = items;
+  both.insert(both.end(), prices.begin(), prices.end());
+  EXPECT_LT(UnreadPrint(page, both), 0.02);
+  const double without_prices = UnreadPrint(page, items);
+  EXPECT_GT(without_prices, 0.3);
+  EXPECT_LT(without_prices, 0.6);
+  EXPECT_GT(UnreadPrint(page, {}), 0.98);
+  // A word of whitespace boxed over the whole page covers nothing.
+  std::vector<Word> blank = items;
+  blank.push_back({cv::Rect(0, 0, 400, 600), 0.95, " "});
+  EXPECT_NEAR(UnreadPrint(page, blank), without_prices, 1e-9);
+  EXPECT_EQ(UnreadPrint(cv::Mat(600, 400, CV_8UC3, cv::Scalar(235, 235, 235)), {}), 0);
 }
 
 TEST(MarkupScale, AltoPositionsAndSizes) {
