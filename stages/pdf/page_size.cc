@@ -83,6 +83,17 @@ PageSize ChoosePageSize(int width_px, int height_px, double text_em_px, const Pa
       continue;
     candidates.push_back(&f);
   }
+  // No format's shape (a page cut off, an odd card): the print's size is the
+  // one measure of the page's left.
+  if (candidates.empty() && text_em_px > 0) {
+    const double dpi = text_em_px / (o.body_text_pt / kPointsPerInch);
+    size.format = "none";
+    size.rule = "text size";
+    size.text_pt = o.body_text_pt;
+    size.width_mm = width_px / dpi * kMillimetresPerInch;
+    size.height_mm = height_px / dpi * kMillimetresPerInch;
+    return finish();
+  }
   if (candidates.empty()) return by_dpi();
 
   const PaperFormat* chosen = nullptr;

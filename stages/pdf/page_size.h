@@ -30,7 +30,9 @@ struct PageSizeOptions {
   double aspect_tolerance = 0.015;
   // A page at least this many times longer than wide is a receipt.
   double receipt_min_aspect = 2.0;
-  // Pixels per inch of the image when no format is matched.
+  // Pixels per inch of the image when no format is matched and the text's
+  // size was not measured (measured: the image at the resolution that sets
+  // its body text at body_text_pt).
   double dpi = 300;
   // Typical body-text size (points) of documents and of receipts; the member
   // of a family whose size puts the page's text nearest to it is chosen.
@@ -46,7 +48,7 @@ struct PageSizeOptions {
 struct PageSize {
   std::string format = "none";  // a PaperFormats() name, or "none"
   // "aspect ratio and text size", "aspect ratio (no text read: the most common size)",
-  // "given", or "dpi"
+  // "given", "text size" (no format's shape), or "dpi"
   std::string rule;
   double width_mm = 0;
   double height_mm = 0;

@@ -314,7 +314,8 @@ void DeclareOptions(OptionTable& table, PdfOptions* o) {
   table.Value("format-tolerance", &o->page.aspect_tolerance, 0.0, 0.2,
               "how far (fraction) the page's aspect ratio may be from a format's");
   table.Value("dpi", &o->page.dpi, 10.0, 2400.0,
-              "image pixels per inch when the page matches no format (or --page-format none)");
+              "image pixels per inch when the page matches no format and its print's size was "
+              "not measured (else its body text is set at 10.5 pt), or with --page-format none");
   table.Choice("enhance", &o->enhance,
                {{"none", Enhance::kNone},
                 {"even-light", Enhance::kEvenLight},

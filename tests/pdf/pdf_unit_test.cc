@@ -68,7 +68,19 @@ TEST(PageSize, AspectWithinTheTolerance) {
   const PageSize off = ChoosePageSize(1000, int(1000 * 1.41429 * 1.025), 0, {});
   EXPECT_EQ(off.format, "none");
   EXPECT_EQ(off.rule, "dpi");
+  EXPECT_NEAR(off.dpi_x, 300, 1e-9);
   EXPECT_NEAR(off.width_mm, 1000 / 300.0 * 25.4, 1e-9);
+}
+
+TEST(PageSize, NoFormatsShapeTakesItsSizeFromItsPrint) {
+  // An A4 page with its top third cut off, 10.5 pt print at 150 dpi.
+  const PageSize cut = ChoosePageSize(1240, 1170, EmPx(10.5, 1240, 210), {});
+  EXPECT_EQ(cut.format, "none");
+  EXPECT_EQ(cut.rule, "text size");
+  EXPECT_NEAR(cut.width_mm, 210, 0.01);
+  EXPECT_NEAR(cut.height_mm, 210 * 1170.0 / 1240, 0.01);
+  EXPECT_NEAR(cut.dpi_y, 1240 / (210 / 25.4), 0.01);
+  EXPECT_EQ(cut.text_pt, 10.5);
 }
 
 TEST(PageSize, ReceiptsKeepTheirLengthAtTheRollWidth) {
