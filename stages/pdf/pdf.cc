@@ -242,9 +242,9 @@ double UnreadPrintOf(const cv::Mat& page, PageReader::Page read, double scale) {
 // `min_long_side` pixels (0: as it is), then, where its print is smaller
 // there than kMinReadEmPx, again enlarged to kReadEmPx to the em; where the
 // automatic segmentation leaves much print unread, again as one column. The
-// text's size is the one measured at the first enlargement: read larger,
-// Tesseract boxes small print's words differently (set01's median word came
-// out 60 % taller).
+// text's size is the one measured at the first enlargement (read larger,
+// Tesseract boxes small print's words differently: set01's median word came
+// out 60 % taller), or, where it measured none, the kept column's.
 PageReading ReadPage(PageReader& reader, const cv::Mat& even_page, int min_long_side) {
   using Segmentation = PageReader::Segmentation;
   PageReading r;
@@ -282,6 +282,15 @@ PageReading ReadPage(PageReader& reader, const cv::Mat& even_page, int min_long_
     r.single_column = true;
     r.unread_print = unread;
     r.specks_erased = specks;
+    // A text size the first reading could not measure, from the column's
+    // words at the same enlargement (a page is read larger only once its
+    // size is known).
+    if (r.size.em_px == 0 && size_read_again.em_px > 0) {
+      r.size = size_read_again;
+      r.size.em_px /= r.scale;
+      r.size.word_height_px /= r.scale;
+      r.size.line_pitch_px /= r.scale;
+    }
   } else {
     // Read as before once more: the renderers write the reading last made.
     r.specks_erased = 0;
