@@ -169,6 +169,28 @@ TEST_F(PdfCli, A300DpiA4PageInColourFitsInOneAndAHalfMegabytes) {
   EXPECT_LE(fs::file_size(dir_ / "out/page300.pdf"), 1500u * 1000u);
 }
 
+// The lower half of the letter in a shadow lit by the room, greener than the
+// lamp's light on the upper half: the shading removal takes the shadow for
+// print, Tesseract reads 59 words of the page's upper half (a search finds
+// 26 % of them), and the page is read again with the tinted shadow divided
+// out too (all 249).
+TEST_F(PdfCli, LinesUnderATintedShadowAreRead) {
+  cv::Mat page;
+  page_.convertTo(page, CV_32FC3);
+  cv::Mat shadow = page.rowRange(page.rows / 2, page.rows);
+  cv::multiply(shadow, cv::Scalar(0.55, 0.60, 0.52), shadow);
+  page.convertTo(page, CV_8UC3);
+  const CommandResult r = Pdf(WriteRenderDir(dir_ / "shadow", page), dir_ / "out");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const Json report = ReadJsonFile(dir_ / "out/pdf.json");
+  EXPECT_EQ(report["text"]["read_as"], "tinted shadows");
+  EXPECT_GT(report["text"]["unread_print_auto"].get<double>(), 0.3);
+  EXPECT_LT(report["text"]["unread_print"].get<double>(), 0.05);
+  EXPECT_GE(WordsFound(ReadFileText(SampleDir("set06") / "ground_truth/text.txt"),
+                       PdfText(dir_ / "out/shadow.pdf")),
+            0.95);
+}
+
 TEST_F(PdfCli, BlackWhiteEmbedsOneBitPrint) {
   const CommandResult r = Pdf(render_, dir_ / "out", "--enhance black-white --name bw");
   ASSERT_EQ(r.exit_code, 0) << r.output;

@@ -121,7 +121,7 @@ TEST(PdfReceipt, ItsColumnOfPricesIsRead) {
   const fs::path out = E2eDir() / "work/set07/80_pdf";
   ASSERT_TRUE(fs::is_regular_file(out / "set07.pdf")) << out;
   const Json report = ReadJsonFile(out / "pdf.json");
-  EXPECT_EQ(report["text"]["segmentation"], "single column");
+  EXPECT_EQ(report["text"]["read_as"], "single column");
   EXPECT_LT(report["text"]["unread_print"].get<double>(), 0.2);
   const double found = WordsFound(ReadFileText(SampleDir("set07") / "ground_truth/text.txt"),
                                   PdfText(out / "set07.pdf"));
