@@ -241,6 +241,14 @@ double UnreadPrintOf(const cv::Mat& page, PageReader::Page read, double scale) {
   return UnreadPrint(page, read.words);
 }
 
+// `size`, measured on the page enlarged by `scale`, in the page's pixels.
+TextSize InPagePixels(TextSize size, double scale) {
+  size.em_px /= scale;
+  size.word_height_px /= scale;
+  size.line_pitch_px /= scale;
+  return size;
+}
+
 // Shading removal that takes a shadow of another tint than the lit paper
 // (lit by the room, not the lamp: r09's greenish band) for paper too. Not
 // the default: Tesseract then dropped r02's whole table.
@@ -267,22 +275,20 @@ PageReading ReadPage(PageReader& reader, const cv::Mat& photo_page, const cv::Ma
   r.scale = std::max(1.0, min_long_side / long_side);
   // Text size measured on the enlarged copy, where word boxes are not
   // rounded to a few pixels.
-  r.page = ReadWithoutSpecks(reader, Enlarged(even_page, r.scale), &r.size, &r.specks_erased,
-                             Segmentation::kAuto);
-  const double size_scale = r.scale;
-  if (min_long_side > 0 && r.size.em_px > 0 && r.size.em_px < kMinReadEmPx) {
-    const double again = std::min(r.scale * kReadEmPx / r.size.em_px, kMaxReadLongSide / long_side);
+  cv::Mat copy = Enlarged(even_page, r.scale);
+  r.page = ReadWithoutSpecks(reader, copy, &r.size, &r.specks_erased, Segmentation::kAuto);
+  r.size = InPagePixels(r.size, r.scale);
+  if (min_long_side > 0 && r.size.em_px > 0 && r.size.em_px * r.scale < kMinReadEmPx) {
+    const double again = std::min(kReadEmPx / r.size.em_px, kMaxReadLongSide / long_side);
     if (again > r.scale) {
       r.scale = again;
       r.specks_erased = 0;
+      copy = Enlarged(even_page, r.scale);
       TextSize size_read_again;
-      r.page = ReadWithoutSpecks(reader, Enlarged(even_page, r.scale), &size_read_again,
-                                 &r.specks_erased, Segmentation::kAuto);
+      r.page =
+          ReadWithoutSpecks(reader, copy, &size_read_again, &r.specks_erased, Segmentation::kAuto);
     }
   }
-  r.size.em_px /= size_scale;
-  r.size.word_height_px /= size_scale;
-  r.size.line_pitch_px /= size_scale;
 
   r.unread_print = r.unread_print_auto = UnreadPrintOf(even_page, r.page, r.scale);
   if (r.unread_print <= kMaxUnreadPrint) return r;
@@ -291,7 +297,6 @@ PageReading ReadPage(PageReader& reader, const cv::Mat& photo_page, const cv::Ma
     cv::Mat copy;
     Segmentation segmentation;
   };
-  const cv::Mat copy = Enlarged(even_page, r.scale);
   const std::vector<Alternative> alternatives = {
       {"auto", copy, Segmentation::kAuto},
       {"single column", copy, Segmentation::kSingleColumn},
@@ -323,12 +328,7 @@ PageReading ReadPage(PageReader& reader, const cv::Mat& photo_page, const cv::Ma
   // A text size the first reading could not measure, from the kept one's
   // words at the same enlargement (a page is read larger only once its size
   // is known).
-  if (r.size.em_px == 0 && size.em_px > 0) {
-    r.size = size;
-    r.size.em_px /= r.scale;
-    r.size.word_height_px /= r.scale;
-    r.size.line_pitch_px /= r.scale;
-  }
+  if (r.size.em_px == 0 && size.em_px > 0) r.size = InPagePixels(size, r.scale);
   return r;
 }
 

@@ -29,20 +29,25 @@ std::vector<PdfPage> PdfPages(const fs::path& pdf) {
   return pages;
 }
 
+namespace {
+
+// What `pdftotext <flags> <pdf> -` writes.
+std::string Pdftotext(const std::string& flags, const fs::path& pdf) {
+  return RunCommand("pdftotext " + flags + " " + Quote(pdf.string()) + " - 2>/dev/null").output;
+}
+
+}  // namespace
+
 std::string PdfText(const fs::path& pdf, int page) {
   const std::string range =
       page > 0 ? " -f " + std::to_string(page) + " -l " + std::to_string(page) : "";
-  return RunCommand("pdftotext -layout" + range + " " + Quote(pdf.string()) + " - 2>/dev/null")
-      .output;
+  return Pdftotext("-layout" + range, pdf);
 }
 
-std::string PdfTextInReadingOrder(const fs::path& pdf) {
-  return RunCommand("pdftotext " + Quote(pdf.string()) + " - 2>/dev/null").output;
-}
+std::string PdfTextInReadingOrder(const fs::path& pdf) { return Pdftotext("", pdf); }
 
 std::vector<PdfWord> PdfWords(const fs::path& pdf) {
-  const std::string html =
-      RunCommand("pdftotext -bbox -f 1 -l 1 " + Quote(pdf.string()) + " - 2>/dev/null").output;
+  const std::string html = Pdftotext("-bbox -f 1 -l 1", pdf);
   static const std::regex element(
       R"re(<word xMin="([-0-9.]+)" yMin="([-0-9.]+)" xMax="([-0-9.]+)" yMax="([-0-9.]+)">([^<]*)</word>)re");
   std::vector<PdfWord> words;
