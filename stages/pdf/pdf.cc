@@ -18,6 +18,7 @@
 #include "common/statistics.h"
 #include "stages/pdf/markup_scale.h"
 #include "stages/pdf/pdf_file.h"
+#include "stages/pdf/ruling.h"
 #include "stages/pdf/unread_print.h"
 
 namespace docunfold::pdf {
@@ -45,6 +46,14 @@ constexpr double kMinUnreadGain = 0.1;
 // The chromaticity distance within which a shadow counts as paper when the
 // page is read again (ShadingOptions::max_chroma_distance: 0.01).
 constexpr double kTintedShadowChroma = 0.04;
+// A page whose rules cover at least this share of its pixels (set02's and
+// r02's tables: 11-12 %; set04's and set06's 4-5 %; an underline or the
+// crop's edge: under 0.1 %), read with them, leaving more than this share of
+// its print unread (set02 32 %, r02 35 %; set04 8 %, set06 0.4 %), is read
+// without them too: Tesseract boxes a table's cells as tall blocks of rules
+// and glyphs where the rules touch the print.
+constexpr double kMinRuleShare = 0.005;
+constexpr double kMaxUnreadPrintOfRuledPage = 0.15;
 
 // A folder inside `out` for what Tesseract and qpdf write before it is
 // renamed into place; removed however Run ends.
@@ -209,7 +218,8 @@ cv::Mat WithoutSpecks(const cv::Mat& image, const std::vector<cv::Rect>& specks,
 // read as '-', 'g' or ':' too: those are painted out and the page read
 // again (18 of 4,399 words on the 15 bench pages were such specks).
 PageReader::Page ReadWithoutSpecks(PageReader& reader, cv::Mat image, TextSize* size,
-                                   size_t* erased, PageReader::Segmentation segmentation) {
+                                   size_t* erased, PageReader::Segmentation segmentation,
+                                   cv::Mat* image_read) {
   PageReader::Page read = reader.Read(image, segmentation);
   *size = EstimateTextSize(read.words, read.lines);
   for (int pass = 0; pass < kSpeckPasses; ++pass) {
@@ -220,6 +230,7 @@ PageReader::Page ReadWithoutSpecks(PageReader& reader, cv::Mat image, TextSize* 
     read = reader.Read(image, segmentation);
     *size = EstimateTextSize(read.words, read.lines);
   }
+  *image_read = image;
   return read;
 }
 
@@ -232,6 +243,20 @@ struct PageReading {
   std::string read_as = "auto";  // "auto", "single column" or "tinted shadows"
   double unread_print = 0;       // share of the print no word kept covers
   double unread_print_auto = 0;  // the same, of the first automatic reading's words
+  bool without_ruling = false;   // read with the page's rules painted out
+  // What the kept reading was made from (specks erased): read again, it
+  // gives the same words.
+  cv::Mat image_read;
+  PageReader::Segmentation segmentation = PageReader::Segmentation::kAuto;
+};
+
+// A page to read.
+struct PageCopies {
+  cv::Mat photo;  // as rendered: read again with tinted shadows divided out
+  cv::Mat even;   // with the light's shading divided out
+  // `even` with its table's rules painted out where it has some (at least
+  // kMinRuleShare of its pixels), else empty.
+  cv::Mat without_ruling;
 };
 
 // The share of `page`'s print that none of `read`'s words (in the pixels of
@@ -258,40 +283,69 @@ ShadingOptions TintedShadows() {
   return o;
 }
 
-// Reads `even_page` enlarged so that its long side has at least
-// `min_long_side` pixels (0: as it is), then, where its print is smaller
-// there than kMinReadEmPx, again enlarged to kReadEmPx to the em. Where that
-// leaves much print unread, the page is read as one column, and as before
-// from `photo_page` with tinted shadows divided out too; the reading that
-// leaves the least unread is kept. The text's size is the one measured at
-// the first enlargement (read larger, Tesseract boxes small print's words
+// Reads `page.even` enlarged so that its long side has at least
+// `min_long_side` pixels (0: as it is); where the page has rules and that
+// leaves much print unread, also without them, and goes on with the copy
+// without them where that leaves at least kMinUnreadGain less unread. Where
+// the print is smaller there
+// than kMinReadEmPx, the page is read again enlarged to kReadEmPx to the em.
+// Where that leaves much print unread, it is read as one column, and as
+// before from `page.photo` with tinted shadows divided out too; the reading
+// that leaves the least unread is kept. The text's size is the one measured
+// at the first enlargement (read larger, Tesseract boxes small print's words
 // differently: set01's median word came out 60 % taller), or, where it
-// measured none, the kept reading's.
-PageReading ReadPage(PageReader& reader, const cv::Mat& photo_page, const cv::Mat& even_page,
-                     int min_long_side) {
+// measured none, the kept reading's. The kept reading is the last made.
+PageReading ReadPage(PageReader& reader, const PageCopies& page, int min_long_side) {
   using Segmentation = PageReader::Segmentation;
   PageReading r;
-  const double long_side = std::max(even_page.cols, even_page.rows);
+  const bool ruled = !page.without_ruling.empty();
+  // Print touching a rule is no glyph-sized mark where the rule is.
+  const cv::Mat& print = ruled ? page.without_ruling : page.even;
+  const double long_side = std::max(page.even.cols, page.even.rows);
   r.scale = std::max(1.0, min_long_side / long_side);
   // Text size measured on the enlarged copy, where word boxes are not
   // rounded to a few pixels.
-  cv::Mat copy = Enlarged(even_page, r.scale);
-  r.page = ReadWithoutSpecks(reader, copy, &r.size, &r.specks_erased, Segmentation::kAuto);
+  cv::Mat copy = Enlarged(page.even, r.scale);
+  r.page = ReadWithoutSpecks(reader, copy, &r.size, &r.specks_erased, Segmentation::kAuto,
+                             &r.image_read);
+  bool kept_read_last = true;
+  const double unread_with_ruling = ruled ? UnreadPrintOf(print, r.page, r.scale) : 0;
+  if (unread_with_ruling > kMaxUnreadPrintOfRuledPage) {
+    PageReading without;
+    without.scale = r.scale;
+    const cv::Mat copy_without = Enlarged(page.without_ruling, r.scale);
+    without.page = ReadWithoutSpecks(reader, copy_without, &without.size, &without.specks_erased,
+                                     Segmentation::kAuto, &without.image_read);
+    if (UnreadPrintOf(print, without.page, r.scale) <= unread_with_ruling - kMinUnreadGain) {
+      r = std::move(without);
+      r.without_ruling = true;
+      copy = copy_without;
+    } else {
+      kept_read_last = false;
+    }
+  }
+  const cv::Mat& even = r.without_ruling ? page.without_ruling : page.even;
   r.size = InPagePixels(r.size, r.scale);
   if (min_long_side > 0 && r.size.em_px > 0 && r.size.em_px * r.scale < kMinReadEmPx) {
     const double again = std::min(kReadEmPx / r.size.em_px, kMaxReadLongSide / long_side);
     if (again > r.scale) {
       r.scale = again;
       r.specks_erased = 0;
-      copy = Enlarged(even_page, r.scale);
+      copy = Enlarged(even, r.scale);
       TextSize size_read_again;
-      r.page =
-          ReadWithoutSpecks(reader, copy, &size_read_again, &r.specks_erased, Segmentation::kAuto);
+      r.page = ReadWithoutSpecks(reader, copy, &size_read_again, &r.specks_erased,
+                                 Segmentation::kAuto, &r.image_read);
+      kept_read_last = true;
     }
   }
 
-  r.unread_print = r.unread_print_auto = UnreadPrintOf(even_page, r.page, r.scale);
-  if (r.unread_print <= kMaxUnreadPrint) return r;
+  r.unread_print = r.unread_print_auto = UnreadPrintOf(print, r.page, r.scale);
+  if (r.unread_print <= kMaxUnreadPrint) {
+    // The renderers write the reading last made.
+    if (!kept_read_last) reader.Read(r.image_read, r.segmentation);
+    return r;
+  }
+  const cv::Mat tinted = RemoveShading(page.photo, TintedShadows()).image;
   struct Alternative {
     std::string name;
     cv::Mat copy;
@@ -300,7 +354,7 @@ PageReading ReadPage(PageReader& reader, const cv::Mat& photo_page, const cv::Ma
   const std::vector<Alternative> alternatives = {
       {"auto", copy, Segmentation::kAuto},
       {"single column", copy, Segmentation::kSingleColumn},
-      {"tinted shadows", Enlarged(RemoveShading(photo_page, TintedShadows()).image, r.scale),
+      {"tinted shadows", Enlarged(r.without_ruling ? WithoutRuling(tinted).page : tinted, r.scale),
        Segmentation::kAuto}};
   size_t best = 0;
   double best_unread = r.unread_print;
@@ -310,20 +364,20 @@ PageReading ReadPage(PageReader& reader, const cv::Mat& photo_page, const cv::Ma
   for (size_t i = 1; i < alternatives.size(); ++i) {
     specks = 0;
     read = ReadWithoutSpecks(reader, alternatives[i].copy, &size, &specks,
-                             alternatives[i].segmentation);
-    const double unread = UnreadPrintOf(even_page, read, r.scale);
+                             alternatives[i].segmentation, &r.image_read);
+    const double unread = UnreadPrintOf(print, read, r.scale);
     if (unread <= r.unread_print - kMinUnreadGain && unread < best_unread)
       best = i, best_unread = unread;
   }
   const Alternative& kept = alternatives[best];
   if (best + 1 != alternatives.size()) {
-    // Read once more: the renderers write the reading last made.
     specks = 0;
-    read = ReadWithoutSpecks(reader, kept.copy, &size, &specks, kept.segmentation);
+    read = ReadWithoutSpecks(reader, kept.copy, &size, &specks, kept.segmentation, &r.image_read);
   }
   r.page = std::move(read);
   r.specks_erased = specks;
   r.read_as = kept.name;
+  r.segmentation = kept.segmentation;
   r.unread_print = best_unread;
   // A text size the first reading could not measure, from the kept one's
   // words at the same enlargement (a page is read larger only once its size
@@ -403,7 +457,10 @@ PdfResult Run(const PdfOptions& o, const PdfInputs& in, const fs::path& out,
   timer.Mark("enhance");
 
   PdfResult r;
-  PageReading read = ReadPage(reader, in.page, even_page, o.ocr_min_long_side);
+  const Ruling ruling = WithoutRuling(even_page);
+  PageReading read = ReadPage(
+      reader, {in.page, even_page, ruling.rule_share >= kMinRuleShare ? ruling.page : cv::Mat()},
+      o.ocr_min_long_side);
   const double ocr_scale = read.scale;
   ScaleToPage(1 / ocr_scale, &read.page);
   r.words = std::move(read.page.words);
@@ -473,6 +530,8 @@ PdfResult Run(const PdfOptions& o, const PdfInputs& in, const fs::path& out,
                {"read_from", "the page with the light's shading divided out"},
                {"read_scale", ocr_scale},
                {"read_as", read.read_as},
+               {"ruling_share", ruling.rule_share},
+               {"read_without_ruling", read.without_ruling},
                {"unread_print", read.unread_print},
                {"unread_print_auto", read.unread_print_auto},
                {"words", r.words.size()},

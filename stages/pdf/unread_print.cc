@@ -6,16 +6,21 @@
 
 namespace docunfold::pdf {
 
-double UnreadPrint(const cv::Mat& page, const std::vector<Word>& words,
-                   const UnreadPrintOptions& o) {
+cv::Mat PrintPixels(const cv::Mat& page, int window_px, double contrast) {
   cv::Mat grey;
   if (page.channels() == 3)
     cv::cvtColor(page, grey, cv::COLOR_BGR2GRAY);
   else
     grey = page;
-  cv::Mat dark;
-  cv::adaptiveThreshold(grey, dark, 255, cv::ADAPTIVE_THRESH_MEAN_C, cv::THRESH_BINARY_INV,
-                        o.window_px | 1, o.contrast);
+  cv::Mat print;
+  cv::adaptiveThreshold(grey, print, 255, cv::ADAPTIVE_THRESH_MEAN_C, cv::THRESH_BINARY_INV,
+                        window_px | 1, contrast);
+  return print;
+}
+
+double UnreadPrint(const cv::Mat& page, const std::vector<Word>& words,
+                   const UnreadPrintOptions& o) {
+  const cv::Mat dark = PrintPixels(page, o.window_px, o.contrast);
   cv::Mat labels, stats, centroids;
   const int count = cv::connectedComponentsWithStats(dark, labels, stats, centroids, 8, CV_32S);
   std::vector<uchar> glyph(count, 0);

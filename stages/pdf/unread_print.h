@@ -28,6 +28,10 @@ struct UnreadPrintOptions {
   double border_of_short_side = 0.02;
 };
 
+// `page`'s print (8-bit, 255): pixels at least `contrast` grey levels darker
+// than the mean of a `window_px` square around them.
+cv::Mat PrintPixels(const cv::Mat& page, int window_px, double contrast);
+
 // The share (0..1) of `page`'s print pixels outside every word's box (`words`
 // in `page`'s pixels; words of whitespace only cover nothing). 0 for a page
 // without print.

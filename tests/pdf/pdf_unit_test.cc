@@ -1,6 +1,7 @@
 // The pdf stage's pure parts: paper size from shape and print size, the
-// print's size from what Tesseract read, how much print no word covers, ALTO
-// and hOCR mapped back onto the page's pixels.
+// print's size from what Tesseract read, how much print no word covers, a
+// table's rules taken out of the copy read, ALTO and hOCR mapped back onto
+// the page's pixels.
 #include <gtest/gtest.h>
 
 #include <opencv2/imgproc.hpp>
@@ -8,6 +9,7 @@
 #include "common/errors.h"
 #include "stages/pdf/markup_scale.h"
 #include "stages/pdf/page_size.h"
+#include "stages/pdf/ruling.h"
 #include "stages/pdf/text_size.h"
 #include "stages/pdf/unread_print.h"
 
@@ -230,6 +232,56 @@ TEST(UnreadPrint, TheShareOfPrintNoWordCovers) {
   blank.push_back({cv::Rect(0, 0, 400, 600), 0.95, " "});
   EXPECT_NEAR(UnreadPrint(page, blank), without_prices, 1e-9);
   EXPECT_EQ(UnreadPrint(cv::Mat(600, 400, CV_8UC3, cv::Scalar(235, 235, 235)), {}), 0);
+}
+
+// Dark pixels (below 128 in every channel) of `page` within `box`.
+int DarkPixels(const cv::Mat& page, const cv::Rect& box) {
+  cv::Mat grey;
+  cv::cvtColor(page(box), grey, cv::COLOR_BGR2GRAY);
+  return cv::countNonZero(grey < 128);
+}
+
+TEST(Ruling, ATablesRulesArePaintedOutAndItsPrintKept) {
+  // A statement's table: 12 rows of 4 cells, ruled, half of it in shadow,
+  // words touching the rules under them; above it a heading and a line of
+  // small print whose letters touch.
+  cv::Mat page(900, 640, CV_8UC3, cv::Scalar(232, 236, 238));
+  page(cv::Rect(0, 525, 640, 375)) *= 0.6;
+  const std::vector<int> columns = {40, 140, 380, 500, 600};
+  const cv::Scalar ink(30, 30, 30);
+  std::vector<cv::Rect> words;
+  for (int row = 0; row <= 12; ++row)
+    cv::line(page, {columns.front(), 200 + row * 50}, {columns.back(), 200 + row * 50}, ink, 2);
+  for (int x : columns) cv::line(page, {x, 200}, {x, 800}, ink, 1);
+  for (int row = 0; row < 12; ++row)
+    for (size_t c = 0; c + 1 < columns.size(); ++c) {
+      const cv::Point at(columns[c] + 8, 200 + row * 50 + 49);  // on the rule below
+      cv::putText(page, c == 1 ? "Refund GARAGE" : "12.34", at, cv::FONT_HERSHEY_SIMPLEX, 0.7, ink,
+                  2);
+      words.push_back(cv::Rect(at.x, at.y - 18, c == 1 ? 200 : 70, 14));  // above the rule
+    }
+  cv::putText(page, "ACCOUNT STATEMENT", {40, 80}, cv::FONT_HERSHEY_DUPLEX, 1.2, ink, 3);
+  cv::putText(page, "permission to use a particular library", {40, 140}, cv::FONT_HERSHEY_PLAIN,
+              0.9, ink, 2);
+  const cv::Rect heading(30, 40, 600, 110);
+
+  const Ruling r = WithoutRuling(page);
+  // 13 rules across and 5 down, each grown to about 5 and 3 pixels.
+  EXPECT_GT(r.rule_share, 0.06);
+  EXPECT_LT(r.rule_share, 0.09);
+  // No rule is left, in the light or in the shadow...
+  for (int row = 0; row <= 12; ++row)
+    EXPECT_EQ(DarkPixels(r.page, cv::Rect(300, 199 + row * 50, 60, 3)), 0) << "row " << row;
+  for (int x : columns) EXPECT_EQ(DarkPixels(r.page, cv::Rect(x - 1, 300, 3, 400)), 0) << x;
+  // ... and the print is as it was.
+  for (const cv::Rect& w : words) EXPECT_EQ(DarkPixels(r.page, w), DarkPixels(page, w)) << w;
+  EXPECT_EQ(DarkPixels(r.page, heading), DarkPixels(page, heading));
+
+  // A page without rules is the page itself.
+  const cv::Mat text_only = page(heading).clone();
+  const Ruling none = WithoutRuling(text_only);
+  EXPECT_EQ(none.rule_share, 0);
+  EXPECT_EQ(none.page.data, text_only.data);
 }
 
 TEST(MarkupScale, AltoPositionsAndSizes) {
