@@ -30,6 +30,11 @@ std::string Number(double v) {
 // apart into one word ("Session3" where Tesseract's boxes of "Session" and
 // "3" overlap). Positions are kept: Tesseract places every word with Td.
 constexpr double kWordGapEm = 0.15;
+// A gap wider than this between two words of one of Tesseract's lines is
+// bridged by the glyphs of the word before it, to kWordGapEm before the
+// next: readers take such a gap for a column's edge, and copy a receipt's
+// item and its price, or a table's cells, a column at a time.
+constexpr double kMaxWordGapEm = 1.0;
 // Tesseract's glyph-less font draws every glyph half an em wide.
 constexpr double kGlyphEm = 0.5;
 
@@ -80,14 +85,18 @@ class WordGlyphsFillTheirBoxes : public QPDFObjectHandle::TokenFilter {
   };
 
   // n codes span n * kGlyphEm * tz/100 em: the n - 1 of the word are
-  // stretched over that, ending kWordGapEm before `next_start` (text space
-  // units from the word's start; 0: none on the line), never narrower than
-  // Tesseract drew them.
+  // stretched over that, ending at least kWordGapEm before `next_start`
+  // (text space units from the word's start; 0: none on the line), and
+  // exactly that where the gap left would be wider than kMaxWordGapEm; never
+  // narrower than Tesseract drew them.
   void Stretch(double next_start) {
     double stretch = tz_ * codes_ / (codes_ - 1);
-    if (next_start > 0 && font_size_ > 0)
-      stretch = std::min(stretch,
-                         100 * (next_start / font_size_ - kWordGapEm) / (kGlyphEm * (codes_ - 1)));
+    if (next_start > 0 && font_size_ > 0) {
+      const double next_em = next_start / font_size_;
+      const double to_next = 100 * (next_em - kWordGapEm) / (kGlyphEm * (codes_ - 1));
+      const double gap_em = next_em - kGlyphEm * (codes_ - 1) * stretch / 100;
+      stretch = gap_em > kMaxWordGapEm ? to_next : std::min(stretch, to_next);
+    }
     held_[tz_at_] = QPDFTokenizer::Token(QPDFTokenizer::tt_real, Number(std::max(tz_, stretch)));
   }
   void Expect() {

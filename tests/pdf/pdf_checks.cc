@@ -95,12 +95,18 @@ std::vector<AltoWord> AltoWords(const fs::path& alto) {
   std::stringstream s;
   s << in.rdbuf();
   const std::string xml = s.str();
-  static const std::regex element(R"(<String ([^>]*)/>)");
+  static const std::regex element(R"(<(String|TextLine) ([^>]*)>)");
   static const std::regex attribute(R"re(([A-Z]+)="([^"]*)")re");
   std::vector<AltoWord> words;
+  int line = -1;
   for (std::sregex_iterator it(xml.begin(), xml.end(), element), end; it != end; ++it) {
-    const std::string attrs = (*it)[1];
+    if ((*it)[1] == "TextLine") {
+      ++line;
+      continue;
+    }
+    const std::string attrs = (*it)[2];
     AltoWord w;
+    w.line = line;
     for (std::sregex_iterator a(attrs.begin(), attrs.end(), attribute); a != end; ++a) {
       const std::string key = (*a)[1], value = (*a)[2];
       if (key == "HPOS") w.box.x = std::stoi(value);

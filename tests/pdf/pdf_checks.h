@@ -48,8 +48,9 @@ struct AltoWord {
   cv::Rect box;
   double confidence = 0;  // WC
   std::string text;
+  int line = -1;  // the index of its <TextLine> in the file
 };
-// The <String> elements of an ALTO file.
+// The <String> elements of an ALTO file, in its order.
 std::vector<AltoWord> AltoWords(const fs::path& alto);
 
 // The words whose box holds no print: none of its darkest tenth of pixels
