@@ -282,6 +282,14 @@ TEST(Ruling, ATablesRulesArePaintedOutAndItsPrintKept) {
   const Ruling none = WithoutRuling(text_only);
   EXPECT_EQ(none.rule_share, 0);
   EXPECT_EQ(none.page.data, text_only.data);
+
+  // A grey page keeps its one channel; a page of a few pixels has no rules.
+  cv::Mat grey(200, 300, CV_8UC1, cv::Scalar(230));
+  cv::line(grey, {20, 100}, {280, 100}, cv::Scalar(20), 2);
+  const Ruling grey_ruling = WithoutRuling(grey);
+  EXPECT_EQ(grey_ruling.page.type(), CV_8UC1);
+  EXPECT_EQ(cv::countNonZero(grey_ruling.page < 128), 0);
+  EXPECT_EQ(WithoutRuling(cv::Mat(3, 3, CV_8UC3, cv::Scalar::all(200))).rule_share, 0);
 }
 
 TEST(MarkupScale, AltoPositionsAndSizes) {
