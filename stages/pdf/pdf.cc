@@ -287,14 +287,14 @@ ShadingOptions TintedShadows() {
 // `min_long_side` pixels (0: as it is); where the page has rules and that
 // leaves much print unread, also without them, and goes on with the copy
 // without them where that leaves at least kMinUnreadGain less unread. Where
-// the print is smaller there
-// than kMinReadEmPx, the page is read again enlarged to kReadEmPx to the em.
-// Where that leaves much print unread, it is read as one column, and as
-// before from `page.photo` with tinted shadows divided out too; the reading
-// that leaves the least unread is kept. The text's size is the one measured
-// at the first enlargement (read larger, Tesseract boxes small print's words
-// differently: set01's median word came out 60 % taller), or, where it
-// measured none, the kept reading's. The kept reading is the last made.
+// the print is smaller there than kMinReadEmPx, the page is read again
+// enlarged to kReadEmPx to the em. Where that leaves much print unread, it is
+// read as one column, and as before from `page.photo` with tinted shadows
+// divided out too; the reading that leaves the least unread is kept. The
+// text's size is the one measured at the first enlargement (read larger,
+// Tesseract boxes small print's words differently: set01's median word came
+// out 60 % taller), or, where it measured none, the kept reading's. The kept
+// reading is the last made: Tesseract's renderers write that one.
 PageReading ReadPage(PageReader& reader, const PageCopies& page, int min_long_side) {
   using Segmentation = PageReader::Segmentation;
   PageReading r;
@@ -371,6 +371,7 @@ PageReading ReadPage(PageReader& reader, const PageCopies& page, int min_long_si
   }
   const Alternative& kept = alternatives[best];
   if (best + 1 != alternatives.size()) {
+    // Read once more: the renderers write the reading last made.
     specks = 0;
     read = ReadWithoutSpecks(reader, kept.copy, &size, &specks, kept.segmentation, &r.image_read);
   }

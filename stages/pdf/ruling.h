@@ -18,7 +18,7 @@ struct RulingOptions {
   // shorter.
   double min_length_of_long_side = 0.1;
   // ... and is on average at most this thick: this fraction of the page's
-  // long side, and never less than `min_thickness_px`.
+  // long side, or `min_thickness_px` where that is more.
   double max_thickness_of_long_side = 0.004;
   double min_thickness_px = 3;
   // Painted over with the lightest colour within this many pixels, after the
