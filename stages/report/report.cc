@@ -523,10 +523,11 @@ void StagesSection(const ReportOptions& o, Page* page) {
   page->Section("stages", "Stages: time, memory and flags");
   const auto timings = StageTimings(o.work);
   const std::vector<std::pair<std::string, std::string>> stages = {
-      {"sfm", "sfm"},        {"segment-boundary", "boundary"},
-      {"densify", "points"}, {"detect-features", "features"},
-      {"init-mesh", "init"}, {"optimize", "optimize"},
-      {"render", "render"},  {"evaluate", "evaluate"}};
+      {"sfm", "sfm"},          {"segment-boundary", "boundary"},
+      {"densify", "points"},   {"detect-features", "features"},
+      {"init-mesh", "init"},   {"optimize", "optimize"},
+      {"render", "render"},    {"pdf", "pdf"},
+      {"evaluate", "evaluate"}};
   std::string t =
       "<table><tr><th class=l>stage</th><th>wall time (s)</th><th>peak memory (MB)"
       "</th><th class=l>flags</th></tr>";

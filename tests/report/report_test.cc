@@ -79,5 +79,27 @@ TEST(ReportRun, NamedAfterThePhotosFolderCountsThePhotosAndListsWhatWasLeftOut) 
             std::string::npos);
 }
 
+// The stages' table has a row for each stage that ran, the pdf stage's too,
+// with its flags, and their total.
+TEST(ReportRun, StagesTableTimesEveryStageThatRan) {
+  TempDir dir;
+  ReportOptions o;
+  o.data = dir / "data";
+  o.work = dir / "work";
+  o.out = dir / "work" / "report.html";
+  EnsureDirectory(o.data / "images");
+  EnsureDirectory(o.work / ".flags");
+  WriteTextAtomic(o.work / "timings.jsonl",
+                  "{\"stage\": \"sfm\", \"seconds\": 10.0, \"max_rss_mb\": 1000.0, \"exit\": 0}\n"
+                  "{\"stage\": \"pdf\", \"seconds\": 2.5, \"max_rss_mb\": 150.0, \"exit\": 0}\n");
+  WriteTextAtomic(o.work / ".flags" / "pdf", "--lang deu\n");
+  const std::string html = report::Run(o).html;
+  EXPECT_NE(html.find("<tr><td class=l>pdf</td><td>2.5</td><td>150</td><td class=l><code>--lang "
+                      "deu</code></td></tr>"),
+            std::string::npos)
+      << html;
+  EXPECT_NE(html.find("<th class=l>total</th><th>12.5</th>"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace docunfold::report
