@@ -4,8 +4,6 @@
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
-#include "stages/pdf/unread_print.h"
-
 namespace docunfold::pdf {
 namespace {
 
@@ -34,7 +32,7 @@ void AddRules(const cv::Mat& print, bool across, int length, double max_thicknes
 }  // namespace
 
 Ruling WithoutRuling(const cv::Mat& page, const RulingOptions& o) {
-  const cv::Mat print = PrintPixels(page, o.window_px, o.contrast);
+  const cv::Mat print = PrintPixels(page, o.print);
   const int long_side = std::max(page.cols, page.rows);
   const double max_thickness =
       std::max(o.min_thickness_px, o.max_thickness_of_long_side * long_side);

@@ -6,13 +6,12 @@
 
 #include <opencv2/core.hpp>
 
+#include "stages/pdf/unread_print.h"
+
 namespace docunfold::pdf {
 
 struct RulingOptions {
-  // Print: pixels at least `contrast` grey levels darker than the mean of a
-  // `window_px` square around them (as for UnreadPrint).
-  int window_px = 31;
-  double contrast = 15;
+  PrintThreshold print;  // what is print, as for UnreadPrint
   // A rule runs unbroken, across or down, along at least this fraction of
   // the page's long side: a word's print, even with its letters touching, is
   // shorter.

@@ -6,7 +6,7 @@
 
 namespace docunfold::pdf {
 
-cv::Mat PrintPixels(const cv::Mat& page, int window_px, double contrast) {
+cv::Mat PrintPixels(const cv::Mat& page, const PrintThreshold& t) {
   cv::Mat grey;
   if (page.channels() == 3)
     cv::cvtColor(page, grey, cv::COLOR_BGR2GRAY);
@@ -14,13 +14,13 @@ cv::Mat PrintPixels(const cv::Mat& page, int window_px, double contrast) {
     grey = page;
   cv::Mat print;
   cv::adaptiveThreshold(grey, print, 255, cv::ADAPTIVE_THRESH_MEAN_C, cv::THRESH_BINARY_INV,
-                        window_px | 1, contrast);
+                        t.window_px | 1, t.contrast);
   return print;
 }
 
 double UnreadPrint(const cv::Mat& page, const std::vector<Word>& words,
                    const UnreadPrintOptions& o) {
-  const cv::Mat dark = PrintPixels(page, o.window_px, o.contrast);
+  const cv::Mat dark = PrintPixels(page, o.print);
   cv::Mat labels, stats, centroids;
   const int count = cv::connectedComponentsWithStats(dark, labels, stats, centroids, 8, CV_32S);
   std::vector<uchar> glyph(count, 0);

@@ -10,11 +10,18 @@
 
 namespace docunfold::pdf {
 
-struct UnreadPrintOptions {
-  // Print: pixels at least `contrast` grey levels darker than the mean of a
-  // `window_px` square around them (the light's shading does not matter).
+// Print: pixels at least `contrast` grey levels darker than the mean of a
+// `window_px` square around them (the light's shading does not matter).
+struct PrintThreshold {
   int window_px = 31;
   double contrast = 15;
+};
+
+// `page`'s print (8-bit, 255 where print).
+cv::Mat PrintPixels(const cv::Mat& page, const PrintThreshold& threshold = {});
+
+struct UnreadPrintOptions {
+  PrintThreshold print;
   // Only glyph-sized marks count: connected components smaller than these
   // fractions of the page's height and width (a table's frame or a rule is
   // not print to read), of at least `min_area_px` pixels (not noise).
@@ -27,10 +34,6 @@ struct UnreadPrintOptions {
   // crop's edge and whatever lies beyond the page there.
   double border_of_short_side = 0.02;
 };
-
-// `page`'s print (8-bit, 255): pixels at least `contrast` grey levels darker
-// than the mean of a `window_px` square around them.
-cv::Mat PrintPixels(const cv::Mat& page, int window_px, double contrast);
 
 // The share (0..1) of `page`'s print pixels outside every word's box (`words`
 // in `page`'s pixels; words of whitespace only cover nothing). 0 for a page
