@@ -96,6 +96,9 @@ PageReader::~PageReader() {
   if (api_) api_->End();
 }
 
+PageReader::PageReader(PageReader&&) noexcept = default;
+PageReader& PageReader::operator=(PageReader&&) noexcept = default;
+
 PageReader::Page PageReader::Read(const cv::Mat& image, Segmentation segmentation) {
   api_->SetPageSegMode(segmentation == Segmentation::kSingleColumn ? tesseract::PSM_SINGLE_COLUMN
                                                                    : tesseract::PSM_AUTO);

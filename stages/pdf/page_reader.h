@@ -27,6 +27,11 @@ class PageReader {
   ~PageReader();
   PageReader(const PageReader&) = delete;
   PageReader& operator=(const PageReader&) = delete;
+  // Moved, it takes its page last read along.
+  PageReader(PageReader&&) noexcept;
+  PageReader& operator=(PageReader&&) noexcept;
+
+  const std::string& language() const { return language_; }
 
   // How Tesseract finds the text: its automatic page segmentation (blocks,
   // columns, pictures), or the page as one column of text of any size.

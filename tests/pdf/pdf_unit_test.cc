@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "common/errors.h"
+#include "stages/pdf/contrast.h"
 #include "stages/pdf/markup_scale.h"
 #include "stages/pdf/page_size.h"
 #include "stages/pdf/ruling.h"
@@ -290,6 +291,40 @@ TEST(Ruling, ATablesRulesArePaintedOutAndItsPrintKept) {
   EXPECT_EQ(grey_ruling.page.type(), CV_8UC1);
   EXPECT_EQ(cv::countNonZero(grey_ruling.page < 128), 0);
   EXPECT_EQ(WithoutRuling(cv::Mat(3, 3, CV_8UC3, cv::Scalar::all(200))).rule_share, 0);
+}
+
+TEST(Contrast, PalePrintIsStretchedToBlackOnWhite) {
+  // A receipt's pale, thin print (grey 150 on paper at 234) on a page
+  // lighter at the top than at the foot.
+  cv::Mat page(400, 300, CV_8UC3, cv::Scalar(234, 234, 234));
+  page(cv::Rect(0, 300, 300, 100)).setTo(cv::Scalar(226, 226, 226));
+  for (int row = 0; row < 8; ++row)
+    cv::putText(page, "Butter 13.52", {20, 40 + row * 45}, cv::FONT_HERSHEY_PLAIN, 1.4,
+                cv::Scalar(150, 150, 150), 1);
+  const cv::Mat out = PrintStretchedToBlack(page);
+  ASSERT_EQ(out.type(), CV_8UC1);
+  ASSERT_EQ(out.size(), page.size());
+  double darkest = 0, lightest = 0;
+  cv::minMaxLoc(out, &darkest, &lightest);
+  EXPECT_LE(darkest, 10);
+  EXPECT_EQ(lightest, 255);
+  EXPECT_EQ(out.at<uchar>(150, 290), 255);  // the paper, white
+  EXPECT_GE(out.at<uchar>(350, 290), 200);  // the paper in the foot's light, nearly so
+
+  // A page with a single short word: black is the word's, not the paper's
+  // grain; a page without print is left as it was, in grey.
+  cv::Mat sparse(600, 600, CV_8UC1, cv::Scalar(230));
+  cv::randu(sparse, cv::Scalar(226), cv::Scalar(235));
+  cv::putText(sparse, "OK", {280, 300}, cv::FONT_HERSHEY_PLAIN, 1, cv::Scalar(120), 1);
+  const cv::Mat stretched = PrintStretchedToBlack(sparse);
+  EXPECT_GE(stretched.at<uchar>(100, 100), 180) << "the paper's grain made print";
+  cv::minMaxLoc(stretched, &darkest, &lightest);
+  EXPECT_LE(darkest, 10);
+  const cv::Mat blank(100, 100, CV_8UC3, cv::Scalar(200, 210, 220));
+  cv::Mat blank_grey;
+  cv::cvtColor(blank, blank_grey, cv::COLOR_BGR2GRAY);
+  EXPECT_EQ(cv::norm(PrintStretchedToBlack(blank), blank_grey, cv::NORM_INF), 0);
+  EXPECT_TRUE(PrintStretchedToBlack(cv::Mat()).empty());
 }
 
 TEST(MarkupScale, AltoPositionsAndSizes) {
