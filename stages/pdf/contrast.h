@@ -1,8 +1,8 @@
-// The copy of the page Tesseract reads, its print made black. Its line
+// A copy of the page for Tesseract with its print made black. Its line
 // recogniser reads the grey levels as they are: pale, thin print (set07's
-// receipt, its darkest print 120 grey levels on paper at 234) came out as
-// "Lig" for "7.37" where the same lines stretched to black on white read
-// right.
+// receipt: the darkest tenth of its print at grey 119, its paper at 234)
+// came out as "Lig" for "7.37" where the same lines stretched to black on
+// white read right.
 #pragma once
 
 #include <opencv2/core.hpp>
