@@ -147,12 +147,8 @@ PageImage EncodePageImage(const cv::Mat& image, bool black_white, int quality,
 }
 
 cv::Mat BlackOnWhite(const cv::Mat& even) {
-  cv::Mat grey, bw;
-  if (even.channels() == 3)
-    cv::cvtColor(even, grey, cv::COLOR_BGR2GRAY);
-  else
-    grey = even;
-  cv::threshold(grey, bw, 0, 255, cv::THRESH_BINARY | cv::THRESH_OTSU);
+  cv::Mat bw;
+  cv::threshold(Grey(even), bw, 0, 255, cv::THRESH_BINARY | cv::THRESH_OTSU);
   return bw;
 }
 
@@ -268,6 +264,10 @@ struct PageCopies {
   // `even` with its table's rules painted out where it has some (at least
   // kMinRuleShare of its pixels), else empty.
   cv::Mat without_ruling;
+
+  // The copy whose print a reading is measured against: print touching a
+  // rule is no glyph-sized mark where the rule is.
+  const cv::Mat& print() const { return without_ruling.empty() ? even : without_ruling; }
 };
 
 // The share of `page`'s print that none of `read`'s words (in the pixels of
@@ -310,8 +310,7 @@ PageReading ReadBestCopy(PageReader& reader, const PageCopies& page, int min_lon
   using Segmentation = PageReader::Segmentation;
   PageReading r;
   const bool ruled = !page.without_ruling.empty();
-  // Print touching a rule is no glyph-sized mark where the rule is.
-  const cv::Mat& print = ruled ? page.without_ruling : page.even;
+  const cv::Mat& print = page.print();
   const double long_side = std::max(page.even.cols, page.even.rows);
   r.scale = std::max(1.0, min_long_side / long_side);
   // Text size measured on the enlarged copy, where word boxes are not
@@ -420,8 +419,7 @@ PageReading ReadPage(PageReader& reader, const PageCopies& page, int min_long_si
   cv::Mat image_read;
   PageReader::Page read = ReadWithoutSpecks(stretched_reader, PrintStretchedToBlack(r.image_read),
                                             &size, &specks, r.segmentation, &image_read);
-  const cv::Mat& print = page.without_ruling.empty() ? page.even : page.without_ruling;
-  const double unread = UnreadPrintOf(print, read, r.scale);
+  const double unread = UnreadPrintOf(page.print(), read, r.scale);
   if (MeanConfidence(read.words) < confidence + kMinConfidenceGain ||
       unread > r.unread_print + kMaxUnreadLossOfStretch)
     return r;

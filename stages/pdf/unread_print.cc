@@ -6,14 +6,16 @@
 
 namespace docunfold::pdf {
 
-cv::Mat PrintPixels(const cv::Mat& page, const PrintThreshold& t) {
+cv::Mat Grey(const cv::Mat& page) {
+  if (page.channels() != 3) return page;
   cv::Mat grey;
-  if (page.channels() == 3)
-    cv::cvtColor(page, grey, cv::COLOR_BGR2GRAY);
-  else
-    grey = page;
+  cv::cvtColor(page, grey, cv::COLOR_BGR2GRAY);
+  return grey;
+}
+
+cv::Mat PrintPixels(const cv::Mat& page, const PrintThreshold& t) {
   cv::Mat print;
-  cv::adaptiveThreshold(grey, print, 255, cv::ADAPTIVE_THRESH_MEAN_C, cv::THRESH_BINARY_INV,
+  cv::adaptiveThreshold(Grey(page), print, 255, cv::ADAPTIVE_THRESH_MEAN_C, cv::THRESH_BINARY_INV,
                         t.window_px | 1, t.contrast);
   return print;
 }

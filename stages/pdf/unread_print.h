@@ -17,6 +17,9 @@ struct PrintThreshold {
   double contrast = 15;
 };
 
+// `page` (8-bit, 1 or 3 channels) in grey: a grey page is itself.
+cv::Mat Grey(const cv::Mat& page);
+
 // `page`'s print (8-bit, 255 where print).
 cv::Mat PrintPixels(const cv::Mat& page, const PrintThreshold& threshold = {});
 
