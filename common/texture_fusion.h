@@ -60,9 +60,11 @@ struct FusionOptions {
   // choice, coarser costs log(cap / resolution).
   double resolution_cap = 1.0;
   // The reference photo keeps a patch unless another resolves it this many
-  // times better: the others are registered to it, so every switch risks a
-  // seam.
-  double reference_preference = 1.5;
+  // times better (1: any photo that resolves it better). The others are
+  // registered and levelled to it, and seams run where the photos agree:
+  // at 1.5 the bench's MS-SSIM was a little lower and its CER higher
+  // (docs/decisions/render.md, "Every photo that resolves a part better").
+  double reference_preference = 1.0;
   // A photo blurred (shaken, out of focus) resolves less than its pixels
   // say: its resolution is scaled by its sharpness against the sharpest
   // photo, measured by squared grey gradients where two photos resolve the
