@@ -118,18 +118,16 @@ TEST_P(PdfE2e, AltoIsValidAndItsWordsLieOnPrint) {
 INSTANTIATE_TEST_SUITE_P(Sets, PdfE2e,
                          ::testing::Values("set02", "set06", "r01", "r02", "r03", "r04"));
 
-// set07's receipt: Tesseract's automatic segmentation left its column of
-// prices unread (51 % of the print; a search found 31 % of its words), so
-// the page was read again as one column (13 % unread, 72 % found); its pale,
-// thin print was read with a mean confidence of 0.75 ("Lig" for "7.37"), so
-// the page was read again with its print stretched to black (0.86; 87 %
-// found).
+// set07's receipt, pale, thin print in two columns. Rendered from the
+// reference photo alone, Tesseract's automatic segmentation left its column
+// of prices unread (51 % of the print; a search found 31 % of its words);
+// read again as one column and with its print stretched to black, 87 % were
+// found. Rendered from every photo that resolves it better, the automatic
+// segmentation reads the prices (17 % unread; 84 % found).
 TEST(PdfReceipt, ItsColumnOfPricesIsRead) {
   const fs::path out = E2eDir() / "work/set07/80_pdf";
   ASSERT_TRUE(fs::is_regular_file(out / "set07.pdf")) << out;
   const Json report = ReadJsonFile(out / "pdf.json");
-  EXPECT_EQ(report["text"]["read_as"], "single column");
-  EXPECT_TRUE(report["text"]["read_with_print_stretched"].get<bool>());
   EXPECT_LT(report["text"]["unread_print"].get<double>(), 0.2);
   const double found = WordsFound(ReadFileText(SampleDir("set07") / "ground_truth/text.txt"),
                                   PdfText(out / "set07.pdf"));
