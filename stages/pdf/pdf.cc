@@ -339,11 +339,16 @@ PageReading ReadBestCopy(PageReader& reader, const PageCopies& page, int min_lon
   const double confidence_with_ruling = MeanConfidence(r.page.words);
   if (ruled && (unread_with_ruling > kMaxUnreadPrintOfRuledPage ||
                 confidence_with_ruling < kMinConfidenceOfRuledPage)) {
+    // Without its rules a table is read as one column: its rows come out as
+    // lines. The automatic segmentation may cut it into a block per column
+    // and give the cells in the wrong order.
     PageReading without;
     without.scale = r.scale;
+    without.read_as = "single column";
+    without.segmentation = Segmentation::kSingleColumn;
     const cv::Mat copy_without = Enlarged(page.without_ruling, r.scale);
     without.page = ReadWithoutSpecks(reader, copy_without, &without.size, &without.specks_erased,
-                                     Segmentation::kAuto, &without.image_read);
+                                     without.segmentation, &without.image_read);
     const double unread_without = UnreadPrintOf(print, without.page, r.scale);
     const bool reads_more = unread_without <= unread_with_ruling - kMinUnreadGain;
     const bool reads_surer =
@@ -366,8 +371,8 @@ PageReading ReadBestCopy(PageReader& reader, const PageCopies& page, int min_lon
       r.specks_erased = 0;
       copy = Enlarged(even, r.scale);
       TextSize size_read_again;
-      r.page = ReadWithoutSpecks(reader, copy, &size_read_again, &r.specks_erased,
-                                 Segmentation::kAuto, &r.image_read);
+      r.page = ReadWithoutSpecks(reader, copy, &size_read_again, &r.specks_erased, r.segmentation,
+                                 &r.image_read);
       kept_read_last = true;
     }
   }
@@ -385,7 +390,7 @@ PageReading ReadBestCopy(PageReader& reader, const PageCopies& page, int min_lon
     Segmentation segmentation;
   };
   const std::vector<Alternative> alternatives = {
-      {"auto", copy, Segmentation::kAuto},
+      {r.read_as, copy, r.segmentation},
       {"single column", copy, Segmentation::kSingleColumn},
       {"tinted shadows", Enlarged(r.without_ruling ? WithoutRuling(tinted).page : tinted, r.scale),
        Segmentation::kAuto}};
