@@ -60,7 +60,7 @@ constexpr double kMaxUnreadPrintOfRuledPage = 0.15;
 // confidence 0.55, 14 % unread, words found 27 %). A ruled page read with a
 // mean confidence below this is read without its rules too, and that
 // reading kept where its confidence is at least kMinConfidenceGainOfRules
-// higher and it leaves at most kMaxUnreadLossOfStretch more print unread.
+// higher and it leaves at most kMaxUnreadLossOfSurerReading more print unread.
 constexpr double kMinConfidenceOfRuledPage = 0.8;
 constexpr double kMinConfidenceGainOfRules = 0.1;
 // Tesseract's line recogniser misreads pale, thin print (set07's receipt:
@@ -68,10 +68,12 @@ constexpr double kMinConfidenceGainOfRules = 0.1;
 // page read with a mean confidence below this is read again with its print
 // stretched to black, and that reading kept where its mean confidence is at
 // least kMinConfidenceGain higher and it leaves at most
-// kMaxUnreadLossOfStretch more print unread.
+// kMaxUnreadLossOfSurerReading more print unread.
 constexpr double kMaxConfidenceToStretch = 0.92;
 constexpr double kMinConfidenceGain = 0.02;
-constexpr double kMaxUnreadLossOfStretch = 0.02;
+// A reading kept for its confidence (without the rules, or stretched) may
+// leave at most this much more of the print unread.
+constexpr double kMaxUnreadLossOfSurerReading = 0.02;
 
 // A folder inside `out` for what Tesseract and qpdf write before it is
 // renamed into place; removed however Run ends.
@@ -291,6 +293,15 @@ double MeanConfidence(const std::vector<Word>& words) {
   return words.empty() ? 0 : sum / words.size();
 }
 
+// Whether a reading at mean word `confidence` leaving `unread` of the print
+// unread is surer than one at (`than_confidence`, `than_unread`) by at least
+// `min_gain` and leaves at most kMaxUnreadLossOfSurerReading more unread.
+bool ReadsSurer(double confidence, double unread, double than_confidence, double than_unread,
+                double min_gain) {
+  return confidence >= than_confidence + min_gain &&
+         unread <= than_unread + kMaxUnreadLossOfSurerReading;
+}
+
 // `size`, measured on the page enlarged by `scale`, in the page's pixels.
 TextSize InPagePixels(TextSize size, double scale) {
   size.em_px /= scale;
@@ -313,7 +324,7 @@ ShadingOptions TintedShadows() {
 // leaves much print unread or is read with little confidence, also without
 // them, and goes on with the copy without them where that leaves at least
 // kMinUnreadGain less unread or is read with kMinConfidenceGainOfRules more
-// confidence and no more than kMaxUnreadLossOfStretch more unread. Where
+// confidence and no more than kMaxUnreadLossOfSurerReading more unread. Where
 // the print is smaller there than kMinReadEmPx, the page is read again
 // enlarged to kReadEmPx to the em. Where that leaves much print unread, it is
 // read as one column, and as before from `page.photo` with tinted shadows
@@ -350,11 +361,9 @@ PageReading ReadBestCopy(PageReader& reader, const PageCopies& page, int min_lon
     without.page = ReadWithoutSpecks(reader, copy_without, &without.size, &without.specks_erased,
                                      without.segmentation, &without.image_read);
     const double unread_without = UnreadPrintOf(print, without.page, r.scale);
-    const bool reads_more = unread_without <= unread_with_ruling - kMinUnreadGain;
-    const bool reads_surer =
-        MeanConfidence(without.page.words) >= confidence_with_ruling + kMinConfidenceGainOfRules &&
-        unread_without <= unread_with_ruling + kMaxUnreadLossOfStretch;
-    if (reads_more || reads_surer) {
+    if (unread_without <= unread_with_ruling - kMinUnreadGain ||
+        ReadsSurer(MeanConfidence(without.page.words), unread_without, confidence_with_ruling,
+                   unread_with_ruling, kMinConfidenceGainOfRules)) {
       r = std::move(without);
       r.without_ruling = true;
       copy = copy_without;
@@ -400,6 +409,8 @@ PageReading ReadBestCopy(PageReader& reader, const PageCopies& page, int min_lon
   TextSize size;
   size_t specks = 0;
   for (size_t i = 1; i < alternatives.size(); ++i) {
+    // A page read without its rules was read as one column already.
+    if (alternatives[i].name == alternatives[0].name) continue;
     specks = 0;
     read = ReadWithoutSpecks(reader, alternatives[i].copy, &size, &specks,
                              alternatives[i].segmentation, &r.image_read);
@@ -429,7 +440,7 @@ PageReading ReadBestCopy(PageReader& reader, const PageCopies& page, int min_lon
 // confidence below kMaxConfidenceToStretch, its copy is read again with the
 // print stretched to black, and that reading kept (`reader` then holds it)
 // where it is read with at least kMinConfidenceGain more and leaves at most
-// kMaxUnreadLossOfStretch more print unread.
+// kMaxUnreadLossOfSurerReading more print unread.
 PageReading ReadPage(PageReader& reader, const PageCopies& page, int min_long_side) {
   PageReading r = ReadBestCopy(reader, page, min_long_side);
   const double confidence = MeanConfidence(r.page.words);
@@ -442,8 +453,8 @@ PageReading ReadPage(PageReader& reader, const PageCopies& page, int min_long_si
   PageReader::Page read = ReadWithoutSpecks(stretched_reader, PrintStretchedToBlack(r.image_read),
                                             &size, &specks, r.segmentation, &image_read);
   const double unread = UnreadPrintOf(page.print(), read, r.scale);
-  if (MeanConfidence(read.words) < confidence + kMinConfidenceGain ||
-      unread > r.unread_print + kMaxUnreadLossOfStretch)
+  if (!ReadsSurer(MeanConfidence(read.words), unread, confidence, r.unread_print,
+                  kMinConfidenceGain))
     return r;
   reader = std::move(stretched_reader);
   r.page = std::move(read);
