@@ -241,12 +241,18 @@ EVAL_OUT := $(WORK)/70_eval/metrics.json
 # reference view, where the data set has a true surface.
 HAS_TRUE_SURFACE := $(wildcard $(DATA_DIR)/ground_truth/mesh.ply)
 FRONT_END_OUT := $(if $(HAS_TRUE_SURFACE),$(WORK)/70_eval/front_end.json)
-evaluate: check-data render $(EVAL_OUT) $(FRONT_END_OUT)
+# The searchable PDF's text layer and page size, where the data set has its
+# true text.
+HAS_TRUE_TEXT := $(wildcard $(DATA_DIR)/ground_truth/text.txt)
+PDF_EVAL_OUT := $(if $(and $(HAS_TRUE_TEXT),$(wildcard $(ROOT)/stages/pdf)),$(WORK)/70_eval/pdf.json)
+evaluate: check-data render $(EVAL_OUT) $(FRONT_END_OUT) $(PDF_EVAL_OUT)
 $(EVAL_OUT): $(BIN)/evaluate $(WORK)/.flags/evaluate $(WORK)/60_render/rectified.png
 	@test -n "$(HAS_GT)" || { echo "pipeline.mk: $(DATA_DIR): no ground_truth/flat.png to evaluate against" >&2; exit 3; }
 	$(call timed,evaluate) $(BIN)/evaluate --data $(DATA_DIR) --work $(WORK) --result $(WORK)/60_render/rectified.png --out $@ $(EVAL_FLAGS)
 $(WORK)/70_eval/front_end.json: $(BIN)/evaluate $(SFM_IN) $(BOUNDARY_IN) $(WORK)/30_features/features.json
 	$(call timed,evaluate-front-end) $(BIN)/evaluate --front-end --data $(DATA_DIR) --work $(WORK) --out $@
+$(WORK)/70_eval/pdf.json: $(BIN)/evaluate $(WORK)/80_pdf/$(NAME).pdf
+	$(call timed,evaluate-pdf) $(BIN)/evaluate --pdf $(WORK)/80_pdf/$(NAME).pdf --data $(DATA_DIR) --out $@
 
 # The report is redrawn whenever a stage's output is newer.
 REPORT_OUT := $(WORK)/report.html
@@ -254,7 +260,7 @@ report: check-data $(REPORT_OUT)
 STAGE_OUTPUTS := sfm:SFM_OUT boundary:BOUNDARY_OUT points:POINTS_OUT features:FEATURES_OUT init:INIT_OUT \
   optimize:OPTIMIZE_OUT render:RENDER_OUT pdf:PDF_OUT
 REPORT_IN := $(foreach s,$(STAGE_OUTPUTS),$(if $(filter $(call pair_name,$(s)),$(IMPLEMENTED) $(if $(wildcard $(ROOT)/stages/pdf),pdf)),$($(call pair_value,$(s))))) \
-  $(if $(and $(HAS_GT),$(wildcard $(ROOT)/stages/evaluate)),$(EVAL_OUT) $(FRONT_END_OUT))
+  $(if $(and $(HAS_GT),$(wildcard $(ROOT)/stages/evaluate)),$(EVAL_OUT) $(FRONT_END_OUT) $(PDF_EVAL_OUT))
 $(REPORT_OUT): $(BIN)/report $(REPORT_IN) | check-data
 	$(BIN)/report --data $(DATA_DIR) --work $(WORK) --out $@
 
@@ -304,7 +310,8 @@ help:
 	@echo "  pages          photos of several pages in DATA: the others, each to work/<name>-p<k>,"
 	@echo "                 all joined into work/<name>.pdf (WORK=dir: dir-p<k>, dir.pdf; part of all)"
 	@echo "  evaluate       metrics against ground truth -> 70_eval/ (sets with ground_truth/;"
-	@echo "                 front_end.json: boundary and features in the reference view)"
+	@echo "                 front_end.json: boundary and features in the reference view;"
+	@echo "                 pdf.json: the PDF's text layer and page size)"
 	@echo "  report         one HTML page with every stage's output -> work/<name>/report.html"
 	@echo "  test           build, then run all tests (ctest)"
 	@echo "  build          configure and build build/bin/*"

@@ -327,6 +327,14 @@ run_set() {  # run_set <data dir> <work dir>
       >> "$work/bench/front_end.log" 2>&1 ||
       echo "bench: evaluate --front-end failed: $(tail -n 1 "$work/bench/front_end.log")" >&2
   fi
+  # The searchable PDF read back as a viewer reads it: words a search finds,
+  # CER in reading order, page size.
+  local pdf_file=$work/80_pdf/$(basename "$work").pdf
+  if [[ -f $pdf_file && -f $data/ground_truth/text.txt ]]; then
+    "$timer" "$work/bench/timings.jsonl" "evaluate:pdf" "$bin/evaluate" --pdf "$pdf_file" \
+      --data "$data" --out "$work/70_eval/pdf.json" >> "$work/bench/pdf_eval.log" 2>&1 ||
+      echo "bench: evaluate --pdf failed: $(tail -n 1 "$work/bench/pdf_eval.log")" >&2
+  fi
   if [[ ! -f $data/ground_truth/flat.png ]]; then
     record "-" skipped "" "" "" "no ground_truth/flat.png: not evaluated"
     return

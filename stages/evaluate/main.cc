@@ -4,6 +4,7 @@
 #include "common/json_io.h"
 #include "stages/evaluate/evaluate.h"
 #include "stages/evaluate/front_end.h"
+#include "stages/evaluate/pdf_metrics.h"
 
 using namespace docunfold;
 
@@ -31,6 +32,19 @@ void FrontEnd(const evaluate::EvaluateInputs& in, const fs::path& out, const Jso
   Log(evaluate::Summary(r) + " -> " + out.string());
 }
 
+void Pdf(const evaluate::EvaluateInputs& in, const fs::path& pdf, const fs::path& out,
+         const Json& record) {
+  if (!in.result.empty()) throw UsageError("--result and --pdf exclude each other");
+  if (!evaluate::HasTrueText(in.data)) {
+    Log("note: " + in.data.string() +
+        " has no ground_truth/text.txt; nothing to measure the PDF against, no metrics written");
+    return;
+  }
+  const evaluate::PdfMetricsResult r = evaluate::MeasurePdf(in.data, pdf, record);
+  WriteDocument(out, r.document);
+  Log(evaluate::Summary(r) + " -> " + out.string());
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -47,13 +61,20 @@ int main(int argc, char** argv) {
       "<work>/20_boundary (page region IoU, corners, real sides) and "
       "<work>/30_features (segment precision and recall against the page's "
       "true lines) in sfm's reference view, as a docunfold.front-end-metrics "
-      "file (needs the true surface: ground_truth/mesh.ply, cameras.json)."};
+      "file (needs the true surface: ground_truth/mesh.ply, cameras.json).\n"
+      "With --pdf it judges the pipeline's searchable PDF instead: its text "
+      "layer as poppler's pdftotext extracts it (words a search finds, CER in "
+      "reading order) against ground_truth/text.txt, and its "
+      "page size against ground_truth/page.json, as a docunfold.pdf-metrics "
+      "file."};
   evaluate::EvaluateInputs in;
   evaluate::EvaluateOptions options;
-  fs::path out;
+  fs::path out, pdf;
   command.RequiredPath("data", &in.data, "data set folder");
   command.Path("work", &in.work, "work directory (meshes, 10_sfm/cameras.json, OCR cache)");
   command.Path("result", &in.result, "rectified image to evaluate (not with --front-end)");
+  command.Path("pdf", &pdf,
+               "searchable PDF to measure (80_pdf/<name>.pdf; not with --result or --front-end)");
   command.RequiredPath("out", &out, "metrics JSON to write");
   command.Path("mesh-dir", &options.mesh_dir,
                "folder with mesh3d.ply (and mesh2d.ply) to measure (default: <work>/50_optimize, "
@@ -64,7 +85,10 @@ int main(int argc, char** argv) {
     std::error_code ec;
     if (!fs::is_directory(in.data, ec))
       throw InputError(in.data.string() + ": no such data set folder");
+    if (options.front_end && !pdf.empty())
+      throw UsageError("--front-end and --pdf exclude each other");
     if (options.front_end) return FrontEnd(in, out, command.Record());
+    if (!pdf.empty()) return Pdf(in, pdf, out, command.Record());
     if (in.result.empty()) throw UsageError("--result is required (or --front-end)");
     if (!evaluate::HasGroundTruth(in.data)) {
       Log("note: " + in.data.string() +

@@ -1,7 +1,9 @@
 #include "stages/evaluate/text_metrics.h"
 
 #include <algorithm>
+#include <cctype>
 #include <limits>
+#include <map>
 
 namespace docunfold::evaluate {
 namespace {
@@ -135,6 +137,36 @@ TextScores CompareTexts(const std::string& reference_utf8, const std::string& re
   s.reference_words = reference_words.size();
   s.wer = Ratio(s.word_ed, s.reference_words);
   return s;
+}
+
+namespace {
+
+std::map<std::string, int> WordCounts(const std::string& text) {
+  std::map<std::string, int> counts;
+  std::string word;
+  for (size_t i = 0; i <= text.size(); ++i) {
+    const unsigned char c = i < text.size() ? text[i] : ' ';
+    if (c < 128 && std::isalnum(c)) {
+      word += char(std::tolower(c));
+    } else if (!word.empty()) {
+      ++counts[word];
+      word.clear();
+    }
+  }
+  return counts;
+}
+
+}  // namespace
+
+double WordsFound(const std::string& reference, const std::string& text) {
+  const std::map<std::string, int> wanted = WordCounts(reference), found = WordCounts(text);
+  int total = 0, matched = 0;
+  for (const auto& [word, n] : wanted) {
+    total += n;
+    const auto it = found.find(word);
+    if (it != found.end()) matched += std::min(n, it->second);
+  }
+  return total ? double(matched) / total : 1;
 }
 
 }  // namespace docunfold::evaluate

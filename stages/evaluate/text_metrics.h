@@ -38,4 +38,9 @@ struct TextScores {
 // CER over the texts as they are (OCR of result vs OCR of ground truth).
 TextScores CompareTexts(const std::string& reference_utf8, const std::string& result_utf8);
 
+// Share of the reference's words (runs of ASCII letters and digits, case
+// ignored, counted with multiplicity) that `text` holds too, in any order:
+// what a search of the text finds. 1 for a reference without words.
+double WordsFound(const std::string& reference, const std::string& text);
+
 }  // namespace docunfold::evaluate

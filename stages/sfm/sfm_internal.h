@@ -8,10 +8,10 @@
 #include <string>
 #include <vector>
 
+#include "common/subprocess.h"
 #include "stages/sfm/colmap_model.h"
 #include "stages/sfm/photo_set.h"
 #include "stages/sfm/sfm.h"
-#include "stages/sfm/subprocess.h"
 
 namespace docunfold::sfm::detail {
 

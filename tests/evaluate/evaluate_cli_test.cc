@@ -201,6 +201,36 @@ TEST_F(EvaluateCli, BadUsageAndMissingFolders) {
   EXPECT_FALSE(fs::exists(out));
 }
 
+// (evaluate --pdf on a real PDF: PdfCli.EvaluateMeasuresItsTextLayerAndSize.)
+TEST_F(EvaluateCli, APdfThatIsMissingOrNotAPdfIsBadInput) {
+  auto measure = [&](const fs::path& pdf, const std::string& extra = "") {
+    return RunCommand(Evaluate("--data " + Quote(data.string()) + " --pdf " + Quote(pdf.string()) +
+                               " --out " + Quote(out.string()) + extra));
+  };
+  CommandResult r = measure(dir / "nope.pdf");
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("nope.pdf: no such file"), std::string::npos) << r.output;
+  std::ofstream(dir / "empty.pdf");
+  r = measure(dir / "empty.pdf");
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("empty.pdf: not a PDF poppler can read"), std::string::npos) << r.output;
+  std::ofstream(dir / "flat.pdf") << "%PDF-1.4 but nothing after it";
+  r = measure(dir / "flat.pdf");
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("flat.pdf: "), std::string::npos) << r.output;
+  r = measure(dir / "empty.pdf", " --result " + Quote(flat.string()));
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  r = measure(dir / "empty.pdf", " --front-end");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_FALSE(fs::exists(out));
+  // Without the true text there is nothing to measure against.
+  fs::remove(data / "ground_truth/text.txt");
+  r = measure(dir / "nope.pdf");
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("no ground_truth/text.txt"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(out));
+}
+
 TEST_F(EvaluateCli, UnwritableOutputIsExitFour) {
   std::ofstream(dir / "a_file") << "x";
   out = dir / "a_file" / "metrics.json";  // a folder that cannot exist

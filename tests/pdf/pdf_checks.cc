@@ -168,34 +168,8 @@ double CharacterErrorRate(const std::string& reference, const std::string& text)
       .cer;
 }
 
-namespace {
-
-std::map<std::string, int> WordCounts(const std::string& text) {
-  std::map<std::string, int> counts;
-  std::string word;
-  for (size_t i = 0; i <= text.size(); ++i) {
-    const unsigned char c = i < text.size() ? text[i] : ' ';
-    if (c < 128 && std::isalnum(c)) {
-      word += char(std::tolower(c));
-    } else if (!word.empty()) {
-      ++counts[word];
-      word.clear();
-    }
-  }
-  return counts;
-}
-
-}  // namespace
-
 double WordsFound(const std::string& reference, const std::string& text) {
-  const std::map<std::string, int> wanted = WordCounts(reference), found = WordCounts(text);
-  int total = 0, matched = 0;
-  for (const auto& [word, n] : wanted) {
-    total += n;
-    const auto it = found.find(word);
-    if (it != found.end()) matched += std::min(n, it->second);
-  }
-  return total ? double(matched) / total : 1;
+  return evaluate::WordsFound(reference, text);
 }
 
 std::string TesseractText(const fs::path& image) {

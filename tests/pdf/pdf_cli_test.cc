@@ -97,6 +97,32 @@ TEST_F(PdfCli, TextLayerReadsAsWellAsTesseractOnTheImage) {
   EXPECT_LE(pdf_cer, image_cer + 0.02) << "pdftotext " << pdf_cer << ", image " << image_cer;
 }
 
+// evaluate --pdf reads the PDF back as these tests do: the same words found
+// as pdftotext -layout gives, the page's true size, and a text that follows
+// set06's lines (CER 0.001 in the bench's run of the pipeline).
+TEST_F(PdfCli, EvaluateMeasuresItsTextLayerAndSize) {
+  ASSERT_EQ(run_->exit_code, 0) << run_->output;
+  const fs::path out = dir_ / "70_eval/pdf.json";
+  const CommandResult r = RunCommand(
+      Quote(StageBinary("evaluate").string()) + " --pdf " + Quote((Out() / "letter.pdf").string()) +
+      " --data " + Quote(SampleDir("set06").string()) + " --out " + Quote(out.string()));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("pdf: words found"), std::string::npos) << r.output;
+  const CommandResult v = RunCommand(Quote((SourceDir() / "scripts/validate-json").string()) + " " +
+                                     Quote(out.string()));
+  EXPECT_EQ(v.exit_code, 0) << v.output;
+  const Json doc = ReadJsonFile(out);
+  EXPECT_EQ(doc["format"], "docunfold.pdf-metrics");
+  EXPECT_EQ(doc["pages"], 1);
+  const std::string truth = ReadFileText(SampleDir("set06") / "ground_truth/text.txt");
+  const double found = doc["text"]["words_found"].get<double>();
+  EXPECT_NEAR(found, WordsFound(truth, PdfText(Out() / "letter.pdf")), 0.01);
+  EXPECT_GE(found, 0.95);
+  EXPECT_LE(doc["text"]["cer_reading_order"].get<double>(), 0.05);
+  EXPECT_LT(doc["page"]["size_error"].get<double>(), 0.001);
+  EXPECT_NEAR(doc["page"]["width_mm"].get<double>(), 210, 0.1);
+}
+
 // What a viewer highlights for a word found or selected is the word's print:
 // each word of the text layer spans the box Tesseract read it in (its
 // ALTO box), not, as Tesseract's renderer writes it, that box less one

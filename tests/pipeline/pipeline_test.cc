@@ -62,7 +62,7 @@ TEST_F(Pipeline, WritesEveryStageOutputAndTheyValidate) {
         "25_points/points.ply", "25_points/points.json", "25_points/overlay.png",
         "30_features/features.json", "30_features/overlay.png", "40_init/mesh3d.ply",
         "50_optimize/log.json", "50_optimize/scene.glb", "60_render/rectified.png",
-        "70_eval/metrics.json", "report.html"})
+        "70_eval/metrics.json", "70_eval/pdf.json", "report.html"})
     EXPECT_TRUE(fs::is_regular_file(Work() / f)) << f;
   for (const auto& e : fs::recursive_directory_iterator(Work())) {
     if (e.path().extension() != ".json" || e.path().string().find("/colmap/") != std::string::npos)

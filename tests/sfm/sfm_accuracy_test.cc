@@ -24,8 +24,8 @@
 
 #include "common/json_io.h"
 #include "common/option_table.h"
+#include "common/subprocess.h"
 #include "stages/sfm/sfm.h"
-#include "stages/sfm/subprocess.h"
 #include "tests/sfm/sfm_eval.h"
 #include "tests/support/test_support.h"
 
@@ -120,7 +120,7 @@ TEST_P(SfmAccuracy, MatchesGroundTruth) {
                  "docunfold.cameras " +
                  Quote((options.out_dir / "cameras.json").string()));
   EXPECT_EQ(schema.exit_code, 0) << schema.output;
-  if (!sfm::FindExecutable("colmap").empty()) {
+  if (!FindExecutable("colmap").empty()) {
     const CommandResult analyzer =
         RunCommand("colmap model_analyzer --path " +
                    Quote((options.out_dir / "colmap" / "sparse" / "0").string()));

@@ -14,7 +14,7 @@
 #include "common/camera.h"
 #include "common/json_io.h"
 #include "common/ply.h"
-#include "stages/sfm/subprocess.h"
+#include "common/subprocess.h"
 #include "tests/pipeline/phone_photos.h"
 #include "tests/sfm/sfm_eval.h"
 #include "tests/support/test_support.h"
@@ -76,7 +76,7 @@ class SfmCli : public ::testing::Test {
     if (source.empty()) return {};
     return MakeSmallDataSet(source, tmp_ / "small", views, 800);
   }
-  bool HaveColmap() const { return !sfm::FindExecutable("colmap").empty(); }
+  bool HaveColmap() const { return !FindExecutable("colmap").empty(); }
   TempDir tmp_;
 };
 

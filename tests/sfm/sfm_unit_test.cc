@@ -1,6 +1,6 @@
 // Unit tests of sfm's parts: COLMAP's binary model reader and pixel
 // convention, the reference frame, the reference-view score, the image
-// checks, undistortion, the subprocess runner and exact matching. No COLMAP
+// checks, undistortion and exact matching. No COLMAP
 // needed.
 #include <gtest/gtest.h>
 #include <sqlite3.h>
@@ -21,7 +21,6 @@
 #include "stages/sfm/matching.h"
 #include "stages/sfm/reference_view.h"
 #include "stages/sfm/sfm.h"
-#include "stages/sfm/subprocess.h"
 #include "tests/sfm/sfm_eval.h"
 #include "tests/support/look_at.h"
 #include "tests/support/test_support.h"
@@ -427,48 +426,6 @@ TEST(UndistortTest, LeavesNoDarkFrameAtTheBorder) {
     cv::minMaxLoc(out.reshape(1), &darkest);
     EXPECT_GE(darkest, 195) << "k " << k;
   }
-}
-
-TEST(SubprocessTest, CapturesLinesExitCodeAndLog) {
-  TempDir tmp;
-  std::vector<std::string> lines;
-  sfm::SubprocessOptions o;
-  o.log_file = tmp / "run.log";
-  o.on_line = [&](const std::string& l) { lines.push_back(l); };
-  const auto r =
-      sfm::RunSubprocess({"sh", "-c", "echo one; echo two >&2; printf 'three'; exit 3"}, o);
-  EXPECT_EQ(r.exit_code, 3);
-  EXPECT_FALSE(r.timed_out);
-  EXPECT_FALSE(r.not_found);
-  EXPECT_EQ(lines, (std::vector<std::string>{"one", "two", "three"}));
-  std::ifstream f(o.log_file);
-  const std::string log((std::istreambuf_iterator<char>(f)), {});
-  EXPECT_NE(log.find("two"), std::string::npos);
-  EXPECT_NE(log.find("# exit 3"), std::string::npos);
-}
-
-TEST(SubprocessTest, TimeoutKillsTheWholeProcessGroup) {
-  TempDir tmp;
-  sfm::SubprocessOptions o;
-  o.log_file = tmp / "run.log";
-  o.timeout_seconds = 0.5;
-  const auto start = std::chrono::steady_clock::now();
-  // The child starts a grandchild; both must go.
-  const auto r = sfm::RunSubprocess({"sh", "-c", "sleep 30 & sleep 30; wait"}, o);
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  EXPECT_TRUE(r.timed_out);
-  EXPECT_LT(seconds, 10);
-}
-
-TEST(SubprocessTest, MissingProgram) {
-  TempDir tmp;
-  sfm::SubprocessOptions o;
-  o.log_file = tmp / "run.log";
-  EXPECT_TRUE(sfm::RunSubprocess({"/nonexistent/colmap"}, o).not_found);
-  EXPECT_TRUE(sfm::RunSubprocess({"no-such-program-docunfold"}, o).not_found);
-  EXPECT_TRUE(sfm::FindExecutable("no-such-program-docunfold").empty());
-  EXPECT_FALSE(sfm::FindExecutable("sh").empty());
 }
 
 TEST(SfmEvalTest, PointTriangleDistance) {

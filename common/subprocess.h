@@ -1,6 +1,6 @@
-// Running an external program (COLMAP) with its output going to a log file
-// instead of our stderr, a time limit, and a callback per output line so the
-// caller can turn the program's own progress messages into ours.
+// Running an external program (COLMAP, poppler's pdftotext) with its output
+// going to a log file instead of our stderr, a time limit, and a callback per
+// output line so the caller can turn the program's own messages into ours.
 #pragma once
 
 #include <filesystem>
@@ -8,13 +8,13 @@
 #include <string>
 #include <vector>
 
-namespace docunfold::sfm {
+namespace docunfold {
 
 namespace fs = std::filesystem;
 
 struct SubprocessOptions {
   // Every line the program prints (stdout and stderr, merged) is appended
-  // here. Must be writable.
+  // here (empty: no log). Must be writable.
   fs::path log_file;
   // The program is killed (with its process group) after this many seconds;
   // <= 0: no limit.
@@ -41,4 +41,4 @@ SubprocessResult RunSubprocess(const std::vector<std::string>& argv,
 // a '/' and is executable); empty when there is none.
 fs::path FindExecutable(const std::string& program);
 
-}  // namespace docunfold::sfm
+}  // namespace docunfold

@@ -1,4 +1,4 @@
-#include "stages/sfm/subprocess.h"
+#include "common/subprocess.h"
 
 #include <fcntl.h>
 #include <poll.h>
@@ -17,7 +17,7 @@
 
 #include "common/errors.h"
 
-namespace docunfold::sfm {
+namespace docunfold {
 
 fs::path FindExecutable(const std::string& program) {
   if (program.empty()) return {};
@@ -41,8 +41,10 @@ SubprocessResult RunSubprocess(const std::vector<std::string>& argv,
                                const SubprocessOptions& options) {
   SubprocessResult result;
   const auto start = std::chrono::steady_clock::now();
-  std::ofstream log(options.log_file, std::ios::app);
-  if (!log) throw OutputError(options.log_file.string() + ": cannot write log file");
+  const bool logging = !options.log_file.empty();
+  std::ofstream log;
+  if (logging) log.open(options.log_file, std::ios::app);
+  if (logging && !log) throw OutputError(options.log_file.string() + ": cannot write log file");
   const fs::path exe = FindExecutable(argv.at(0));
   if (exe.empty()) {
     result.not_found = true;
@@ -143,8 +145,8 @@ SubprocessResult RunSubprocess(const std::vector<std::string>& argv,
   if (result.signal) log << " (signal " << result.signal << ")";
   if (result.timed_out) log << " (killed after the time limit)";
   log << ", " << result.seconds << " s\n";
-  if (!log) throw OutputError(options.log_file.string() + ": write failed");
+  if (logging && !log) throw OutputError(options.log_file.string() + ": write failed");
   return result;
 }
 
-}  // namespace docunfold::sfm
+}  // namespace docunfold
