@@ -154,4 +154,10 @@ cv::Mat ReadImage(const fs::path& path, int flags) {
   return image;
 }
 
+std::string ReadTextFile(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path.string() + ": cannot open file");
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
 }  // namespace docunfold

@@ -71,4 +71,7 @@ void WriteImageAtomic(const fs::path& path, const cv::Mat& image,
 // Reads an image or throws InputError naming the file.
 cv::Mat ReadImage(const fs::path& path, int flags = 1 /*cv::IMREAD_COLOR*/);
 
+// Reads a whole file as it is, or throws InputError naming the file.
+std::string ReadTextFile(const fs::path& path);
+
 }  // namespace docunfold

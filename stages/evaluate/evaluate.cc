@@ -27,14 +27,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-std::string ReadTextFile(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path.string() + ": cannot open file");
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return buffer.str();
-}
-
 // FNV-1a over the file's bytes and the OCR settings: a stable cache key
 // (std::hash is not stable across builds).
 std::string CacheKey(const fs::path& file, const std::string& settings) {

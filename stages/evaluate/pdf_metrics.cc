@@ -2,12 +2,11 @@
 
 #include <chrono>
 #include <cmath>
-#include <fstream>
 #include <regex>
-#include <sstream>
 #include <stdexcept>
 #include <vector>
 
+#include "common/atomic_file.h"
 #include "common/dataset.h"
 #include "common/errors.h"
 #include "common/program.h"
@@ -39,14 +38,6 @@ std::string RunPoppler(const std::vector<std::string>& argv, const fs::path& pdf
   return out;
 }
 
-std::string ReadWholeFile(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path.string() + ": cannot open file");
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return buffer.str();
-}
-
 std::string Collapsed(const std::string& text) {
   return CodePointsToUtf8(CollapseWhitespace(Utf8ToCodePoints(text)));
 }
@@ -73,7 +64,7 @@ PdfMetricsResult MeasurePdf(const fs::path& data, const fs::path& pdf, const Jso
   const std::string reading = RunPoppler({"pdftotext", "-q", pdf.string(), "-"}, pdf);
 
   const fs::path text_file = data / "ground_truth" / "text.txt";
-  const std::string truth = ReadWholeFile(text_file);
+  const std::string truth = ReadTextFile(text_file);
   PdfMetricsResult r;
   r.words_found = WordsFound(truth, reading);
   const TextScores in_order = CompareTexts(Collapsed(truth), Collapsed(reading));
