@@ -512,6 +512,8 @@ void PdfSection(const ReportOptions& o, Page* page) {
   }
   page->Add("<p><a href=\"" + MarkupEscape(file) + "\">" + MarkupEscape(file) + "</a>: " + summary +
             "</p>");
+  const std::string check = PdfCheckSummary(TryJson(o.work / "70_eval/pdf.json"));
+  if (!check.empty()) page->Add("<p>" + check + "</p>");
   if (!svg.empty())
     page->Add(Figure(svg,
                      "The words of the text layer in their boxes (blue; red below 0.6 "

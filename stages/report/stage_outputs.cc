@@ -180,4 +180,20 @@ std::string PdfSummary(const Json& pdf) {
          std::to_string(pdf.value("/files/pdf_bytes"_json_pointer, 0) / 1024) + " KB.";
 }
 
+std::string PdfCheckSummary(const Json& metrics) {
+  if (!metrics.is_object() || metrics.value("format", "") != "docunfold.pdf-metrics") return {};
+  const Json text = metrics.value("text", Json::object()),
+             page = metrics.value("page", Json::object());
+  std::string s = "Read back against the true text: a search finds " +
+                  Fixed(100 * text.value("words_found", 0.0), 1) + " % of its words";
+  if (text.value("cer_reading_order", Json()).is_number())
+    s += ", and copied text has a CER of " + Fixed(text["cer_reading_order"].get<double>(), 3);
+  if (page.value("true_width_mm", Json()).is_number())
+    s += "; the page is " + Fixed(page.value("width_mm", 0.0), 0) + " × " +
+         Fixed(page.value("height_mm", 0.0), 0) + " mm, the true page " +
+         Fixed(page["true_width_mm"].get<double>(), 0) + " × " +
+         Fixed(page.value("true_height_mm", 0.0), 0) + " mm";
+  return s + ".";
+}
+
 }  // namespace docunfold::report

@@ -29,6 +29,10 @@ std::string PdfWordsSvg(const cv::Mat& page_image, const Json& pdf, int width);
 // from pdf.json; empty when it is not one.
 std::string PdfSummary(const Json& pdf);
 
+// One sentence on the PDF read back against the true text and page
+// (70_eval/pdf.json, docunfold.pdf-metrics); empty when it is not that.
+std::string PdfCheckSummary(const Json& metrics);
+
 // " <n> sfm points on the page, <n> texture, <n> outline." from points.json;
 // empty without counts.
 std::string PointsCounts(const Json& points);

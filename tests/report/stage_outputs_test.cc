@@ -108,5 +108,16 @@ TEST(PointsCounts, RejectsCountsThatAreNotIntegers) {
   }
 }
 
+TEST(PdfCheckSummary, SaysWhatASearchFindsAndTheSizes) {
+  const Json metrics = Json::parse(R"({"format": "docunfold.pdf-metrics",
+    "text": {"words_found": 0.8378, "cer_reading_order": 0.329},
+    "page": {"width_mm": 130.5, "height_mm": 194.9, "true_width_mm": 100, "true_height_mm": 150}})");
+  EXPECT_EQ(PdfCheckSummary(metrics),
+            "Read back against the true text: a search finds 83.8 % of its words, and copied "
+            "text has a CER of 0.329; the page is 130 × 195 mm, the true page 100 × 150 mm.");
+  EXPECT_EQ(PdfCheckSummary(Json::parse(R"({"format": "docunfold.pdf"})")), "");
+  EXPECT_EQ(PdfCheckSummary(Json()), "");
+}
+
 }  // namespace
 }  // namespace docunfold::report
