@@ -3,10 +3,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <opencv2/imgproc.hpp>
 #include <optional>
-#include <sstream>
 
 #include "common/atomic_file.h"
 #include "common/camera.h"
@@ -144,12 +142,9 @@ Json EvaluateOcr(const EvaluateInputs& in, const EvaluateOptions& options,
   if (fs::is_regular_file(text_file, ec)) {
     // text.txt has one line per text line and no paragraph gaps; OCR output
     // has both, so whitespace is normalised before this comparison.
-    auto collapse = [](const std::string& t) {
-      return CodePointsToUtf8(CollapseWhitespace(Utf8ToCodePoints(t)));
-    };
-    const std::string truth = collapse(ReadTextFile(text_file));
-    const TextScores t = CompareTexts(truth, collapse(result));
-    const TextScores f = CompareTexts(truth, collapse(reference));
+    const std::string truth = CollapseWhitespace(ReadTextFile(text_file));
+    const TextScores t = CompareTexts(truth, CollapseWhitespace(result));
+    const TextScores f = CompareTexts(truth, CollapseWhitespace(reference));
     m->cer_text = t.cer;
     m->wer_text = t.wer;
     Json tj = ScoresJson(t);

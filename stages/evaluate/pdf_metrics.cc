@@ -38,10 +38,6 @@ std::string RunPoppler(const std::vector<std::string>& argv, const fs::path& pdf
   return out;
 }
 
-std::string Collapsed(const std::string& text) {
-  return CodePointsToUtf8(CollapseWhitespace(Utf8ToCodePoints(text)));
-}
-
 }  // namespace
 
 bool HasTrueText(const fs::path& data) {
@@ -67,7 +63,7 @@ PdfMetricsResult MeasurePdf(const fs::path& data, const fs::path& pdf, const Jso
   const std::string truth = ReadTextFile(text_file);
   PdfMetricsResult r;
   r.words_found = WordsFound(truth, reading);
-  const TextScores in_order = CompareTexts(Collapsed(truth), Collapsed(reading));
+  const TextScores in_order = CompareTexts(CollapseWhitespace(truth), CollapseWhitespace(reading));
   r.cer_reading_order = in_order.cer;
   r.size_error = NAN;
 

@@ -119,6 +119,10 @@ std::u32string CollapseWhitespace(const std::u32string& text) {
   return out;
 }
 
+std::string CollapseWhitespace(const std::string& utf8) {
+  return CodePointsToUtf8(CollapseWhitespace(Utf8ToCodePoints(utf8)));
+}
+
 size_t EditDistance(const std::u32string& a, const std::u32string& b) { return Levenshtein(a, b); }
 size_t EditDistance(const std::vector<std::u32string>& a, const std::vector<std::u32string>& b) {
   return Levenshtein(a, b);

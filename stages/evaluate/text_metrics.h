@@ -21,6 +21,10 @@ std::vector<std::u32string> SplitWords(const std::u32string& text);
 // Runs of whitespace collapsed to one space, no leading/trailing space.
 std::u32string CollapseWhitespace(const std::u32string& text);
 
+// The same on UTF-8 text: a text compared line for line with one whose
+// lines and paragraphs break elsewhere (text.txt against OCR or a PDF).
+std::string CollapseWhitespace(const std::string& utf8);
+
 // Levenshtein distance (unit costs for insertion, deletion, substitution).
 size_t EditDistance(const std::u32string& a, const std::u32string& b);
 size_t EditDistance(const std::vector<std::u32string>& a, const std::vector<std::u32string>& b);

@@ -163,9 +163,7 @@ std::vector<AltoWord> WordsWithoutPrint(const cv::Mat& page, const std::vector<A
 
 double CharacterErrorRate(const std::string& reference, const std::string& text) {
   using namespace evaluate;
-  return CompareTexts(CodePointsToUtf8(CollapseWhitespace(Utf8ToCodePoints(reference))),
-                      CodePointsToUtf8(CollapseWhitespace(Utf8ToCodePoints(text))))
-      .cer;
+  return CompareTexts(CollapseWhitespace(reference), CollapseWhitespace(text)).cer;
 }
 
 double WordsFound(const std::string& reference, const std::string& text) {
