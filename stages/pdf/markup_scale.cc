@@ -3,7 +3,10 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <map>
 #include <regex>
+
+#include "common/markup.h"
 
 namespace docunfold::pdf {
 namespace {
@@ -68,6 +71,69 @@ std::string ScaleHocrPixels(const std::string& hocr, double scale, int read_dpi,
     out = ReplaceMatches(out, resolution, [&res](const std::smatch&) { return res; });
   }
   return out;
+}
+
+namespace {
+
+// The words of `markup` that `element` matches, in order, each given by
+// `edit(match, replacement)` where one of `replacements` numbers it
+// (WordReplacement::in_files; its old text checked by `text_of(match)`);
+// nullopt where one does not match.
+std::optional<std::string> EditWords(
+    const std::string& markup, const std::regex& element,
+    const std::function<std::string(const std::smatch&)>& text_of,
+    const std::vector<WordReplacement>& replacements,
+    const std::function<std::string(const std::smatch&, const WordReplacement&)>& edit) {
+  std::map<int, const WordReplacement*> by_word;
+  for (const WordReplacement& r : replacements) by_word[r.in_files] = &r;
+  if (by_word.empty()) return markup;
+  int word = 0;
+  bool aligned = true;
+  std::string out = ReplaceMatches(markup, element, [&](const std::smatch& m) {
+    const auto it = by_word.find(word++);
+    if (it == by_word.end()) return m[0].str();
+    if (text_of(m) != MarkupEscape(it->second->old_text)) aligned = false;
+    return edit(m, *it->second);
+  });
+  if (!aligned || word <= by_word.rbegin()->first) return std::nullopt;
+  return out;
+}
+
+}  // namespace
+
+std::optional<std::string> ReplaceAltoWords(const std::string& alto,
+                                            const std::vector<WordReplacement>& replacements) {
+  static const std::regex string_element(
+      R"re((<SP\b[^>]*/>\s*)?<String ID="([^"]*)"[^>]*CONTENT="([^"]*)"[^>]*/>)re");
+  return EditWords(
+      alto, string_element, [](const std::smatch& m) { return m[3].str(); }, replacements,
+      [](const std::smatch& m, const WordReplacement& r) -> std::string {
+        if (r.text.empty()) return "";
+        const cv::Rect& b = r.box;
+        return m[1].str() + "<String ID=\"" + m[2].str() + "\" HPOS=\"" + std::to_string(b.x) +
+               "\" VPOS=\"" + std::to_string(b.y) + "\" WIDTH=\"" + std::to_string(b.width) +
+               "\" HEIGHT=\"" + std::to_string(b.height) + "\" WC=\"" + Decimal(r.confidence, 2) +
+               "\" CONTENT=\"" + MarkupEscape(r.text) + "\"/>";
+      });
+}
+
+std::optional<std::string> ReplaceHocrWords(const std::string& hocr,
+                                            const std::vector<WordReplacement>& replacements) {
+  static const std::regex word_span(
+      R"re((\s*)<span class='ocrx_word' id='([^']*)' title='bbox [-0-9 ]+;([^']*)'>(.*?)</span>)re");
+  static const std::regex confidence(R"re(x_wconf [0-9]+)re");
+  return EditWords(
+      hocr, word_span, [](const std::smatch& m) { return m[4].str(); }, replacements,
+      [](const std::smatch& m, const WordReplacement& r) -> std::string {
+        if (r.text.empty()) return "";
+        const cv::Rect& b = r.box;
+        const std::string properties = std::regex_replace(
+            m[3].str(), confidence, "x_wconf " + std::to_string(std::lround(100 * r.confidence)));
+        return m[1].str() + "<span class='ocrx_word' id='" + m[2].str() + "' title='bbox " +
+               std::to_string(b.x) + " " + std::to_string(b.y) + " " + std::to_string(b.br().x) +
+               " " + std::to_string(b.br().y) + ";" + properties + "'>" + MarkupEscape(r.text) +
+               "</span>";
+      });
 }
 
 }  // namespace docunfold::pdf

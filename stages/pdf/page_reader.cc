@@ -101,6 +101,7 @@ PageReader& PageReader::operator=(PageReader&&) noexcept = default;
 
 PageReader::Page PageReader::Read(const cv::Mat& image, Segmentation segmentation) {
   api_->SetPageSegMode(segmentation == Segmentation::kSingleColumn ? tesseract::PSM_SINGLE_COLUMN
+                       : segmentation == Segmentation::kSingleLine ? tesseract::PSM_SINGLE_LINE
                                                                    : tesseract::PSM_AUTO);
   // Through a PNG, so that Leptonica reads it exactly as it reads the file.
   std::vector<uchar> png;
@@ -155,6 +156,10 @@ void PageReader::Write(const fs::path& base, const fs::path& image_file, int ppi
   if (!renderer->BeginDocument(title.c_str()) || !renderer->AddImage(api_.get()) ||
       !renderer->EndDocument())
     throw std::runtime_error(base.string() + ": Tesseract could not write the PDF page");
+}
+
+bool PageReader::IsDictionaryWord(const std::string& word) const {
+  return api_->IsValidWord(word.c_str()) != 0;
 }
 
 std::string PageReader::Version() { return tesseract::TessBaseAPI::Version(); }

@@ -34,8 +34,9 @@ class PageReader {
   const std::string& language() const { return language_; }
 
   // How Tesseract finds the text: its automatic page segmentation (blocks,
-  // columns, pictures), or the page as one column of text of any size.
-  enum class Segmentation { kAuto, kSingleColumn };
+  // columns, pictures), the page as one column of text of any size, or the
+  // image as a single line of text.
+  enum class Segmentation { kAuto, kSingleColumn, kSingleLine };
 
   // Reads `image` (8-bit BGR or grey) as the tesseract command reads a PNG
   // of it (the resolution estimated from the text), and returns its words
@@ -50,6 +51,9 @@ class PageReader {
   // read at `ppi` pixels per inch), <base>.xml (ALTO) and <base>.hocr for the
   // page last read; the last two name `image_file` as their image.
   void Write(const fs::path& base, const fs::path& image_file, int ppi, const std::string& title);
+
+  // Whether `word` is in the language's dictionary (Tesseract's word lists).
+  bool IsDictionaryWord(const std::string& word) const;
 
   // "5.3.0"
   static std::string Version();

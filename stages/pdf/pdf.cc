@@ -7,6 +7,7 @@
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 #include <sstream>
 
 #include "common/atomic_file.h"
@@ -21,6 +22,7 @@
 #include "stages/pdf/pdf_file.h"
 #include "stages/pdf/ruling.h"
 #include "stages/pdf/unread_print.h"
+#include "stages/pdf/word_reread.h"
 
 namespace docunfold::pdf {
 namespace {
@@ -265,6 +267,7 @@ struct PageReading {
   // gives the same words.
   cv::Mat image_read;
   PageReader::Segmentation segmentation = PageReader::Segmentation::kAuto;
+  Rereading reread;  // doubted words read again (ReadPage)
 };
 
 // A page to read.
@@ -441,7 +444,7 @@ PageReading ReadBestCopy(PageReader& reader, const PageCopies& page, int min_lon
 // print stretched to black, and that reading kept (`reader` then holds it)
 // where it is read with at least kMinConfidenceGain more and leaves at most
 // kMaxUnreadLossOfSurerReading more print unread.
-PageReading ReadPage(PageReader& reader, const PageCopies& page, int min_long_side) {
+PageReading ReadKeptCopy(PageReader& reader, const PageCopies& page, int min_long_side) {
   PageReading r = ReadBestCopy(reader, page, min_long_side);
   const double confidence = MeanConfidence(r.page.words);
   if (r.page.words.empty() || confidence >= kMaxConfidenceToStretch) return r;
@@ -463,6 +466,52 @@ PageReading ReadPage(PageReader& reader, const PageCopies& page, int min_long_si
   r.unread_print = unread;
   r.print_stretched = true;
   return r;
+}
+
+// ReadKeptCopy's reading with the words Tesseract doubted read again on
+// their own from the copy it read, and replaced (`reader` keeps Tesseract's
+// reading: the replacements are made in its files after it writes them).
+PageReading ReadPage(PageReader& reader, const PageCopies& page, int min_long_side,
+                     const std::string& language) {
+  PageReading r = ReadKeptCopy(reader, page, min_long_side);
+  r.reread = RereadDoubtedWords(r.image_read, r.page.words, language);
+  r.page.words = WithReplacements(r.page.words, r.reread.replacements);
+  return r;
+}
+
+struct Markup {
+  std::string alto, hocr;
+  bool words_replaced = true;  // in both
+};
+
+// Tesseract's ALTO and hOCR of the page read (page.xml, page.hocr in
+// `staged`), naming the page image beside them rather than the staging
+// folder it was read from (Tesseract writes the name escaped), with the
+// words read again replaced as in the PDF (a file whose words are not the
+// reading's keeps its own), mapped from the pixels of the enlarged copy read
+// onto the page's.
+Markup StagedMarkup(const fs::path& staged, const fs::path& image_path,
+                    const std::string& image_name, const std::vector<WordReplacement>& replacements,
+                    double ocr_scale, int read_ppi, int page_dpi) {
+  const std::string staged_name = MarkupEscape(image_path.string());
+  const std::string alto =
+      ReplaceAll(ReadText(staged / "page.xml"), staged_name, MarkupEscape(image_name));
+  const std::string hocr =
+      ReplaceAll(ReadText(staged / "page.hocr"), staged_name, MarkupEscape(image_name));
+  const std::optional<std::string> alto_replaced = ReplaceAltoWords(alto, replacements);
+  const std::optional<std::string> hocr_replaced = ReplaceHocrWords(hocr, replacements);
+  Markup m;
+  m.alto = ScaleAltoPixels(alto_replaced.value_or(alto), 1 / ocr_scale);
+  m.hocr = ScaleHocrPixels(hocr_replaced.value_or(hocr), 1 / ocr_scale, read_ppi, page_dpi);
+  m.words_replaced = alto_replaced && hocr_replaced;
+  return m;
+}
+
+// [word, old text, new text] of each word replaced ("" dropped).
+Json ReplacementsJson(const std::vector<WordReplacement>& replacements) {
+  Json list = Json::array();
+  for (const WordReplacement& r : replacements) list.push_back({r.word, r.old_text, r.text});
+  return list;
 }
 
 Json WordsJson(const std::vector<Word>& words) {
@@ -539,7 +588,8 @@ PdfResult Run(const PdfOptions& o, const PdfInputs& in, const fs::path& out,
   const Ruling ruling = WithoutRuling(even_page);
   PageReading read = ReadPage(
       reader, {in.page, even_page, ruling.rule_share >= kMinRuleShare ? ruling.page : cv::Mat()},
-      o.ocr_min_long_side);
+      o.ocr_min_long_side, o.language);
+  const Rereading& reread = read.reread;
   const double ocr_scale = read.scale;
   ScaleToPage(1 / ocr_scale, &read.page);
   r.words = std::move(read.page.words);
@@ -560,24 +610,24 @@ PdfResult Run(const PdfOptions& o, const PdfInputs& in, const fs::path& out,
   const double width_pt = r.size.width_mm / kMillimetresPerInch * kPointsPerInch;
   const double height_pt = r.size.height_mm / kMillimetresPerInch * kPointsPerInch;
   const std::string tesseract = "Tesseract " + PageReader::Version();
-  FitPage(
+  const FittedPage fitted = FitPage(
       staging.dir() / "page.pdf", staging.dir() / "fitted.pdf", width_pt, height_pt, image,
-      {name, std::string("docunfold ") + ProgramVersion(), tesseract + ", qpdf " + QpdfVersion()});
+      {name, std::string("docunfold ") + ProgramVersion(), tesseract + ", qpdf " + QpdfVersion()},
+      reread.replacements);
   timer.Mark("write_pdf");
 
-  // The ALTO and hOCR files name the page image beside them, not the
-  // staging folder it was read from (Tesseract writes the name escaped).
-  // Both are in the pixels of the enlarged copy read: mapped onto the page's.
-  const std::string staged = MarkupEscape(image_path.string());
-  const std::string alto = ScaleAltoPixels(
-      ReplaceAll(ReadText(staging.dir() / "page.xml"), staged, MarkupEscape(image_name)),
-      1 / ocr_scale);
-  const std::string hocr = ScaleHocrPixels(
-      ReplaceAll(ReadText(staging.dir() / "page.hocr"), staged, MarkupEscape(image_name)),
-      1 / ocr_scale, ppi, int(std::lround((r.size.dpi_x + r.size.dpi_y) / 2)));
+  const Markup markup =
+      StagedMarkup(staging.dir(), image_path, image_name, reread.replacements, ocr_scale, ppi,
+                   int(std::lround((r.size.dpi_x + r.size.dpi_y) / 2)));
+  r.words_read_again_everywhere =
+      markup.words_replaced && fitted.words_replaced == int(reread.replacements.size());
+  if (!r.words_read_again_everywhere)
+    Log("warning: the words read again are not in every file (" +
+        std::to_string(fitted.words_replaced) + " of " +
+        std::to_string(reread.replacements.size()) + " in the PDF)");
   Rename(image_path, out / image_name);
-  WriteTextAtomic(out / (name + ".alto.xml"), alto);
-  WriteTextAtomic(out / (name + ".hocr"), hocr);
+  WriteTextAtomic(out / (name + ".alto.xml"), markup.alto);
+  WriteTextAtomic(out / (name + ".hocr"), markup.hocr);
   r.pdf_file = out / (name + ".pdf");
   r.pdf_bytes = fs::file_size(staging.dir() / "fitted.pdf");
   Rename(staging.dir() / "fitted.pdf", r.pdf_file);
@@ -612,6 +662,12 @@ PdfResult Run(const PdfOptions& o, const PdfInputs& in, const fs::path& out,
                {"ruling_share", ruling.rule_share},
                {"read_without_ruling", read.without_ruling},
                {"read_with_print_stretched", read.print_stretched},
+               {"doubted_words_read_again",
+                {{"groups", reread.groups},
+                 {"groups_replaced", reread.groups_replaced},
+                 {"words_replaced", reread.replacements.size()},
+                 {"replacements", ReplacementsJson(reread.replacements)},
+                 {"in_every_file", r.words_read_again_everywhere}}},
                {"unread_print", read.unread_print},
                {"unread_print_auto", read.unread_print_auto},
                {"words", r.words.size()},

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <map>
 #include <qpdf/QPDF.hh>
 #include <qpdf/QPDFPageDocumentHelper.hh>
 #include <qpdf/QPDFPageObjectHelper.hh>
@@ -38,8 +39,38 @@ constexpr double kMaxWordGapEm = 1.0;
 // Tesseract's glyph-less font draws every glyph half an em wide.
 constexpr double kGlyphEm = 0.5;
 
+// UTF-8 as the two-byte codes (UTF-16BE) Tesseract's glyph-less font shows.
+std::string Utf16Codes(const std::string& utf8) {
+  std::string out;
+  auto put = [&out](unsigned unit) {
+    out += char(unit >> 8);
+    out += char(unit & 0xff);
+  };
+  for (size_t i = 0; i < utf8.size();) {
+    const unsigned char c = utf8[i];
+    const int extra = c < 0x80 ? 0 : c < 0xe0 ? 1 : c < 0xf0 ? 2 : 3;
+    unsigned code = extra == 0 ? c : c & (0x3f >> extra);
+    for (int k = 1; k <= extra && i + k < utf8.size(); ++k) code = code << 6 | (utf8[i + k] & 0x3f);
+    i += extra + 1;
+    if (code >= 0x10000) {
+      put(0xd800 + ((code - 0x10000) >> 10));
+      put(0xdc00 + ((code - 0x10000) & 0x3ff));
+    } else {
+      put(code);
+    }
+  }
+  return out;
+}
+
 class WordGlyphsFillTheirBoxes : public QPDFObjectHandle::TokenFilter {
  public:
+  explicit WordGlyphsFillTheirBoxes(const std::vector<WordReplacement>& replacements) {
+    for (const WordReplacement& r : replacements) replacements_[r.in_files] = &r;
+  }
+  // Words whose text was replaced (where a word shown is not its
+  // replacement's old text, none after it is).
+  int replaced() const { return replaced_; }
+
   void handleToken(const QPDFTokenizer::Token& token) override {
     held_.push_back(token);
     switch (token.getType()) {
@@ -49,6 +80,7 @@ class WordGlyphsFillTheirBoxes : public QPDFObjectHandle::TokenFilter {
         return;
       case QPDFTokenizer::tt_string:
         shown_ = token.getValue();
+        shown_at_ = int(held_.size()) - 1;
         ++strings_;
         return;
       case QPDFTokenizer::tt_word:
@@ -58,9 +90,12 @@ class WordGlyphsFillTheirBoxes : public QPDFObjectHandle::TokenFilter {
     }
     const std::string& op = token.getValue();
     if (op == "Tf" && !operands_.empty()) font_size_ = operands_.back().value;
+    if ((op == "TJ" || op == "Tj") && strings_ == 1) Replace(words_shown_++);
     if (codes_ > 0) {
-      // The word shown waits for where the next one starts.
-      const bool next_on_line = op == "Td" && operands_.size() == 2 && operands_[1].value == 0;
+      // The word shown waits for where the next one starts; the next one
+      // dropped, its glyphs span their own box.
+      const bool next_on_line =
+          op == "Td" && operands_.size() == 2 && operands_[1].value == 0 && !Dropped(words_shown_);
       Stretch(next_on_line ? operands_[0].value : 0);
     } else if (op == "Tz" && operands_.size() == 1 && tz_at_ < 0) {
       tz_at_ = operands_[0].at;
@@ -83,6 +118,32 @@ class WordGlyphsFillTheirBoxes : public QPDFObjectHandle::TokenFilter {
     double value;
     int at;  // index in held_
   };
+
+  bool Dropped(int word) const {
+    const auto it = replacements_.find(word);
+    return !misaligned_ && it != replacements_.end() && it->second->text.empty();
+  }
+  // The word shown (numbered `word`) given its replacement's text, its
+  // glyphs as wide as the replacement says.
+  void Replace(int word) {
+    const auto it = replacements_.find(word);
+    if (it == replacements_.end() || misaligned_) return;
+    const WordReplacement& r = *it->second;
+    const std::string space("\0 ", 2);
+    const bool spaced = shown_.size() >= 2 && shown_.compare(shown_.size() - 2, 2, space) == 0;
+    const std::string old = Utf16Codes(r.old_text) + (spaced ? space : "");
+    if (old != shown_) {
+      misaligned_ = true;
+      return;
+    }
+    shown_ = r.text.empty() ? "" : Utf16Codes(r.text) + (spaced ? space : "");
+    held_[shown_at_] = QPDFTokenizer::Token(QPDFTokenizer::tt_string, shown_);
+    if (tz_at_ >= 0 && !shown_.empty()) {
+      tz_ *= double(old.size()) / shown_.size() * r.width_ratio;
+      held_[tz_at_] = QPDFTokenizer::Token(QPDFTokenizer::tt_real, Number(tz_));
+    }
+    ++replaced_;
+  }
 
   // n codes span n * kGlyphEm * tz/100 em: the n - 1 of the word are
   // stretched over that, ending at least kWordGapEm before `next_start`
@@ -111,14 +172,19 @@ class WordGlyphsFillTheirBoxes : public QPDFObjectHandle::TokenFilter {
     codes_ = 0;
   }
 
-  std::vector<QPDFTokenizer::Token> held_;  // since the last operator written
-  std::vector<Operand> operands_;           // since the last operator
-  int strings_ = 0;                         // strings since the last operator
-  std::string shown_;                       // the last of them
-  double font_size_ = 0;                    // the last Tf's
-  int tz_at_ = -1;                          // a held Tz operand's index, or -1
-  double tz_ = 100;                         // its value
-  int codes_ = 0;                           // glyphs of a word shown, held
+  std::vector<QPDFTokenizer::Token> held_;              // since the last operator written
+  std::vector<Operand> operands_;                       // since the last operator
+  int strings_ = 0;                                     // strings since the last operator
+  std::string shown_;                                   // the last of them
+  double font_size_ = 0;                                // the last Tf's
+  int tz_at_ = -1;                                      // a held Tz operand's index, or -1
+  double tz_ = 100;                                     // its value
+  int codes_ = 0;                                       // glyphs of a word shown, held
+  int shown_at_ = -1;                                   // the last string's index in held_
+  std::map<int, const WordReplacement*> replacements_;  // by word
+  int words_shown_ = 0;
+  int replaced_ = 0;
+  bool misaligned_ = false;
 };
 
 }  // namespace
@@ -146,7 +212,8 @@ QPDFObjectHandle ImageObject(QPDF* pdf, const PageImage& image) {
 }
 
 FittedPage FitPage(const fs::path& in, const fs::path& out, double width_pt, double height_pt,
-                   const PageImage& image, const DocumentInfo& info) {
+                   const PageImage& image, const DocumentInfo& info,
+                   const std::vector<WordReplacement>& replacements) {
   QPDF pdf;
   pdf.setSuppressWarnings(true);
   try {
@@ -190,7 +257,8 @@ FittedPage FitPage(const fs::path& in, const fs::path& out, double width_pt, dou
     page.getObjectHandle().replaceKey(
         "/MediaBox",
         QPDFObjectHandle::newFromRectangle(QPDFObjectHandle::Rectangle(0, 0, width_pt, height_pt)));
-    page.addContentTokenFilter(std::make_shared<WordGlyphsFillTheirBoxes>());
+    const auto words = std::make_shared<WordGlyphsFillTheirBoxes>(replacements);
+    page.addContentTokenFilter(words);
 
     QPDFObjectHandle dict = QPDFObjectHandle::newDictionary();
     dict.replaceKey("/Title", QPDFObjectHandle::newUnicodeString(info.title));
@@ -203,6 +271,7 @@ FittedPage FitPage(const fs::path& in, const fs::path& out, double width_pt, dou
     writer.setObjectStreamMode(qpdf_o_generate);
     writer.setCompressStreams(true);
     writer.write();
+    fitted.words_replaced = words->replaced();
     return fitted;
   } catch (const std::runtime_error&) {
     throw;

@@ -6,6 +6,9 @@
 
 #include <filesystem>
 #include <string>
+#include <vector>
+
+#include "stages/pdf/text_size.h"
 
 namespace docunfold::pdf {
 
@@ -31,16 +34,19 @@ struct FittedPage {
   double height_pt = 0;
   double scale_x = 1;  // how the renderer's page was stretched onto it
   double scale_y = 1;
+  int words_replaced = 0;  // of the replacements given
 };
 
 // Reads the one-page PDF `in` (Tesseract's text layer), sets its page to
 // width_pt x height_pt with the text stretched to fill it, each word's glyphs
-// spanning its box (without the trailing space), draws `image` under it over
+// spanning its box (without the trailing space), each word of `replacements`
+// showing its new text (dropped ones nothing), draws `image` under it over
 // the whole page, replaces the document information and writes
 // `out` (the same bytes for the same input). Throws std::runtime_error when
 // qpdf cannot read or write.
 FittedPage FitPage(const fs::path& in, const fs::path& out, double width_pt, double height_pt,
-                   const PageImage& image, const DocumentInfo& info);
+                   const PageImage& image, const DocumentInfo& info,
+                   const std::vector<WordReplacement>& replacements = {});
 
 // "11.3.0"
 std::string QpdfVersion();

@@ -18,6 +18,22 @@ struct Word {
   int line = -1;          // index of the TextLine it was read in (-1: none known)
 };
 
+// A word of a page's reading given another text after it was read: where
+// Tesseract's files show `old_text`, they are to show `text` over `box`
+// (image pixels). Empty text: the word is dropped, its print now part of the
+// word before.
+struct WordReplacement {
+  int word = 0;      // index in the reading's words
+  int in_files = 0;  // its number in Tesseract's files, which leave out blank words
+  std::string old_text;
+  std::string text;
+  double confidence = 0;  // 0..1
+  cv::Rect box;
+  // The word's glyphs, which start where Tesseract put them, span this many
+  // times the old word's width (the new box's right edge from the old left).
+  double width_ratio = 1;
+};
+
 struct TextLine {
   int block = 0;  // Tesseract's block, counted from 0
   cv::Rect box;   // image pixels

@@ -123,16 +123,25 @@ INSTANTIATE_TEST_SUITE_P(Sets, PdfE2e,
 // of prices unread (51 % of the print; a search found 31 % of its words);
 // read again as one column and with its print stretched to black, 87 % were
 // found. Rendered from every photo that resolves it better, the automatic
-// segmentation reads the prices (17 % unread; 84 % found).
+// segmentation reads the prices (17 % unread; 84 % found), four of them
+// wrongly ("BPX Be |" for 7.37, "13502" for 13.52); read again on their own
+// in black and white, they are right in the PDF and the ALTO file (95 %).
 TEST(PdfReceipt, ItsColumnOfPricesIsRead) {
   const fs::path out = E2eDir() / "work/set07/80_pdf";
   ASSERT_TRUE(fs::is_regular_file(out / "set07.pdf")) << out;
   const Json report = ReadJsonFile(out / "pdf.json");
   EXPECT_LT(report["text"]["unread_print"].get<double>(), 0.2);
-  const double found = WordsFound(ReadFileText(SampleDir("set07") / "ground_truth/text.txt"),
-                                  PdfText(out / "set07.pdf"));
+  EXPECT_TRUE(report["text"]["doubted_words_read_again"]["in_every_file"].get<bool>());
+  const std::string text = PdfText(out / "set07.pdf");
+  const double found = WordsFound(ReadFileText(SampleDir("set07") / "ground_truth/text.txt"), text);
   RecordProperty("words_found", std::to_string(found));
-  EXPECT_GE(found, 0.8);
+  EXPECT_GE(found, 0.9);
+  std::string alto_text;
+  for (const AltoWord& w : AltoWords(out / "set07.alto.xml")) alto_text += w.text + " ";
+  for (const char* price : {"7.37", "5.19", "13.52", "12.79"}) {
+    EXPECT_NE(text.find(price), std::string::npos) << price << " not in the PDF's text";
+    EXPECT_NE(alto_text.find(price), std::string::npos) << price << " not in the ALTO file";
+  }
 }
 
 TEST(PdfBook, ThreeSamplesInTheOrderGiven) {

@@ -1,7 +1,7 @@
 // The pdf stage's pure parts: paper size from shape and print size, the
 // print's size from what Tesseract read, how much print no word covers, a
 // table's rules taken out of the copy read, ALTO and hOCR mapped back onto
-// the page's pixels.
+// the page's pixels, doubted words read again and replaced in ALTO and hOCR.
 #include <gtest/gtest.h>
 
 #include <opencv2/imgproc.hpp>
@@ -13,6 +13,7 @@
 #include "stages/pdf/ruling.h"
 #include "stages/pdf/text_size.h"
 #include "stages/pdf/unread_print.h"
+#include "stages/pdf/word_reread.h"
 
 namespace docunfold::pdf {
 namespace {
@@ -350,6 +351,106 @@ TEST(MarkupScale, HocrBoxesBaselinesAndResolution) {
             "title='bbox 50 20 80 31; x_wconf 96'");
   // A mark 1 pixel wide read at 3x keeps a pixel.
   EXPECT_EQ(ScaleAltoPixels(R"(HPOS="301" WIDTH="1")", 1.0 / 3), R"(HPOS="100" WIDTH="1")");
+}
+
+// Words of a receipt's line as Tesseract reads pale prices: "Yoghurt" sure,
+// its price cut into three doubted pieces, then a doubted word on the next
+// line and one past a wide gap.
+std::vector<Word> ReceiptLine() {
+  return {
+      {cv::Rect(50, 500, 90, 20), 0.95, "Yoghurt", 0}, {cv::Rect(604, 499, 36, 16), 0.37, "BPX", 0},
+      {cv::Rect(641, 497, 7, 24), 0.25, "Be", 0},      {cv::Rect(650, 497, 6, 24), 0.29, "|", 0},
+      {cv::Rect(50, 530, 60, 20), 0.40, "Pasla", 1},   {cv::Rect(400, 530, 60, 20), 0.50, "ns", 1},
+      {cv::Rect(480, 530, 20, 20), 0.99, " ", 1},      {cv::Rect(510, 530, 20, 20), 0.10, " ", 1}};
+}
+
+TEST(WordReread, DoubtedWordsAreGroupedAlongTheirLine) {
+  const std::vector<std::vector<int>> groups = DoubtedWordGroups(ReceiptLine());
+  // The price's pieces together; the next line's words apart (344 px is
+  // more than two word heights); blank words never.
+  EXPECT_EQ(groups, (std::vector<std::vector<int>>{{1, 2, 3}, {4}, {5}}));
+  RereadOptions sure;
+  sure.max_confidence = 0.2;
+  EXPECT_TRUE(DoubtedWordGroups(ReceiptLine(), sure).empty());
+  EXPECT_TRUE(IsBlank(" \t") && IsBlank("") && !IsBlank(" a"));
+}
+
+TEST(WordReread, PalePriceIsReadAgainInBlackAndWhite) {
+  // A price in pale, thin print (grey 160 on paper at 232) and a word
+  // Tesseract read surely are given as read wrongly: the doubted one is read
+  // again and replaced, over the box of its print; the sure one is kept.
+  cv::Mat page(120, 700, CV_8UC3, cv::Scalar(232, 232, 232));
+  cv::putText(page, "13.52", {420, 70}, cv::FONT_HERSHEY_SIMPLEX, 1.2, cv::Scalar(160, 160, 160), 2,
+              cv::LINE_AA);
+  cv::putText(page, "Butter", {40, 70}, cv::FONT_HERSHEY_SIMPLEX, 1.2, cv::Scalar(160, 160, 160), 2,
+              cv::LINE_AA);
+  const std::vector<Word> words = {{cv::Rect(40, 40, 130, 32), 0.9, "Buttor", 0},
+                                   {cv::Rect(420, 40, 110, 32), 0.22, "13502", 0}};
+  const Rereading reread = RereadDoubtedWords(page, words, "eng");
+  EXPECT_EQ(reread.groups, 1);
+  ASSERT_EQ(reread.replacements.size(), 1u);
+  const WordReplacement& r = reread.replacements[0];
+  EXPECT_EQ(r.word, 1);
+  EXPECT_EQ(r.in_files, 1);
+  EXPECT_EQ(r.old_text, "13502");
+  EXPECT_EQ(r.text, "13.52");
+  EXPECT_GE(r.confidence, 0.85);
+  EXPECT_EQ(r.box & cv::Rect(415, 35, 120, 42), r.box) << r.box;
+  EXPECT_GE(r.box.width, 90);
+  const std::vector<Word> replaced = WithReplacements(words, reread.replacements);
+  ASSERT_EQ(replaced.size(), 2u);
+  EXPECT_EQ(replaced[0].text, "Buttor");
+  EXPECT_EQ(replaced[1].text, "13.52");
+}
+
+// Tesseract's files after a doubted price, read as three words, was read
+// again as one: the first word takes it over the group's box, the others go.
+std::vector<WordReplacement> PriceReadAgain() {
+  return {{1, 1, "BPX", "7.37", 0.94, cv::Rect(604, 498, 52, 18), 1.4},
+          {2, 2, "Be", "", 0, {}, 1},
+          {3, 3, "|", "", 0, {}, 1}};
+}
+
+TEST(WordReread, AltoWordsReplacedAndDropped) {
+  const std::string alto =
+      R"(<TextLine><String ID="string_0" HPOS="50" VPOS="500" WIDTH="90" HEIGHT="20" WC="0.95" CONTENT="Yoghurt"/>)"
+      R"(<SP WIDTH="10" VPOS="500" HPOS="140"/><String ID="string_1" HPOS="604" VPOS="499" WIDTH="36" HEIGHT="16" WC="0.37" CONTENT="BPX"/>)"
+      R"(<SP WIDTH="1" VPOS="500" HPOS="640"/><String ID="string_2" HPOS="641" VPOS="497" WIDTH="7" HEIGHT="24" WC="0.25" CONTENT="Be"/>)"
+      R"(<SP WIDTH="2" VPOS="500" HPOS="648"/><String ID="string_3" HPOS="650" VPOS="497" WIDTH="6" HEIGHT="24" WC="0.29" CONTENT="|"/></TextLine>)";
+  EXPECT_EQ(
+      ReplaceAltoWords(alto, PriceReadAgain()).value_or("misaligned"),
+      R"(<TextLine><String ID="string_0" HPOS="50" VPOS="500" WIDTH="90" HEIGHT="20" WC="0.95" CONTENT="Yoghurt"/>)"
+      R"(<SP WIDTH="10" VPOS="500" HPOS="140"/><String ID="string_1" HPOS="604" VPOS="498" WIDTH="52" HEIGHT="18" WC="0.94" CONTENT="7.37"/></TextLine>)");
+  EXPECT_EQ(ReplaceAltoWords(alto, {}).value_or(""), alto);
+  // A file whose words are not the reading's (another reading, or fewer
+  // words) is left for the caller to keep as it is.
+  std::vector<WordReplacement> shifted = PriceReadAgain();
+  for (WordReplacement& r : shifted) ++r.in_files;
+  EXPECT_FALSE(ReplaceAltoWords(alto, shifted).has_value());
+}
+
+TEST(WordReread, HocrWordsReplacedAndDropped) {
+  const std::string hocr =
+      "<span class='ocr_line' id='line_1_1'>\n"
+      "     <span class='ocrx_word' id='word_1_1' title='bbox 50 500 140 520; x_wconf "
+      "95'>Yoghurt</span>\n"
+      "     <span class='ocrx_word' id='word_1_2' title='bbox 604 499 640 515; x_wconf "
+      "37'>BPX</span>\n"
+      "     <span class='ocrx_word' id='word_1_3' title='bbox 641 497 648 521; x_wconf "
+      "25'>Be</span>\n"
+      "     <span class='ocrx_word' id='word_1_4' title='bbox 650 497 656 521; x_wconf "
+      "29'>|</span>\n"
+      "    </span>";
+  EXPECT_EQ(ReplaceHocrWords(hocr, PriceReadAgain()).value_or("misaligned"),
+            "<span class='ocr_line' id='line_1_1'>\n"
+            "     <span class='ocrx_word' id='word_1_1' title='bbox 50 500 140 520; x_wconf "
+            "95'>Yoghurt</span>\n"
+            "     <span class='ocrx_word' id='word_1_2' title='bbox 604 498 656 516; x_wconf "
+            "94'>7.37</span>\n"
+            "    </span>");
+  std::vector<WordReplacement> other = PriceReadAgain();
+  other[0].old_text = "B&X";
+  EXPECT_FALSE(ReplaceHocrWords(hocr, other).has_value());
 }
 
 }  // namespace
