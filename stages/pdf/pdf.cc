@@ -290,12 +290,6 @@ double UnreadPrintOf(const cv::Mat& page, PageReader::Page read, double scale) {
   return UnreadPrint(page, read.words);
 }
 
-double MeanConfidence(const std::vector<Word>& words) {
-  double sum = 0;
-  for (const Word& w : words) sum += w.confidence;
-  return words.empty() ? 0 : sum / words.size();
-}
-
 // Whether a reading at mean word `confidence` leaving `unread` of the print
 // unread is surer than one at (`than_confidence`, `than_unread`) by at least
 // `min_gain` and leaves at most kMaxUnreadLossOfSurerReading more unread.
@@ -619,9 +613,9 @@ PdfResult Run(const PdfOptions& o, const PdfInputs& in, const fs::path& out,
   const Markup markup =
       StagedMarkup(staging.dir(), image_path, image_name, reread.replacements, ocr_scale, ppi,
                    int(std::lround((r.size.dpi_x + r.size.dpi_y) / 2)));
-  r.words_read_again_everywhere =
+  const bool read_again_in_every_file =
       markup.words_replaced && fitted.words_replaced == int(reread.replacements.size());
-  if (!r.words_read_again_everywhere)
+  if (!read_again_in_every_file)
     Log("warning: the words read again are not in every file (" +
         std::to_string(fitted.words_replaced) + " of " +
         std::to_string(reread.replacements.size()) + " in the PDF)");
@@ -667,7 +661,7 @@ PdfResult Run(const PdfOptions& o, const PdfInputs& in, const fs::path& out,
                  {"groups_replaced", reread.groups_replaced},
                  {"words_replaced", reread.replacements.size()},
                  {"replacements", ReplacementsJson(reread.replacements)},
-                 {"in_every_file", r.words_read_again_everywhere}}},
+                 {"in_every_file", read_again_in_every_file}}},
                {"unread_print", read.unread_print},
                {"unread_print_auto", read.unread_print_auto},
                {"words", r.words.size()},

@@ -57,8 +57,6 @@ struct PdfResult {
   TextSize text_size;
   double mean_confidence = 0;
   size_t specks_erased = 0;  // words too small to be glyphs, painted out before the last read
-  // The doubted words read again are replaced in the PDF, ALTO and hOCR alike.
-  bool words_read_again_everywhere = true;
   size_t pdf_bytes = 0;
   fs::path pdf_file;
   Json report;  // pdf.json

@@ -75,6 +75,12 @@ TextSize EstimateTextSize(const std::vector<Word>& words, const std::vector<Text
   return size;
 }
 
+double MeanConfidence(const std::vector<Word>& words) {
+  double sum = 0;
+  for (const Word& w : words) sum += w.confidence;
+  return words.empty() ? 0 : sum / words.size();
+}
+
 std::vector<cv::Rect> SpeckBoxes(const std::vector<Word>& words, double side_px) {
   std::vector<cv::Rect> specks;
   for (const Word& w : words)

@@ -18,6 +18,9 @@ struct Word {
   int line = -1;          // index of the TextLine it was read in (-1: none known)
 };
 
+// The words' mean confidence (0 for none).
+double MeanConfidence(const std::vector<Word>& words);
+
 // A word of a page's reading given another text after it was read: where
 // Tesseract's files show `old_text`, they are to show `text` over `box`
 // (image pixels). Empty text: the word is dropped, its print now part of the

@@ -15,12 +15,6 @@ namespace {
 // that touches the image's edge.
 constexpr int kBorderPx = 20;
 
-double MeanConfidenceOf(const std::vector<Word>& words) {
-  double sum = 0;
-  for (const Word& w : words) sum += w.confidence;
-  return words.empty() ? 0 : sum / words.size();
-}
-
 // A word of letters alone (punctuation around it aside) that is not in the
 // dictionary.
 bool IsNonWord(const PageReader& reader, const std::string& text) {
@@ -106,8 +100,8 @@ Rereading RereadDoubtedWords(const cv::Mat& image, const std::vector<Word>& word
     ++result.groups;
     std::vector<Word> read = reader->Read(piece, PageReader::Segmentation::kSingleLine).words;
     if (read.empty()) continue;
-    const double confidence = MeanConfidenceOf(read);
-    if (confidence < o.min_confidence || confidence < MeanConfidenceOf(old) + o.min_gain) continue;
+    const double confidence = MeanConfidence(read);
+    if (confidence < o.min_confidence || confidence < MeanConfidence(old) + o.min_gain) continue;
     if (std::any_of(read.begin(), read.end(), [&](const Word& w) {
           return IsNonWord(*reader, w.text) || !HasLetterOrDigit(w.text);
         }))
@@ -132,7 +126,7 @@ Rereading RereadDoubtedWords(const cv::Mat& image, const std::vector<Word>& word
         const size_t to = i + 1 == m ? k : i + 1;  // the last word takes the rest
         for (size_t j = i; j < to; ++j) r.text += (j > i ? " " : "") + read[j].text;
         r.box = Union(read, i, to);
-        r.confidence = MeanConfidenceOf(std::vector<Word>(read.begin() + i, read.begin() + to));
+        r.confidence = MeanConfidence(std::vector<Word>(read.begin() + i, read.begin() + to));
         r.width_ratio =
             std::max(0.1, double(r.box.br().x - old[i].box.x) / std::max(1, old[i].box.width));
       }
