@@ -18,6 +18,7 @@
 #include "common/shading.h"
 #include "common/statistics.h"
 #include "stages/pdf/contrast.h"
+#include "stages/pdf/decimal_marks.h"
 #include "stages/pdf/markup_scale.h"
 #include "stages/pdf/pdf_file.h"
 #include "stages/pdf/ruling.h"
@@ -268,6 +269,9 @@ struct PageReading {
   cv::Mat image_read;
   PageReader::Segmentation segmentation = PageReader::Segmentation::kAuto;
   Rereading reread;  // doubted words read again (ReadPage)
+  // The amounts given the page's decimal mark (ReadPage); its replacements
+  // are the reread's and its own, the ones made in Tesseract's files.
+  EvenedMarks marks;
 };
 
 // A page to read.
@@ -463,13 +467,15 @@ PageReading ReadKeptCopy(PageReader& reader, const PageCopies& page, int min_lon
 }
 
 // ReadKeptCopy's reading with the words Tesseract doubted read again on
-// their own from the copy it read, and replaced (`reader` keeps Tesseract's
-// reading: the replacements are made in its files after it writes them).
+// their own from the copy it read, and its amounts given the page's decimal
+// mark (`reader` keeps Tesseract's reading: the replacements are made in its
+// files after it writes them).
 PageReading ReadPage(PageReader& reader, const PageCopies& page, int min_long_side,
                      const std::string& language) {
   PageReading r = ReadKeptCopy(reader, page, min_long_side);
   r.reread = RereadDoubtedWords(r.image_read, r.page.words, language);
-  r.page.words = WithReplacements(r.page.words, r.reread.replacements);
+  r.marks = EvenDecimalMarks(r.page.words, r.reread.replacements);
+  r.page.words = WithReplacements(r.page.words, r.marks.replacements);
   return r;
 }
 
@@ -499,13 +505,6 @@ Markup StagedMarkup(const fs::path& staged, const fs::path& image_path,
   m.hocr = ScaleHocrPixels(hocr_replaced.value_or(hocr), 1 / ocr_scale, read_ppi, page_dpi);
   m.words_replaced = alto_replaced && hocr_replaced;
   return m;
-}
-
-// [word, old text, new text] of each word replaced ("" dropped).
-Json ReplacementsJson(const std::vector<WordReplacement>& replacements) {
-  Json list = Json::array();
-  for (const WordReplacement& r : replacements) list.push_back({r.word, r.old_text, r.text});
-  return list;
 }
 
 Json WordsJson(const std::vector<Word>& words) {
@@ -583,7 +582,7 @@ PdfResult Run(const PdfOptions& o, const PdfInputs& in, const fs::path& out,
   PageReading read = ReadPage(
       reader, {in.page, even_page, ruling.rule_share >= kMinRuleShare ? ruling.page : cv::Mat()},
       o.ocr_min_long_side, o.language);
-  const Rereading& reread = read.reread;
+  const std::vector<WordReplacement>& replacements = read.marks.replacements;
   const double ocr_scale = read.scale;
   ScaleToPage(1 / ocr_scale, &read.page);
   r.words = std::move(read.page.words);
@@ -607,18 +606,17 @@ PdfResult Run(const PdfOptions& o, const PdfInputs& in, const fs::path& out,
   const FittedPage fitted = FitPage(
       staging.dir() / "page.pdf", staging.dir() / "fitted.pdf", width_pt, height_pt, image,
       {name, std::string("docunfold ") + ProgramVersion(), tesseract + ", qpdf " + QpdfVersion()},
-      reread.replacements);
+      replacements);
   timer.Mark("write_pdf");
 
-  const Markup markup =
-      StagedMarkup(staging.dir(), image_path, image_name, reread.replacements, ocr_scale, ppi,
-                   int(std::lround((r.size.dpi_x + r.size.dpi_y) / 2)));
-  const bool read_again_in_every_file =
-      markup.words_replaced && fitted.words_replaced == int(reread.replacements.size());
-  if (!read_again_in_every_file)
-    Log("warning: the words read again are not in every file (" +
-        std::to_string(fitted.words_replaced) + " of " +
-        std::to_string(reread.replacements.size()) + " in the PDF)");
+  const Markup markup = StagedMarkup(staging.dir(), image_path, image_name, replacements, ocr_scale,
+                                     ppi, int(std::lround((r.size.dpi_x + r.size.dpi_y) / 2)));
+  const bool replaced_in_every_file =
+      markup.words_replaced && fitted.words_replaced == int(replacements.size());
+  if (!replaced_in_every_file)
+    Log("warning: the words replaced are not in every file (" +
+        std::to_string(fitted.words_replaced) + " of " + std::to_string(replacements.size()) +
+        " in the PDF)");
   Rename(image_path, out / image_name);
   WriteTextAtomic(out / (name + ".alto.xml"), markup.alto);
   WriteTextAtomic(out / (name + ".hocr"), markup.hocr);
@@ -656,12 +654,8 @@ PdfResult Run(const PdfOptions& o, const PdfInputs& in, const fs::path& out,
                {"ruling_share", ruling.rule_share},
                {"read_without_ruling", read.without_ruling},
                {"read_with_print_stretched", read.print_stretched},
-               {"doubted_words_read_again",
-                {{"groups", reread.groups},
-                 {"groups_replaced", reread.groups_replaced},
-                 {"words_replaced", reread.replacements.size()},
-                 {"replacements", ReplacementsJson(reread.replacements)},
-                 {"in_every_file", read_again_in_every_file}}},
+               {"doubted_words_read_again", RereadingJson(read.reread, replaced_in_every_file)},
+               {"decimal_marks", EvenedMarksJson(read.marks)},
                {"unread_print", read.unread_print},
                {"unread_print_auto", read.unread_print_auto},
                {"words", r.words.size()},

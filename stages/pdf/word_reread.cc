@@ -45,6 +45,13 @@ bool IsBlank(const std::string& text) {
   return std::all_of(text.begin(), text.end(), [](unsigned char c) { return std::isspace(c); });
 }
 
+std::vector<int> NumbersInFiles(const std::vector<Word>& words) {
+  std::vector<int> numbers(words.size());
+  for (size_t i = 0, n = 0; i < words.size(); ++i)
+    numbers[i] = IsBlank(words[i].text) ? -1 : int(n++);
+  return numbers;
+}
+
 std::vector<std::vector<int>> DoubtedWordGroups(const std::vector<Word>& words,
                                                 const RereadOptions& o) {
   std::vector<std::vector<int>> groups;
@@ -75,9 +82,7 @@ Rereading RereadDoubtedWords(const cv::Mat& image, const std::vector<Word>& word
     cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
   else
     grey = image;
-  std::vector<int> in_files(words.size());
-  for (size_t i = 0, n = 0; i < words.size(); ++i)
-    in_files[i] = IsBlank(words[i].text) ? -1 : int(n++);
+  const std::vector<int> in_files = NumbersInFiles(words);
   std::unique_ptr<PageReader> reader;
   for (const std::vector<int>& group : groups) {
     std::vector<Word> old;
@@ -134,6 +139,17 @@ Rereading RereadDoubtedWords(const cv::Mat& image, const std::vector<Word>& word
     }
   }
   return result;
+}
+
+Json RereadingJson(const Rereading& rereading, bool in_every_file) {
+  Json list = Json::array();
+  for (const WordReplacement& r : rereading.replacements)
+    list.push_back({r.word, r.old_text, r.text});
+  return {{"groups", rereading.groups},
+          {"groups_replaced", rereading.groups_replaced},
+          {"words_replaced", rereading.replacements.size()},
+          {"replacements", list},
+          {"in_every_file", in_every_file}};
 }
 
 std::vector<Word> WithReplacements(const std::vector<Word>& words,

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "common/json_io.h"
 #include "stages/pdf/text_size.h"
 
 namespace docunfold::pdf {
@@ -36,6 +37,10 @@ struct RereadOptions {
 // renderers leave them out.
 bool IsBlank(const std::string& text);
 
+// Each word's number among the non-blank words of `words`, as Tesseract's
+// files number them (-1: blank).
+std::vector<int> NumbersInFiles(const std::vector<Word>& words);
+
 // The doubted words of `words` (in reading order, blank ones never), grouped
 // as above.
 std::vector<std::vector<int>> DoubtedWordGroups(const std::vector<Word>& words,
@@ -54,6 +59,10 @@ struct Rereading {
 // of them the rest of the new reading; words left over are dropped.
 Rereading RereadDoubtedWords(const cv::Mat& image, const std::vector<Word>& words,
                              const std::string& language, const RereadOptions& options = {});
+
+// pdf.json's record of `rereading`: its counts and [word, old text, new
+// text] of each word replaced ("" dropped).
+Json RereadingJson(const Rereading& rereading, bool in_every_file);
 
 // `words` with `replacements` made (dropped words left out).
 std::vector<Word> WithReplacements(const std::vector<Word>& words,

@@ -126,6 +126,8 @@ INSTANTIATE_TEST_SUITE_P(Sets, PdfE2e,
 // segmentation reads the prices (17 % unread; 84 % found), four of them
 // wrongly ("BPX Be |" for 7.37, "13502" for 13.52); read again on their own
 // in black and white, they are right in the PDF and the ALTO file (95 %).
+// "1.80" is read as "1,80"; the receipt's other 20 amounts have a full stop,
+// and so is it given one.
 TEST(PdfReceipt, ItsColumnOfPricesIsRead) {
   const fs::path out = E2eDir() / "work/set07/80_pdf";
   ASSERT_TRUE(fs::is_regular_file(out / "set07.pdf")) << out;
@@ -138,7 +140,8 @@ TEST(PdfReceipt, ItsColumnOfPricesIsRead) {
   EXPECT_GE(found, 0.9);
   std::string alto_text;
   for (const AltoWord& w : AltoWords(out / "set07.alto.xml")) alto_text += w.text + " ";
-  for (const char* price : {"7.37", "5.19", "13.52", "12.79"}) {
+  EXPECT_EQ(report["text"]["decimal_marks"]["mark"], ".");
+  for (const char* price : {"7.37", "5.19", "13.52", "12.79", "1.80"}) {
     EXPECT_NE(text.find(price), std::string::npos) << price << " not in the PDF's text";
     EXPECT_NE(alto_text.find(price), std::string::npos) << price << " not in the ALTO file";
   }

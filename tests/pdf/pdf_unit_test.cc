@@ -1,13 +1,15 @@
 // The pdf stage's pure parts: paper size from shape and print size, the
 // print's size from what Tesseract read, how much print no word covers, a
 // table's rules taken out of the copy read, ALTO and hOCR mapped back onto
-// the page's pixels, doubted words read again and replaced in ALTO and hOCR.
+// the page's pixels, doubted words read again and replaced in ALTO and hOCR,
+// a page's amounts given one decimal mark.
 #include <gtest/gtest.h>
 
 #include <opencv2/imgproc.hpp>
 
 #include "common/errors.h"
 #include "stages/pdf/contrast.h"
+#include "stages/pdf/decimal_marks.h"
 #include "stages/pdf/markup_scale.h"
 #include "stages/pdf/page_size.h"
 #include "stages/pdf/ruling.h"
@@ -451,6 +453,74 @@ TEST(WordReread, HocrWordsReplacedAndDropped) {
   std::vector<WordReplacement> other = PriceReadAgain();
   other[0].old_text = "B&X";
   EXPECT_FALSE(ReplaceHocrWords(hocr, other).has_value());
+}
+
+// Words of a receipt as read, one word to a line: `texts` in order.
+std::vector<Word> WordsOf(const std::vector<std::string>& texts) {
+  std::vector<Word> words;
+  for (size_t i = 0; i < texts.size(); ++i)
+    words.push_back({cv::Rect(300, 20 * int(i), 60, 16), 0.9, texts[i], int(i)});
+  return words;
+}
+
+TEST(DecimalMarks, AmountsReadWithACommaTakeThePagesFullStop) {
+  const std::vector<Word> words = WordsOf({"Pasta", "14,66", "2.90", " ", "5.47", "$12.45", "-3.20",
+                                           "975", "1,234", "12,5", "2624", "0.83", "7.10", "3.33"});
+  // Read again before: "975" as "9,75" (it is evened too, its old text kept)
+  // and "2624" as "2.21".
+  const std::vector<WordReplacement> prior = {
+      {7, 6, "975", "9,75", 0.93, cv::Rect(300, 140, 50, 16), 1.2},
+      {10, 9, "2624", "2.21", 0.95, cv::Rect(300, 200, 60, 16), 1}};
+  const EvenedMarks e = EvenDecimalMarks(words, prior);
+  EXPECT_EQ(e.mark, ".");
+  EXPECT_EQ(e.amounts, 10);  // not "1,234" (a thousands mark) nor "12,5"
+  ASSERT_EQ(e.evened.size(), 2u);
+  EXPECT_EQ(e.evened[0].word, 1);
+  EXPECT_EQ(e.evened[0].before, "14,66");
+  EXPECT_EQ(e.evened[0].after, "14.66");
+  EXPECT_EQ(e.evened[1].word, 7);
+  EXPECT_EQ(e.evened[1].before, "9,75");
+  ASSERT_EQ(e.replacements.size(), 3u);
+  const WordReplacement& fresh = e.replacements[0];
+  EXPECT_EQ(fresh.word, 1);
+  EXPECT_EQ(fresh.in_files, 1);
+  EXPECT_EQ(fresh.old_text, "14,66");
+  EXPECT_EQ(fresh.text, "14.66");
+  EXPECT_EQ(fresh.box, words[1].box);
+  EXPECT_DOUBLE_EQ(fresh.width_ratio, 1);
+  // The word read again keeps its new box and Tesseract's text as the old.
+  EXPECT_EQ(e.replacements[1].old_text, "975");
+  EXPECT_EQ(e.replacements[1].text, "9.75");
+  EXPECT_EQ(e.replacements[1].in_files, 6);  // the blank word is not in the files
+  EXPECT_DOUBLE_EQ(e.replacements[1].width_ratio, 1.2);
+  EXPECT_EQ(e.replacements[2].text, "2.21");
+  const std::vector<Word> read = WithReplacements(words, e.replacements);
+  EXPECT_EQ(read[1].text, "14.66");
+  EXPECT_EQ(read[8].text, "1,234");
+}
+
+TEST(DecimalMarks, APageWrittenWithCommasKeepsThem) {
+  const EvenedMarks e =
+      EvenDecimalMarks(WordsOf({"1,20", "3,45", "12,00", "4.50", "0,99", "7,10"}), {});
+  EXPECT_EQ(e.mark, ",");
+  ASSERT_EQ(e.replacements.size(), 1u);
+  EXPECT_EQ(e.replacements[0].text, "4,50");
+}
+
+TEST(DecimalMarks, FewOrMixedAmountsAreLeftAlone) {
+  // Four amounts are too few to tell the page's mark by.
+  EXPECT_TRUE(EvenDecimalMarks(WordsOf({"1.20", "3.45", "12.00", "4,50"}), {}).mark.empty());
+  // Seven of ten is too close a split.
+  const std::vector<WordReplacement> prior = {{0, 0, "1.20", "1.26", 0.9, {}, 1}};
+  const EvenedMarks mixed = EvenDecimalMarks(
+      WordsOf({"1.20", "3.45", "12.00", "4,50", "5.00", "6,10", "7.77", "8.80", "9,90", "2.00"}),
+      prior);
+  EXPECT_TRUE(mixed.mark.empty());
+  EXPECT_EQ(mixed.amounts, 10);
+  EXPECT_TRUE(mixed.evened.empty());
+  ASSERT_EQ(mixed.replacements.size(), 1u);
+  EXPECT_EQ(mixed.replacements[0].text, "1.26");
+  EXPECT_TRUE(EvenDecimalMarks({}, {}).replacements.empty());
 }
 
 }  // namespace
