@@ -325,7 +325,8 @@ def pdf_markdown(sets):
     lines = ["", "## The searchable PDF", "",
              "80_pdf/<set>.pdf read back as a viewer reads it (`evaluate --pdf`, "
              "70_eval/pdf.json): words found = share of ground_truth/text.txt's words that "
-             "pdftotext's text holds, in any order (what a search finds); CER of that text in "
+             "pdftotext's text holds, in any order (what a search finds: a word is what "
+             "whitespace separates, less the punctuation at its ends); CER of that text in "
              "its reading order (what a copy gives; a receipt's dashed separators, which the "
              "PDF does not spell out, count against it); the page's size against the true "
              "page's (✗: a side more than 1 % off).", "",

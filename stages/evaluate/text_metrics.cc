@@ -145,17 +145,25 @@ TextScores CompareTexts(const std::string& reference_utf8, const std::string& re
 
 namespace {
 
-std::map<std::string, int> WordCounts(const std::string& text) {
-  std::map<std::string, int> counts;
-  std::string word;
-  for (size_t i = 0; i <= text.size(); ++i) {
-    const unsigned char c = i < text.size() ? text[i] : ' ';
-    if (c < 128 && std::isalnum(c)) {
-      word += char(std::tolower(c));
-    } else if (!word.empty()) {
-      ++counts[word];
-      word.clear();
-    }
+// What a search passes over at a word's ends: ASCII's punctuation, Latin-1's
+// signs (« » ¡ ¿ § …) and the General Punctuation block (curly quotes,
+// dashes, the ellipsis).
+bool IsEdgePunctuation(char32_t c) {
+  if (c < 128) return !std::isalnum(int(c));
+  return (c >= 0xA0 && c <= 0xBF) || c == 0xD7 || c == 0xF7 || (c >= 0x2000 && c <= 0x206F);
+}
+
+std::map<std::u32string, int> WordCounts(const std::string& text) {
+  std::map<std::u32string, int> counts;
+  for (const std::u32string& word : SplitWords(Utf8ToCodePoints(text))) {
+    size_t from = 0, to = word.size();
+    while (from < to && IsEdgePunctuation(word[from])) ++from;
+    while (to > from && IsEdgePunctuation(word[to - 1])) --to;
+    if (from == to) continue;
+    std::u32string core = word.substr(from, to - from);
+    for (char32_t& c : core)
+      if (c < 128) c = char32_t(std::tolower(int(c)));
+    ++counts[core];
   }
   return counts;
 }
@@ -163,7 +171,7 @@ std::map<std::string, int> WordCounts(const std::string& text) {
 }  // namespace
 
 double WordsFound(const std::string& reference, const std::string& text) {
-  const std::map<std::string, int> wanted = WordCounts(reference), found = WordCounts(text);
+  const std::map<std::u32string, int> wanted = WordCounts(reference), found = WordCounts(text);
   int total = 0, matched = 0;
   for (const auto& [word, n] : wanted) {
     total += n;

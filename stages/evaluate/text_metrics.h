@@ -42,9 +42,12 @@ struct TextScores {
 // CER over the texts as they are (OCR of result vs OCR of ground truth).
 TextScores CompareTexts(const std::string& reference_utf8, const std::string& result_utf8);
 
-// Share of the reference's words (runs of ASCII letters and digits, case
-// ignored, counted with multiplicity) that `text` holds too, in any order:
-// what a search of the text finds. 1 for a reference without words.
+// Share of the reference's words that `text` holds too, in any order,
+// counted with multiplicity: what a search of the text finds. A word is
+// what whitespace separates, less the punctuation at its ends (quotes, a
+// full stop or comma after it), ASCII case ignored; the punctuation inside
+// it counts ("14.66" is not found in "14,66", nor "11/11/2026" in
+// "11/11/202"). 1 for a reference without words.
 double WordsFound(const std::string& reference, const std::string& text);
 
 }  // namespace docunfold::evaluate

@@ -39,6 +39,17 @@ TEST(SplitWords, AnyWhitespaceSeparates) {
   EXPECT_EQ(CollapseWhitespace(U"\n a  b\n\nc "), U"a b c");
 }
 
+TEST(WordsFound, AWordIsFoundAsASearchFindsIt) {
+  // Punctuation at a word's ends and case do not matter; inside it they do.
+  EXPECT_DOUBLE_EQ(WordsFound("Hello, \"World\".", "\xE2\x80\x9Chello\xE2\x80\x9D WORLD"), 1);
+  EXPECT_DOUBLE_EQ(WordsFound("Pasta 14.66 Tea 2.90", "Pasta 14,66\nTea 2.90"), 0.75);
+  EXPECT_DOUBLE_EQ(WordsFound("11/11/2026 Fee", "11/11/202 Fee"), 0.5);
+  // Repeats count: two "Tea"s found once.
+  EXPECT_DOUBLE_EQ(WordsFound("Tea Tea -- ...", "Tea"), 0.5);
+  EXPECT_DOUBLE_EQ(WordsFound("na\xC3\xAFve", "NA\xC3\xAFVE"), 1);
+  EXPECT_DOUBLE_EQ(WordsFound("", "anything"), 1);
+}
+
 TEST(CompareTexts, CerAndWerAreRelativeToTheReference) {
   const TextScores s = CompareTexts("the quick brown fox", "the quack brown fix jumps");
   EXPECT_EQ(s.reference_chars, 19u);
