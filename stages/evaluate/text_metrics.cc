@@ -146,7 +146,7 @@ TextScores CompareTexts(const std::string& reference_utf8, const std::string& re
 namespace {
 
 // What a search passes over at a word's ends: ASCII's punctuation, Latin-1's
-// signs (« » ¡ ¿ § …) and the General Punctuation block (curly quotes,
+// signs (« » ¡ ¿ °) and the General Punctuation block (curly quotes,
 // dashes, the ellipsis).
 bool IsEdgePunctuation(char32_t c) {
   if (c < 128) return !std::isalnum(int(c));
