@@ -66,6 +66,12 @@ TextSize EstimateTextSize(const std::vector<Word>& words, const std::vector<Text
   } else if (heights.size() >= o.min_words) {
     size.cue = "word height";
     size.em_px = size.word_height_px / o.word_height_em;
+    // Both cues err on the large side (a blurred word's box grows, a line's
+    // pitch grows with its leading and a table's rows), so the smaller wins.
+    if (size.line_pitch_px > 0 && size.line_pitch_px / o.line_pitch_em < size.em_px) {
+      size.cue = "line pitch (below the word height's)";
+      size.em_px = size.line_pitch_px / o.line_pitch_em;
+    }
   } else if (size.line_pitch_px > 0) {
     size.cue = "line pitch";
     size.em_px = size.line_pitch_px / o.line_pitch_em;

@@ -56,14 +56,17 @@ struct TextSizeOptions {
   // A word boxed this close to its line's pitch (the distance to the nearer
   // neighbouring line of its block; the page's median pitch for a word of
   // no known line) or taller spans more than a line: its height is not the
-  // text's. Too few words left and the text's size is the line pitch's.
+  // text's. Too few words left and the text's size is the line pitch's; so
+  // it is where the pitch gives a smaller size than the word height.
   double max_word_height_of_pitch = 0.9;
   size_t min_line_pairs = 5;
 };
 
 struct TextSize {
-  double em_px = 0;           // 0: not measured
-  std::string cue;            // "word height", "line pitch" or why not measured
+  double em_px = 0;  // 0: not measured
+  // "word height", "line pitch", "line pitch (below the word height's)" or
+  // why not measured.
+  std::string cue;
   size_t words = 0;           // body words
   double word_height_px = 0;  // median over the body words within their line (0: none)
   double line_pitch_px = 0;   // median over neighbouring lines of a block (0: too few)

@@ -4,9 +4,11 @@
 // enhancements, and bad input.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
 #include <memory>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "common/json_io.h"
 #include "tests/pdf/pdf_checks.h"
@@ -249,6 +251,28 @@ TEST_F(PdfCli, PageFormatNoneTakesTheImageAtTheGivenDpi) {
   ASSERT_EQ(pages.size(), 1u);
   EXPECT_NEAR(pages[0].width_pt, page_.cols / 100.0 * 72, 0.01);
   EXPECT_NEAR(pages[0].height_pt, page_.rows / 100.0 * 72, 0.01);
+}
+
+// A letter rendered a little blurred: Tesseract boxes its words 0.83 of a
+// line pitch high, which taken for 0.75 em would make its 10 pt print 15 pt
+// on A4, and the page A5. The lines' pitch keeps it A4.
+TEST_F(PdfCli, ABlurredLetterIsStillA4) {
+  const CommandResult made =
+      RunCommand(Quote(StageBinary("synth").string()) + " --seed 5102 --kind text --creases 0 " +
+                 "--views 1 --width 320 --height 240 --out " + Quote((dir_ / "data").string()));
+  ASSERT_EQ(made.exit_code, 0) << made.output;
+  const cv::Mat flat = cv::imread((dir_ / "data/ground_truth/flat.png").string());
+  ASSERT_FALSE(flat.empty());
+  cv::Mat page;
+  cv::resize(flat, page, cv::Size(900, int(std::lround(flat.rows * 900.0 / flat.cols))), 0, 0,
+             cv::INTER_AREA);
+  cv::GaussianBlur(page, page, cv::Size(), 0.8);
+  const fs::path render = WriteRenderDir(dir_ / "blurred", page);
+  const CommandResult r = Pdf(render, dir_ / "blurred/80_pdf");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const Json report = ReadJsonFile(dir_ / "blurred/80_pdf/pdf.json");
+  EXPECT_EQ(report["page"]["format"], "a4") << report["text"]["size"].dump();
+  EXPECT_NEAR(report["page"]["text_pt"].get<double>(), 10.5, 1.5);
 }
 
 TEST_F(PdfCli, NoRenderedPageIsBadInput) {

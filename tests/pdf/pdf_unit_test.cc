@@ -135,11 +135,20 @@ std::vector<TextLine> Lines(int n, double pitch) {
 }
 
 TEST(TextSize, FromWordHeights) {
-  const TextSize s = EstimateTextSize(BodyWords(30, 24), Lines(10, 40));
+  const TextSize s = EstimateTextSize(BodyWords(30, 24), Lines(10, 48));
   EXPECT_EQ(s.cue, "word height");
   EXPECT_DOUBLE_EQ(s.em_px, 24 / 0.75);
   EXPECT_EQ(s.words, 30u);
-  EXPECT_NEAR(s.line_pitch_px, 40, 1e-9);
+  EXPECT_NEAR(s.line_pitch_px, 48, 1e-9);
+}
+
+TEST(TextSize, TheSmallerOfTheTwoCuesWins) {
+  // Blurred print: words boxed 24 px high on lines 30 px apart say 32 px to
+  // the em, the lines 22.2.
+  const TextSize s = EstimateTextSize(BodyWords(30, 24), Lines(10, 30));
+  EXPECT_EQ(s.cue, "line pitch (below the word height's)");
+  EXPECT_NEAR(s.em_px, 30 / 1.35, 1e-9);
+  EXPECT_NEAR(s.word_height_px, 24, 1e-9);
 }
 
 TEST(TextSize, FromLinePitchWhenWordBoxesSpanLines) {
@@ -149,11 +158,11 @@ TEST(TextSize, FromLinePitchWhenWordBoxesSpanLines) {
 }
 
 TEST(TextSize, WordsBoxedTallerThanTheirLinesAreApartAreLeftOut) {
-  // A table of 10 rows 40 px apart with 25 words 24 px high, and a paragraph
+  // A table of 10 rows 48 px apart with 25 words 24 px high, and a paragraph
   // of 4 lines 16 px apart whose 30 words Tesseract boxed 28 px high: the
   // paragraph's words say nothing of the text's height, though the median
   // over all words and lines would take them.
-  std::vector<TextLine> lines = Lines(10, 40);
+  std::vector<TextLine> lines = Lines(10, 48);
   for (TextLine& l : Lines(4, 16)) {
     l.block = 1;
     l.box.y += 500;
