@@ -70,8 +70,10 @@ struct SameShotOptions {
   // Of them, at least this share within max_error_px of one similarity.
   double min_similarity_share = 0.9;
   // ... or of one homography that maps one frame's corners inside the
-  // other's frame (to within frame_margin of its size).
-  double min_perspective_share = 0.75;
+  // other's frame (to within frame_margin of its size). A copy's matches
+  // all fit it; a closer photo's fit it on a textured table's plane, not
+  // on the page's creases.
+  double min_perspective_share = 0.95;
   double max_error_px = 2.0;  // pixels of the copies COLMAP read
   double frame_margin = 0.02;
 };

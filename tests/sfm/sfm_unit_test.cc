@@ -744,6 +744,63 @@ TEST(ExactMatchingTest, EditedAndScannedCopiesAreTheSameShotAndASecondViewIsNot)
   EXPECT_EQ(sfm::SameShots(db_file, options).size(), 3u);
 }
 
+// A second photo taken closer, from nearly straight above, of a creased page
+// on a granite table: most matches lie on the table, whose plane a homography
+// maps, and its frame lies inside the first photo's; but the page's matches
+// stand off that plane by their parallax. A copy's matches all fit its map.
+TEST(ExactMatchingTest, ACloserSecondPhotoOfACreasedPageOnATexturedTableIsNotACopy) {
+  TempDir tmp;
+  const fs::path db_file = tmp.path() / "database.db";
+  MakeDatabase(db_file, {{1, "IMG_0001.png"}, {2, "IMG_0002.png"}});
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open(db_file.c_str(), &db), SQLITE_OK);
+  ASSERT_EQ(sqlite3_exec(db,
+                         "DELETE FROM keypoints; CREATE TABLE two_view_geometries (pair_id "
+                         "INTEGER PRIMARY KEY NOT NULL, rows INTEGER NOT NULL, cols INTEGER NOT "
+                         "NULL, data BLOB, config INTEGER NOT NULL);",
+                         nullptr, nullptr, nullptr),
+            SQLITE_OK);
+  // The closer photo sees the middle of the first one's, enlarged 1.4 times.
+  const cv::Matx33f closer_from_first(1.4f, 0.05f, -340, -0.04f, 1.4f, -230, 2e-5f, 1e-5f, 1);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> x(450, 1150), y(330, 870);
+  std::normal_distribution<float> noise(0, 0.3f);
+  std::vector<std::vector<float>> keypoints(2);
+  for (int i = 0; i < 200; ++i) {
+    const cv::Point2f p(x(rng), y(rng));
+    const cv::Vec3f q = closer_from_first * cv::Vec3f(p.x, p.y, 1);
+    // 13 % on the page, 6-30 px off the table's plane.
+    const float parallax = i % 8 == 0 ? 6 + float(i % 25) : 0;
+    keypoints[0].insert(keypoints[0].end(), {p.x, p.y, 1, 0, 0, 1});
+    keypoints[1].insert(keypoints[1].end(), {q[0] / q[2] + noise(rng) + parallax,
+                                             q[1] / q[2] + noise(rng), 1, 0, 0, 1});
+  }
+  sqlite3_stmt* stmt = nullptr;
+  ASSERT_EQ(
+      sqlite3_prepare_v2(db, "INSERT INTO keypoints VALUES (?, 200, 6, ?)", -1, &stmt, nullptr),
+      SQLITE_OK);
+  for (int k = 0; k < 2; ++k) {
+    sqlite3_bind_int(stmt, 1, k + 1);
+    sqlite3_bind_blob(stmt, 2, keypoints[size_t(k)].data(), 200 * 6 * sizeof(float),
+                      SQLITE_TRANSIENT);
+    EXPECT_EQ(sqlite3_step(stmt), SQLITE_DONE);
+    sqlite3_reset(stmt);
+  }
+  sqlite3_finalize(stmt);
+  std::vector<uint32_t> matches;
+  for (uint32_t i = 0; i < 200; ++i) matches.insert(matches.end(), {i, i});
+  ASSERT_EQ(sqlite3_prepare_v2(db, "INSERT INTO two_view_geometries VALUES (?, 200, 2, ?, 6)", -1,
+                               &stmt, nullptr),
+            SQLITE_OK);
+  sqlite3_bind_int64(stmt, 1, 1L * 2147483647L + 2);
+  sqlite3_bind_blob(stmt, 2, matches.data(), int(matches.size() * sizeof(uint32_t)),
+                    SQLITE_TRANSIENT);
+  EXPECT_EQ(sqlite3_step(stmt), SQLITE_DONE);
+  sqlite3_finalize(stmt);
+  sqlite3_close(db);
+  EXPECT_TRUE(sfm::SameShots(db_file, sfm::SameShotOptions{}).empty());
+}
+
 TEST(ExactMatchingTest, BadDatabasesAreErrorsNamingTheFile) {
   TempDir tmp;
   const fs::path db = tmp.path() / "short.db";
