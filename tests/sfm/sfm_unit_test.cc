@@ -650,6 +650,54 @@ TEST(ExactMatchingTest, ViewsLinkedByVerifiedMatchesFallIntoGroups) {
       (Groups{{"b0.jpg", "b1.jpg"}, {"a0.jpg"}, {"a1.jpg"}, {"a2.jpg"}, {"b2.jpg"}, {"cat.jpg"}}));
 }
 
+// Gives a database made by MakeDatabase 200 keypoints per image (x, y of
+// each) and a two_view_geometries table: each pair (image ids, rows) has its
+// first `rows` keypoints matched one to one as verified matches. `sql` runs
+// first (cameras for the images, say).
+void AddVerifiedMatches(const fs::path& db_file, const std::vector<std::vector<float>>& xy,
+                        const std::vector<std::tuple<long, long, int>>& pairs,
+                        const std::string& sql = "") {
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open(db_file.c_str(), &db), SQLITE_OK);
+  ASSERT_EQ(sqlite3_exec(db,
+                         ("DELETE FROM keypoints; CREATE TABLE two_view_geometries (pair_id "
+                          "INTEGER PRIMARY KEY NOT NULL, rows INTEGER NOT NULL, cols INTEGER NOT "
+                          "NULL, data BLOB, config INTEGER NOT NULL);" +
+                          sql)
+                             .c_str(),
+                         nullptr, nullptr, nullptr),
+            SQLITE_OK);
+  sqlite3_stmt* stmt = nullptr;
+  ASSERT_EQ(
+      sqlite3_prepare_v2(db, "INSERT INTO keypoints VALUES (?, 200, 6, ?)", -1, &stmt, nullptr),
+      SQLITE_OK);
+  for (size_t k = 0; k < xy.size(); ++k) {
+    ASSERT_EQ(xy[k].size(), 400u);
+    std::vector<float> rows;  // x, y, scale, orientation as COLMAP's affine shape
+    for (size_t i = 0; i < 200; ++i)
+      rows.insert(rows.end(), {xy[k][2 * i], xy[k][2 * i + 1], 1, 0, 0, 1});
+    sqlite3_bind_int(stmt, 1, int(k + 1));
+    sqlite3_bind_blob(stmt, 2, rows.data(), int(rows.size() * sizeof(float)), SQLITE_TRANSIENT);
+    EXPECT_EQ(sqlite3_step(stmt), SQLITE_DONE);
+    sqlite3_reset(stmt);
+  }
+  sqlite3_finalize(stmt);
+  std::vector<uint32_t> matches;
+  for (uint32_t i = 0; i < 200; ++i) matches.insert(matches.end(), {i, i});
+  ASSERT_EQ(sqlite3_prepare_v2(db, "INSERT INTO two_view_geometries VALUES (?, ?, 2, ?, 6)", -1,
+                               &stmt, nullptr),
+            SQLITE_OK);
+  for (const auto& [a, b, rows] : pairs) {
+    sqlite3_bind_int64(stmt, 1, a * 2147483647L + b);
+    sqlite3_bind_int(stmt, 2, rows);
+    sqlite3_bind_blob(stmt, 3, matches.data(), int(rows * 2 * sizeof(uint32_t)), SQLITE_TRANSIENT);
+    EXPECT_EQ(sqlite3_step(stmt), SQLITE_DONE);
+    sqlite3_reset(stmt);
+  }
+  sqlite3_finalize(stmt);
+  sqlite3_close(db);
+}
+
 // A phone's edited copy (the photo cropped, turned and scaled) is one shot
 // with its photo: a similarity takes their matches onto each other. So is a
 // scanner app's copy (the page cut out of the photo and straightened): a
@@ -662,16 +710,6 @@ TEST(ExactMatchingTest, EditedAndScannedCopiesAreTheSameShotAndASecondViewIsNot)
   MakeDatabase(
       db_file,
       {{1, "IMG_0001.png"}, {2, "IMG_E0001.png"}, {3, "IMG_0002.png"}, {4, "Scan 2026-12-06.png"}});
-  sqlite3* db = nullptr;
-  ASSERT_EQ(sqlite3_open(db_file.c_str(), &db), SQLITE_OK);
-  ASSERT_EQ(sqlite3_exec(db,
-                         "DELETE FROM keypoints; CREATE TABLE two_view_geometries (pair_id "
-                         "INTEGER PRIMARY KEY NOT NULL, rows INTEGER NOT NULL, cols INTEGER NOT "
-                         "NULL, data BLOB, config INTEGER NOT NULL); INSERT INTO cameras VALUES "
-                         "(2, 0, 1000, 1400, NULL, 0); UPDATE images SET camera_id = 2 WHERE "
-                         "image_id = 4;",
-                         nullptr, nullptr, nullptr),
-            SQLITE_OK);
   // The page in the photo, and the scan: that quadrilateral made the frame.
   const std::vector<cv::Point2f> page = {{300, 180}, {1280, 240}, {1330, 1010}, {250, 960}};
   const cv::Matx33f scan_from_photo(cv::getPerspectiveTransform(
@@ -688,44 +726,22 @@ TEST(ExactMatchingTest, EditedAndScannedCopiesAreTheSameShotAndASecondViewIsNot)
   // the page seen from elsewhere (a homography).
   const cv::Matx33f copy_from_photo(0, -1.3f, 1200 * 1.3f - 100, 1.3f, 0, -150, 0, 0, 1);
   const cv::Matx33f view_from_photo(0.9f, 0.12f, 40, -0.05f, 1.05f, 20, 4e-5f, 6e-5f, 1);
-  std::vector<std::vector<float>> keypoints(4);
+  std::vector<std::vector<float>> xy(4);
   for (const cv::Point2f& p : photo) {
-    keypoints[0].insert(keypoints[0].end(), {p.x, p.y, 1, 0, 0, 1});
+    xy[0].insert(xy[0].end(), {p.x, p.y});
     for (const auto& [k, h] :
          {std::pair{1, copy_from_photo}, {2, view_from_photo}, {3, scan_from_photo}}) {
       const cv::Vec3f q = h * cv::Vec3f(p.x, p.y, 1);
-      keypoints[size_t(k)].insert(keypoints[size_t(k)].end(),
-                                  {q[0] / q[2] + noise(rng), q[1] / q[2] + noise(rng), 1, 0, 0, 1});
+      xy[size_t(k)].insert(xy[size_t(k)].end(),
+                           {q[0] / q[2] + noise(rng), q[1] / q[2] + noise(rng)});
     }
   }
-  sqlite3_stmt* stmt = nullptr;
-  ASSERT_EQ(
-      sqlite3_prepare_v2(db, "INSERT INTO keypoints VALUES (?, 200, 6, ?)", -1, &stmt, nullptr),
-      SQLITE_OK);
-  for (int k = 0; k < 4; ++k) {
-    sqlite3_bind_int(stmt, 1, k + 1);
-    sqlite3_bind_blob(stmt, 2, keypoints[size_t(k)].data(), 200 * 6 * sizeof(float),
-                      SQLITE_TRANSIENT);
-    EXPECT_EQ(sqlite3_step(stmt), SQLITE_DONE);
-    sqlite3_reset(stmt);
-  }
-  sqlite3_finalize(stmt);
-  // Every keypoint matched to its own, in each pair; 1-3 with 40 only.
-  std::vector<uint32_t> matches;
-  for (uint32_t i = 0; i < 200; ++i) matches.insert(matches.end(), {i, i});
-  ASSERT_EQ(sqlite3_prepare_v2(db, "INSERT INTO two_view_geometries VALUES (?, ?, 2, ?, 6)", -1,
-                               &stmt, nullptr),
-            SQLITE_OK);
-  for (const auto& [a, b, rows] :
-       {std::tuple{1L, 2L, 200}, {2L, 3L, 200}, {1L, 3L, 40}, {1L, 4L, 200}, {3L, 4L, 200}}) {
-    sqlite3_bind_int64(stmt, 1, a * 2147483647L + b);
-    sqlite3_bind_int(stmt, 2, rows);
-    sqlite3_bind_blob(stmt, 3, matches.data(), int(rows * 2 * sizeof(uint32_t)), SQLITE_TRANSIENT);
-    EXPECT_EQ(sqlite3_step(stmt), SQLITE_DONE);
-    sqlite3_reset(stmt);
-  }
-  sqlite3_finalize(stmt);
-  sqlite3_close(db);
+  // Every keypoint matched to its own, in each pair; 1-3 with 40 only. The
+  // scan is 1000 x 1400.
+  AddVerifiedMatches(
+      db_file, xy, {{1, 2, 200}, {2, 3, 200}, {1, 3, 40}, {1, 4, 200}, {3, 4, 200}},
+      "INSERT INTO cameras VALUES (2, 0, 1000, 1400, NULL, 0); UPDATE images SET camera_id = 2 "
+      "WHERE image_id = 4;");
 
   sfm::SameShotOptions options;
   const std::vector<sfm::SameShot> shots = sfm::SameShots(db_file, options);
@@ -752,52 +768,21 @@ TEST(ExactMatchingTest, ACloserSecondPhotoOfACreasedPageOnATexturedTableIsNotACo
   TempDir tmp;
   const fs::path db_file = tmp.path() / "database.db";
   MakeDatabase(db_file, {{1, "IMG_0001.png"}, {2, "IMG_0002.png"}});
-  sqlite3* db = nullptr;
-  ASSERT_EQ(sqlite3_open(db_file.c_str(), &db), SQLITE_OK);
-  ASSERT_EQ(sqlite3_exec(db,
-                         "DELETE FROM keypoints; CREATE TABLE two_view_geometries (pair_id "
-                         "INTEGER PRIMARY KEY NOT NULL, rows INTEGER NOT NULL, cols INTEGER NOT "
-                         "NULL, data BLOB, config INTEGER NOT NULL);",
-                         nullptr, nullptr, nullptr),
-            SQLITE_OK);
   // The closer photo sees the middle of the first one's, enlarged 1.4 times.
   const cv::Matx33f closer_from_first(1.4f, 0.05f, -340, -0.04f, 1.4f, -230, 2e-5f, 1e-5f, 1);
   std::mt19937 rng(11);
   std::uniform_real_distribution<float> x(450, 1150), y(330, 870);
   std::normal_distribution<float> noise(0, 0.3f);
-  std::vector<std::vector<float>> keypoints(2);
+  std::vector<std::vector<float>> xy(2);
   for (int i = 0; i < 200; ++i) {
     const cv::Point2f p(x(rng), y(rng));
     const cv::Vec3f q = closer_from_first * cv::Vec3f(p.x, p.y, 1);
-    // 13 % on the page, 6-30 px off the table's plane.
+    // One in eight on the page, 6-30 px off the table's plane.
     const float parallax = i % 8 == 0 ? 6 + float(i % 25) : 0;
-    keypoints[0].insert(keypoints[0].end(), {p.x, p.y, 1, 0, 0, 1});
-    keypoints[1].insert(keypoints[1].end(), {q[0] / q[2] + noise(rng) + parallax,
-                                             q[1] / q[2] + noise(rng), 1, 0, 0, 1});
+    xy[0].insert(xy[0].end(), {p.x, p.y});
+    xy[1].insert(xy[1].end(), {q[0] / q[2] + noise(rng) + parallax, q[1] / q[2] + noise(rng)});
   }
-  sqlite3_stmt* stmt = nullptr;
-  ASSERT_EQ(
-      sqlite3_prepare_v2(db, "INSERT INTO keypoints VALUES (?, 200, 6, ?)", -1, &stmt, nullptr),
-      SQLITE_OK);
-  for (int k = 0; k < 2; ++k) {
-    sqlite3_bind_int(stmt, 1, k + 1);
-    sqlite3_bind_blob(stmt, 2, keypoints[size_t(k)].data(), 200 * 6 * sizeof(float),
-                      SQLITE_TRANSIENT);
-    EXPECT_EQ(sqlite3_step(stmt), SQLITE_DONE);
-    sqlite3_reset(stmt);
-  }
-  sqlite3_finalize(stmt);
-  std::vector<uint32_t> matches;
-  for (uint32_t i = 0; i < 200; ++i) matches.insert(matches.end(), {i, i});
-  ASSERT_EQ(sqlite3_prepare_v2(db, "INSERT INTO two_view_geometries VALUES (?, 200, 2, ?, 6)", -1,
-                               &stmt, nullptr),
-            SQLITE_OK);
-  sqlite3_bind_int64(stmt, 1, 1L * 2147483647L + 2);
-  sqlite3_bind_blob(stmt, 2, matches.data(), int(matches.size() * sizeof(uint32_t)),
-                    SQLITE_TRANSIENT);
-  EXPECT_EQ(sqlite3_step(stmt), SQLITE_DONE);
-  sqlite3_finalize(stmt);
-  sqlite3_close(db);
+  AddVerifiedMatches(db_file, xy, {{1, 2, 200}});
   EXPECT_TRUE(sfm::SameShots(db_file, sfm::SameShotOptions{}).empty());
 }
 
