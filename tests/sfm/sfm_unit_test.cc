@@ -673,7 +673,7 @@ void AddVerifiedMatches(const fs::path& db_file, const std::vector<std::vector<f
       SQLITE_OK);
   for (size_t k = 0; k < xy.size(); ++k) {
     ASSERT_EQ(xy[k].size(), 400u);
-    std::vector<float> rows;  // x, y, scale, orientation as COLMAP's affine shape
+    std::vector<float> rows;  // x, y and an identity affine shape (COLMAP's 6 columns)
     for (size_t i = 0; i < 200; ++i)
       rows.insert(rows.end(), {xy[k][2 * i], xy[k][2 * i + 1], 1, 0, 0, 1});
     sqlite3_bind_int(stmt, 1, int(k + 1));
