@@ -544,6 +544,12 @@ TEST(ExactMatchingTest, TheAvx2KernelGivesThePortableOnesMatches) {
   }
 }
 
+// COLMAP's table of verified pairs, and its id of the pair of images a < b.
+constexpr char kTwoViewGeometriesTable[] =
+    "CREATE TABLE two_view_geometries (pair_id INTEGER PRIMARY KEY NOT NULL, rows INTEGER NOT "
+    "NULL, cols INTEGER NOT NULL, data BLOB, config INTEGER NOT NULL);";
+long ColmapPairId(long a, long b) { return a * 2147483647L + b; }
+
 // A COLMAP-like database: images, keypoints and descriptors tables.
 void MakeDatabase(const fs::path& file, const std::vector<std::pair<int, std::string>>& images,
                   int descriptor_bytes = 128) {
@@ -622,11 +628,9 @@ TEST(ExactMatchingTest, ViewsLinkedByVerifiedMatchesFallIntoGroups) {
                     {5, "b1.jpg"},
                     {6, "b2.jpg"},
                     {7, "cat.jpg"}});
-  std::string sql =
-      "CREATE TABLE two_view_geometries (pair_id INTEGER PRIMARY KEY NOT NULL, rows INTEGER NOT "
-      "NULL, cols INTEGER NOT NULL, data BLOB, config INTEGER NOT NULL);";
+  std::string sql = kTwoViewGeometriesTable;
   auto pair = [&](long a, long b, int rows, int config) {
-    sql += "INSERT INTO two_view_geometries VALUES (" + std::to_string(a * 2147483647L + b) + ", " +
+    sql += "INSERT INTO two_view_geometries VALUES (" + std::to_string(ColmapPairId(a, b)) + ", " +
            std::to_string(rows) + ", 2, NULL, " + std::to_string(config) + ");";
   };
   pair(1, 2, 400, 6);  // a0-a1-a2: a chain
@@ -659,13 +663,9 @@ void AddVerifiedMatches(const fs::path& db_file, const std::vector<std::vector<f
                         const std::string& sql = "") {
   sqlite3* db = nullptr;
   ASSERT_EQ(sqlite3_open(db_file.c_str(), &db), SQLITE_OK);
-  ASSERT_EQ(sqlite3_exec(db,
-                         ("DELETE FROM keypoints; CREATE TABLE two_view_geometries (pair_id "
-                          "INTEGER PRIMARY KEY NOT NULL, rows INTEGER NOT NULL, cols INTEGER NOT "
-                          "NULL, data BLOB, config INTEGER NOT NULL);" +
-                          sql)
-                             .c_str(),
-                         nullptr, nullptr, nullptr),
+  ASSERT_EQ(sqlite3_exec(
+                db, ("DELETE FROM keypoints;" + std::string(kTwoViewGeometriesTable) + sql).c_str(),
+                nullptr, nullptr, nullptr),
             SQLITE_OK);
   sqlite3_stmt* stmt = nullptr;
   ASSERT_EQ(
@@ -688,7 +688,7 @@ void AddVerifiedMatches(const fs::path& db_file, const std::vector<std::vector<f
                                &stmt, nullptr),
             SQLITE_OK);
   for (const auto& [a, b, rows] : pairs) {
-    sqlite3_bind_int64(stmt, 1, a * 2147483647L + b);
+    sqlite3_bind_int64(stmt, 1, ColmapPairId(a, b));
     sqlite3_bind_int(stmt, 2, rows);
     sqlite3_bind_blob(stmt, 3, matches.data(), int(rows * 2 * sizeof(uint32_t)), SQLITE_TRANSIENT);
     EXPECT_EQ(sqlite3_step(stmt), SQLITE_DONE);
